@@ -1,0 +1,66 @@
+"""Closed-loop speed: wall milliseconds per simulated second of `navsim.run` at vector fidelity.
+
+Configurations (600 s each): gyro and star-sensor attitude fixes both at 10 Hz (the set-up in
+which Basilisk's C core with its UKF took 0.35-0.47 ms per simulated second on this kind of
+machine), the same with star-vector updates, and a 100 Hz gyro with 10 Hz fixes. The first run
+of each configuration is a warm-up (numba compilation or cache load) and is not counted.
+
+    python benchmarks/closed_loop.py [--repeats 3]
+
+Prints a table and writes benchmarks/results/closed_loop.json. Asserts nothing.
+"""
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+
+import navsim
+
+SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "demo.toml"
+BASILISK_MS_PER_SIM_S = (0.35, 0.47)
+
+CONFIGS = {
+    "gyro10_fix10_attitude": {"gyro.rate_hz": 10.0, "star_sensor.rate_hz": 10.0, "truth.rate_hz": 40.0,
+                              "star_sensor.measurement": "attitude"},
+    "gyro10_fix10_stars": {"gyro.rate_hz": 10.0, "star_sensor.rate_hz": 10.0, "truth.rate_hz": 40.0,
+                           "star_sensor.measurement": "stars"},
+    "gyro100_fix10_attitude": {"gyro.rate_hz": 100.0, "star_sensor.rate_hz": 10.0, "truth.rate_hz": 400.0,
+                               "star_sensor.measurement": "attitude"},
+}
+
+
+def measure(overrides, duration_s, repeats):
+    overrides = {**overrides, "duration_s": duration_s}
+    navsim.run(SCENARIO, seed=0, overrides=overrides)  # warm-up
+    times = []
+    for seed in range(repeats):
+        start = time.perf_counter()
+        navsim.run(SCENARIO, seed=seed, overrides=overrides)
+        times.append(time.perf_counter() - start)
+    best = min(times)
+    return {"duration_s": duration_s, "wall_s": times, "ms_per_sim_s_best": 1e3 * best / duration_s,
+            "ms_per_sim_s_median": 1e3 * sorted(times)[len(times) // 2] / duration_s}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--duration-s", type=float, default=600.0)
+    args = parser.parse_args()
+    results = {name: measure(o, args.duration_s, args.repeats) for name, o in CONFIGS.items()}
+    print(f"{'configuration':28s} {'ms / simulated s (best)':>24s} {'median':>8s}")
+    for name, r in results.items():
+        print(f"{name:28s} {r['ms_per_sim_s_best']:24.3f} {r['ms_per_sim_s_median']:8.3f}")
+    print(f"Basilisk (C core, UKF, gyro + fixes at 10 Hz): {BASILISK_MS_PER_SIM_S[0]}-{BASILISK_MS_PER_SIM_S[1]} ms / simulated s")
+    out = Path(__file__).resolve().parent / "results" / "closed_loop.json"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    payload = {"machine": platform.platform(), "python": platform.python_version(),
+               "basilisk_ms_per_sim_s": BASILISK_MS_PER_SIM_S, "results": results}
+    out.write_text(json.dumps(payload, indent=2) + "\n")
+    print(f"written {out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,131 @@
+"""From a validated scenario (units in key names) to model objects in SI units."""
+
+import numpy as np
+
+from navsim import quaternion as quat
+from navsim import units
+from navsim.filter import AttitudeFilter
+from navsim.gyro import GyroModel, bias_instability_to_sigma
+from navsim.star_sensor import AttitudeFixSensor, StarVectorSensor
+from navsim.truth import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
+
+
+def truth_profile(scenario):
+    """The truth-motion strategy object of ``scenario['truth']``."""
+    truth = scenario["truth"]
+    profile = truth["profile"]
+    spec = truth[profile]
+    if profile == "constant_rate":
+        return ConstantRate(rate=tuple(units.deg_to_rad(spec["rate_deg_per_s"])))
+    if profile == "sinusoidal_axis":
+        return SinusoidalAxis(
+            axis=tuple(spec["axis"]),
+            theta0=float(units.deg_to_rad(spec["theta0_deg"])),
+            amplitude=float(units.deg_to_rad(spec["amplitude_deg"])),
+            angular_frequency=spec["angular_frequency_rad_per_s"],
+            phase=float(units.deg_to_rad(spec["phase_deg"])),
+        )
+    if profile == "rate_segments":
+        return RateSegments(
+            segments=tuple(
+                (s["duration_s"], tuple(units.deg_to_rad(s["rate_deg_per_s"]))) for s in spec["segments"]
+            )
+        )
+    return RigidBody(
+        inertia=tuple(map(tuple, spec["inertia_kg_m2"])),
+        initial_rate=tuple(units.deg_to_rad(spec["initial_rate_deg_per_s"])),
+        torque_segments=tuple((s["duration_s"], tuple(s["torque_N_m"])) for s in spec["torque_segments"]),
+    )
+
+
+def gyro_model(scenario):
+    """The gyro of ``scenario['gyro']``: a preset (if named) with any given field overriding it."""
+    g = scenario["gyro"]
+    base = GyroModel.preset(g["preset"], g["rate_hz"]) if g.get("preset") else GyroModel(rate_hz=g["rate_hz"])
+    fields = {
+        "arw_deg_per_sqrt_h": ("arw", units.arw_to_si),
+        "rrw_deg_per_h_per_sqrt_h": ("rrw", units.rrw_to_si),
+        "bias_turn_on_deg_per_h": ("bias_turn_on_sigma", units.deg_per_h_to_rad_per_s),
+        "bias_instability_deg_per_h": ("bias_instability_sigma", _bias_instability),
+        "bias_correlation_s": ("bias_correlation_time", float),
+        "scale_factor_ppm": ("scale_factor_sigma", lambda v: v * 1e-6),
+        "misalignment_arcsec": ("misalignment_sigma", units.arcsec_to_rad),
+        "quantization_arcsec": ("quantization", units.arcsec_to_rad),
+        "saturation_deg_per_s": ("saturation", units.deg_to_rad),
+    }
+    changes = {name: float(convert(g[key])) for key, (name, convert) in fields.items() if g.get(key) is not None}
+    return GyroModel(**{**base.__dict__, **changes})
+
+
+def _bias_instability(deg_per_h):
+    return bias_instability_to_sigma(units.deg_per_h_to_rad_per_s(deg_per_h))
+
+
+def mounting(scenario):
+    """(q_BS nominal, q_BS true) from the sensor's mounting rotation vector and misalignment."""
+    sensor = scenario["star_sensor"]
+    q_BS = quat.from_rotation_vector(units.deg_to_rad(sensor["mounting_rotvec_deg"]))
+    q_BS_true = quat.multiply(q_BS, quat.from_rotation_vector(units.arcsec_to_rad(sensor["misalignment_arcsec"])))
+    return q_BS, q_BS_true
+
+
+def star_sensor(scenario, star_catalog):
+    """The vector-fidelity sensor of ``scenario['star_sensor']``; ``star_catalog`` is a
+    :class:`startrack.star_catalog.StarCatalog` (used for the 'stars' measurement)."""
+    sensor = scenario["star_sensor"]
+    _, q_BS_true = mounting(scenario)
+    if sensor["measurement"] == "attitude":
+        return AttitudeFixSensor(
+            sigma_cross=float(units.arcsec_to_rad(sensor["attitude_sigma_cross_arcsec"])),
+            sigma_roll=float(units.arcsec_to_rad(sensor["attitude_sigma_roll_arcsec"])),
+            q_BS_true=q_BS_true,
+        )
+    stars = star_catalog.brighter_than(sensor["mag_limit"])
+    return StarVectorSensor(
+        star_vectors=np.asarray(stars.vectors),
+        star_ids=np.asarray(stars.hip),
+        star_mags=np.asarray(stars.v_mag),
+        fov=float(units.deg_to_rad(sensor["fov_deg"])),
+        sigma=float(units.arcsec_to_rad(sensor["star_sigma_arcsec"])),
+        max_stars=sensor["max_stars"],
+        q_BS_true=q_BS_true,
+    )
+
+
+def initial_covariance(scenario, gyro):
+    """P0 (n x n) from the filter's initial σ; defaults follow the gyro's own errors."""
+    f = scenario["filter"]
+    sigma_att = float(units.deg_to_rad(f["initial_attitude_sigma_deg"]))
+    if f["initial_bias_sigma_deg_per_h"] is not None:
+        sigma_bias = float(units.deg_per_h_to_rad_per_s(f["initial_bias_sigma_deg_per_h"]))
+    else:
+        sigma_bias = float(np.hypot(gyro.bias_turn_on_sigma, gyro.bias_instability_sigma))
+        sigma_bias = max(sigma_bias, float(units.deg_per_h_to_rad_per_s(0.001)))
+    diag = [sigma_att**2] * 3 + [sigma_bias**2] * 3
+    if f["estimate_scale_factor"]:
+        ppm = f["initial_scale_factor_sigma_ppm"] or max(gyro.scale_factor_sigma * 1e6, 1.0)
+        diag += [(ppm * 1e-6) ** 2] * 3
+    if f["estimate_misalignment"]:
+        arcsec = f["initial_misalignment_sigma_arcsec"] or 60.0
+        diag += [float(units.arcsec_to_rad(arcsec)) ** 2] * 3
+    return np.diag(diag)
+
+
+def attitude_filter(scenario, gyro, q0, P0):
+    """The MEKF of ``scenario['filter']`` starting from attitude q0, zero bias and P0."""
+    f = scenario["filter"]
+    q_BS, _ = mounting(scenario)
+    arw = gyro.arw if f["arw_deg_per_sqrt_h"] is None else float(units.arw_to_si(f["arw_deg_per_sqrt_h"]))
+    rrw = gyro.filter_rrw if f["rrw_deg_per_h_per_sqrt_h"] is None else float(units.rrw_to_si(f["rrw_deg_per_h_per_sqrt_h"]))
+    return AttitudeFilter(
+        q=q0,
+        b=np.zeros(3),
+        P=P0,
+        arw=arw,
+        rrw=rrw,
+        q_BS=q_BS,
+        estimate_scale_factor=f["estimate_scale_factor"],
+        estimate_misalignment=f["estimate_misalignment"],
+        process_noise_scale=f["process_noise_scale"],
+        gate_probability=f["gate_probability"],
+    )

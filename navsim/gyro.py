@@ -1,0 +1,175 @@
+"""Three-axis rate-integrating gyro model.
+
+Output sample k is the measured rate averaged over its interval [t_(k-1), t_k] of length Δt
+(a delta-angle divided by Δt):
+
+    ω̃_k = (I + S)(I + M) ω̄_k + b_c + ½(b_(k-1) + b_k) + ½(g_(k-1) + g_k) + n_k
+
+- ω̄_k: true mean body rate over the interval; S = diag(scale-factor errors); M: small
+  misalignment / non-orthogonality (off-diagonal) matrix; b_c: turn-on bias (constant).
+- b_k: rate random walk, b_k = b_(k-1) + σ_u √Δt N(0, I).
+- n_k: angle random walk plus the in-interval part of the bias walk,
+  σ = (σ_v²/Δt + σ_u² Δt/12)^½ — the exact discretisation of the continuous model
+  ω̃ = ω + β + η_v, β̇ = η_u (Farrenkopf 1978; Crassidis & Junkins, *Optimal Estimation of
+  Dynamic Systems*, 2nd ed., §7.2.1).
+- g_k: bias instability as a first-order Gauss-Markov process with steady σ_g and correlation
+  time τ: g_k = φ g_(k-1) + σ_g (1 − φ²)^½ N(0, I), φ = exp(−Δt/τ).
+- then saturation (clip to ± saturation) and quantisation of the accumulated angle to the
+  LSB (so quantisation error does not accumulate).
+
+Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`navsim.units`.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import lfilter
+
+from navsim import units
+
+#: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
+#: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,
+#: the maximum of :func:`allan_variance` below).
+GAUSS_MARKOV_PEAK_ADEV = 0.6174
+FLICKER_FLOOR_FACTOR = 0.664
+
+
+@dataclass(frozen=True)
+class GyroRecord:
+    """One gyro record: ``omega`` (M, 3) measured rates [rad/s]; ``bias`` (M, 3) the true total
+    bias (turn-on + random walk + Gauss-Markov) at each sample time, the filter's target;
+    ``matrix`` the true (I+S)(I+M)."""
+
+    omega: np.ndarray
+    bias: np.ndarray
+    matrix: np.ndarray
+
+
+@dataclass(frozen=True)
+class GyroModel:
+    """Gyro error parameters, SI units. A field set to 0 switches that error off."""
+
+    rate_hz: float
+    arw: float = 0.0  # σ_v, angle random walk [rad/√s]
+    rrw: float = 0.0  # σ_u, rate random walk [rad/s^(3/2)]
+    bias_turn_on_sigma: float = 0.0  # 1σ per axis of the constant bias [rad/s]
+    bias_instability_sigma: float = 0.0  # steady σ_g of the Gauss-Markov bias [rad/s]
+    bias_correlation_time: float = 300.0  # τ [s]
+    scale_factor_sigma: float = 0.0  # 1σ per axis [-]
+    misalignment_sigma: float = 0.0  # 1σ per off-diagonal element [rad]
+    quantization: float = 0.0  # delta-angle LSB [rad]
+    saturation: float = np.inf  # |rate| limit [rad/s]
+    bias_turn_on: tuple | None = field(default=None)  # fixed turn-on bias [rad/s] instead of a draw
+
+    @property
+    def dt(self):
+        return 1.0 / self.rate_hz
+
+    @classmethod
+    def preset(cls, name, rate_hz):
+        """Datasheet presets: 'navigation' (ARW 0.002 deg/√h, bias 0.0035 deg/h), 'tactical'
+        (0.125, 1) and 'mems' (0.15, 0.5). The bias figure is used both as the turn-on 1σ
+        and as the bias-instability floor B (σ_g = 0.664 B / 0.6174); RRW, scale factor
+        and misalignment are typical of each grade."""
+        table = {
+            # arw deg/√h, bias deg/h, rrw deg/h/√h, τ s, scale ppm, misalignment arcsec
+            "navigation": (0.002, 0.0035, 0.0003, 3600.0, 5.0, 5.0),
+            "tactical": (0.125, 1.0, 0.05, 300.0, 100.0, 60.0),
+            "mems": (0.15, 0.5, 0.3, 100.0, 500.0, 300.0),
+        }
+        if name not in table:
+            raise ValueError(f"unknown gyro preset {name!r}; choose one of {', '.join(table)}")
+        arw, bias, rrw, tau, scale_ppm, misalignment_arcsec = table[name]
+        return cls(
+            rate_hz=rate_hz,
+            arw=units.arw_to_si(arw),
+            rrw=units.rrw_to_si(rrw),
+            bias_turn_on_sigma=units.deg_per_h_to_rad_per_s(bias),
+            bias_instability_sigma=bias_instability_to_sigma(units.deg_per_h_to_rad_per_s(bias)),
+            bias_correlation_time=tau,
+            scale_factor_sigma=scale_ppm * 1e-6,
+            misalignment_sigma=units.arcsec_to_rad(misalignment_arcsec),
+        )
+
+    @property
+    def filter_rrw(self):
+        """Random-walk σ_u a 6-state filter should assume: RRW plus the Gauss-Markov driving
+        noise (2 σ_g²/τ)^½ [rad/s^(3/2)]."""
+        gm = 0.0
+        if self.bias_instability_sigma > 0.0:
+            gm = 2.0 * self.bias_instability_sigma**2 / self.bias_correlation_time
+        return float(np.sqrt(self.rrw**2 + gm))
+
+    def draw_errors(self, rng):
+        """Constant errors of one unit: (turn-on bias (3,), matrix (I+S)(I+M) (3, 3))."""
+        if self.bias_turn_on is not None:
+            bias = np.asarray(self.bias_turn_on, dtype=float)
+            rng.standard_normal(3)  # keep the stream layout independent of the option
+        else:
+            bias = self.bias_turn_on_sigma * rng.standard_normal(3)
+        scale = self.scale_factor_sigma * rng.standard_normal(3)
+        misalignment = self.misalignment_sigma * rng.standard_normal((3, 3))
+        np.fill_diagonal(misalignment, 0.0)
+        return bias, np.diag(1.0 + scale) @ (np.eye(3) + misalignment)
+
+    def measure(self, omega_mean, seed) -> "GyroRecord":
+        """Gyro samples for true interval-mean rates ``omega_mean`` (M, 3) [rad/s].
+
+        ``seed`` is a :class:`numpy.random.SeedSequence` (or an int); the constant errors and
+        the noise come from two spawned sub-streams.
+        """
+        omega_mean = np.asarray(omega_mean, dtype=float)
+        m = omega_mean.shape[0]
+        dt = self.dt
+        if not isinstance(seed, np.random.SeedSequence):
+            seed = np.random.SeedSequence(seed)
+        error_rng, noise_rng = (np.random.default_rng(s) for s in seed.spawn(2))
+        bias_c, matrix = self.draw_errors(error_rng)
+        n_white, n_walk, n_gm, gm0 = (
+            noise_rng.standard_normal((m, 3)),
+            noise_rng.standard_normal((m, 3)),
+            noise_rng.standard_normal((m, 3)),
+            noise_rng.standard_normal(3),
+        )
+        walk = np.vstack([np.zeros(3), np.cumsum(self.rrw * np.sqrt(dt) * n_walk, axis=0)])
+        gm = np.empty((m + 1, 3))
+        gm[0] = self.bias_instability_sigma * gm0
+        phi = np.exp(-dt / self.bias_correlation_time)
+        drive = self.bias_instability_sigma * np.sqrt(1.0 - phi * phi) * n_gm
+        # g_(k+1) = φ g_k + drive_k as a first-order recursive filter with initial state g_0.
+        gm[1:] = lfilter([1.0], [1.0, -phi], drive, axis=0, zi=phi * gm[0][None, :])[0]
+        sigma_white = np.sqrt(self.arw**2 / dt + self.rrw**2 * dt / 12.0)
+        omega = (
+            omega_mean @ matrix.T
+            + bias_c
+            + 0.5 * (walk[:-1] + walk[1:])
+            + 0.5 * (gm[:-1] + gm[1:])
+            + sigma_white * n_white
+        )
+        omega = np.clip(omega, -self.saturation, self.saturation)
+        if self.quantization > 0.0:
+            angle = np.cumsum(omega * dt, axis=0)
+            counts = np.round(angle / self.quantization)
+            counts = np.diff(np.vstack([np.zeros(3), counts]), axis=0)
+            omega = counts * self.quantization / dt
+        return GyroRecord(omega=omega, bias=bias_c + walk[1:] + gm[1:], matrix=matrix)
+
+
+def bias_instability_to_sigma(bias_instability):
+    """Gauss-Markov σ_g whose peak Allan deviation equals the flicker floor 0.664 B."""
+    return FLICKER_FLOOR_FACTOR * bias_instability / GAUSS_MARKOV_PEAK_ADEV
+
+
+def allan_variance(tau, model):
+    """Theoretical Allan variance [(rad/s)²] of the model's noise terms at cluster times tau [s].
+
+    ARW: σ_v²/τ; RRW: σ_u² τ/3; Gauss-Markov of σ_g, T: with r = τ/T,
+    σ_g² [2(r − 1 + e^(−r))/r² − (1 − e^(−r))²/r²] (IEEE Std 952-1997, annex C).
+    """
+    tau = np.asarray(tau, dtype=float)
+    avar = model.arw**2 / tau + model.rrw**2 * tau / 3.0
+    if model.bias_instability_sigma > 0.0:
+        r = tau / model.bias_correlation_time
+        e = np.exp(-r)
+        avar = avar + model.bias_instability_sigma**2 * (2.0 * (r - 1.0 + e) - (1.0 - e) ** 2) / r**2
+    return avar

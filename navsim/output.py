@@ -1,0 +1,46 @@
+"""Run outputs: ``summary.json`` and ``timeseries.npz``, byte-identical for the same inputs.
+
+``np.savez`` stamps the current time into the zip; :func:`write_npz` writes the same format
+(a zip of ``.npy`` members, readable by ``np.load(..., allow_pickle=False)``) with a fixed
+timestamp, so the same seed gives the same bytes.
+"""
+
+import io
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+FIXED_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+
+def write_npz(path, arrays):
+    """Write ``arrays`` (name -> ndarray, no object arrays) to an .npz file deterministically."""
+    path = Path(path)
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for name in sorted(arrays):
+            buffer = io.BytesIO()
+            np.lib.format.write_array(buffer, np.ascontiguousarray(arrays[name]), allow_pickle=False)
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=FIXED_ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, buffer.getvalue())
+
+
+def read_npz(path):
+    """Load an .npz written by :func:`write_npz` into a dict (no pickle)."""
+    with np.load(path, allow_pickle=False) as data:
+        return {name: data[name] for name in data.files}
+
+
+def write_json(path, payload):
+    Path(path).write_text(json.dumps(payload, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def write_run(directory, result):
+    """Write a :class:`~navsim.simulation.RunResult` into ``directory`` (created if needed)."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    write_json(directory / "summary.json", result.summary)
+    write_npz(directory / "timeseries.npz", result.series)
+    return directory

@@ -1,0 +1,242 @@
+"""Scenario files: strict TOML with the unit in every key name.
+
+``load_scenario(path, overrides)`` reads a file, applies ``--set key=value`` overrides
+(dotted keys, TOML values), validates everything against :data:`SCHEMA` and returns a
+:class:`Scenario` (the validated plain dictionary plus the name of its file). Every problem
+ends in one :class:`InputError` naming the file, the key and what is wrong.
+"""
+
+import copy
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from navsim.schema import ListOfTables, Table, Value
+from startrack.errors import InputError
+
+PROFILES = ("constant_rate", "sinusoidal_axis", "rate_segments", "rigid_body")
+
+SCHEMA = Table(
+    {
+        "name": Value("str"),
+        "description": Value("str", default=""),
+        "duration_s": Value("float", exclusive_minimum=0.0),
+        "seed": Value("int", default=0, minimum=0),
+        "epoch_jyear": Value("float", default=2000.0, minimum=1900.0, maximum=2100.0),
+        "settle_s": Value("float", default=None, minimum=0.0,
+                          doc="errors are summarised after this time (default: 10 % of the run)"),
+        "truth": Table(
+            {
+                "profile": Value("str", choices=PROFILES),
+                "rate_hz": Value("float", default=None, exclusive_minimum=0.0,
+                                 doc="truth integration rate, an integer multiple of the gyro rate"),
+                "initial_q_IB": Value("quaternion", default=[0.0, 0.0, 0.0, 1.0]),
+                "constant_rate": Table({"rate_deg_per_s": Value("vector")}, optional=True),
+                "sinusoidal_axis": Table(
+                    {
+                        "axis": Value("vector"),
+                        "theta0_deg": Value("float", default=0.0),
+                        "amplitude_deg": Value("float"),
+                        "angular_frequency_rad_per_s": Value("float", minimum=0.0),
+                        "phase_deg": Value("float", default=0.0),
+                    },
+                    optional=True,
+                ),
+                "rate_segments": Table(
+                    {
+                        "segments": ListOfTables(
+                            Table({"duration_s": Value("float", exclusive_minimum=0.0),
+                                   "rate_deg_per_s": Value("vector")}),
+                            required=True,
+                            min_length=1,
+                        )
+                    },
+                    optional=True,
+                ),
+                "rigid_body": Table(
+                    {
+                        "inertia_kg_m2": Value("matrix"),
+                        "initial_rate_deg_per_s": Value("vector"),
+                        "torque_segments": ListOfTables(
+                            Table({"duration_s": Value("float", exclusive_minimum=0.0),
+                                   "torque_N_m": Value("vector")})
+                        ),
+                    },
+                    optional=True,
+                ),
+            }
+        ),
+        "gyro": Table(
+            {
+                "preset": Value("str", default=None, choices=("navigation", "tactical", "mems")),
+                "rate_hz": Value("float", exclusive_minimum=0.0),
+                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0),
+                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0),
+                "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0),
+                "bias_instability_deg_per_h": Value("float", default=None, minimum=0.0),
+                "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0),
+                "scale_factor_ppm": Value("float", default=None, minimum=0.0),
+                "misalignment_arcsec": Value("float", default=None, minimum=0.0),
+                "quantization_arcsec": Value("float", default=None, minimum=0.0),
+                "saturation_deg_per_s": Value("float", default=None, exclusive_minimum=0.0),
+            }
+        ),
+        "star_sensor": Table(
+            {
+                "fidelity": Value("str", default="vector", choices=("vector",)),
+                "measurement": Value("str", default="stars", choices=("stars", "attitude")),
+                "rate_hz": Value("float", exclusive_minimum=0.0),
+                "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
+                                 doc="full cone angle of the circular field"),
+                "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0),
+                "max_stars": Value("int", default=10, minimum=1),
+                "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0,
+                                           doc="1σ direction error per star and tangent axis"),
+                "attitude_sigma_cross_arcsec": Value("float", default=5.0, exclusive_minimum=0.0),
+                "attitude_sigma_roll_arcsec": Value("float", default=40.0, exclusive_minimum=0.0),
+                "mounting_rotvec_deg": Value("vector", default=[0.0, 0.0, 0.0],
+                                             doc="nominal R_BS (sensor to body) as a rotation vector"),
+                "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0],
+                                             doc="true, unknown mounting error (rotation vector in S)"),
+            }
+        ),
+        "filter": Table(
+            {
+                "initial_attitude_sigma_deg": Value("float", default=0.1, exclusive_minimum=0.0),
+                "initial_bias_sigma_deg_per_h": Value("float", default=None, exclusive_minimum=0.0),
+                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0,
+                                            doc="ARW the filter assumes (default: the gyro's)"),
+                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0,
+                                                  doc="RRW the filter assumes (default: the gyro's "
+                                                      "RRW plus its Gauss-Markov drive)"),
+                "estimate_scale_factor": Value("bool", default=False),
+                "initial_scale_factor_sigma_ppm": Value("float", default=None, exclusive_minimum=0.0),
+                "estimate_misalignment": Value("bool", default=False),
+                "initial_misalignment_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0),
+                "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
+                "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
+                "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
+            }
+        ),
+    }
+)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario: ``data`` is the checked dictionary (units in key names)."""
+
+    data: dict
+    source: str = "<scenario>"
+
+    @property
+    def name(self):
+        return self.data["name"]
+
+    def __getitem__(self, key):
+        return self.data[key]
+
+
+def parse_override(text):
+    """``'gyro.rate_hz=200'`` -> (['gyro', 'rate_hz'], 200.0); the value is read as TOML,
+    a bare word as a string."""
+    if "=" not in text:
+        raise InputError(f"--set {text!r}: expected KEY=VALUE, e.g. --set gyro.rate_hz=200")
+    key, raw = text.split("=", 1)
+    path = [part.strip() for part in key.strip().split(".")]
+    if not all(path):
+        raise InputError(f"--set {text!r}: empty key")
+    try:
+        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    return path, value
+
+
+def apply_overrides(data, overrides, source):
+    """Return a copy of ``data`` with overrides applied; ``overrides`` is a dict {dotted: value}
+    or a list of 'key=value' strings."""
+    data = copy.deepcopy(data)
+    items = overrides.items() if isinstance(overrides, dict) else (parse_override(o) for o in overrides)
+    for key, value in items:
+        path = key.split(".") if isinstance(key, str) else list(key)
+        node = data
+        for part in path[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise InputError(f"{source}: {'.'.join(path)}: {part} is not a table")
+        node[path[-1]] = value
+    return data
+
+
+def validate(data, source="<scenario>"):
+    """Check a raw dictionary against the schema and the cross-key rules."""
+    try:
+        checked = SCHEMA.check("", data)
+    except InputError as error:
+        raise InputError(f"{source}: {error}") from None
+    truth = checked["truth"]
+    profile = truth["profile"]
+    if profile not in truth:
+        raise InputError(f"{source}: truth.{profile}: missing table for truth.profile = {profile!r}")
+    for other in PROFILES:
+        if other != profile and other in truth:
+            raise InputError(f"{source}: truth.{other}: given, but truth.profile is {profile!r}")
+    gyro_hz = checked["gyro"]["rate_hz"]
+    sensor_hz = checked["star_sensor"]["rate_hz"]
+    if not _is_multiple(gyro_hz, sensor_hz):
+        raise InputError(
+            f"{source}: star_sensor.rate_hz: {sensor_hz:g} Hz must divide gyro.rate_hz = {gyro_hz:g} Hz"
+        )
+    truth_hz = truth.get("rate_hz") or 4.0 * gyro_hz
+    if not _is_multiple(truth_hz, gyro_hz):
+        raise InputError(
+            f"{source}: truth.rate_hz: {truth_hz:g} Hz must be an integer multiple of gyro.rate_hz"
+        )
+    truth["rate_hz"] = truth_hz
+    if checked["duration_s"] * sensor_hz < 1.0:
+        raise InputError(f"{source}: duration_s: shorter than one star-sensor frame")
+    if profile == "rate_segments":
+        covered = sum(s["duration_s"] for s in truth["rate_segments"]["segments"])
+        if covered + 1e-9 < checked["duration_s"]:
+            raise InputError(
+                f"{source}: truth.rate_segments.segments: cover {covered:g} s, "
+                f"less than duration_s = {checked['duration_s']:g} s"
+            )
+    if checked["settle_s"] is None:
+        checked["settle_s"] = 0.1 * checked["duration_s"]
+    if checked["settle_s"] >= checked["duration_s"]:
+        raise InputError(f"{source}: settle_s: must be shorter than duration_s")
+    if profile == "rigid_body":
+        J = np.array(truth["rigid_body"]["inertia_kg_m2"])
+        if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
+            raise InputError(f"{source}: truth.rigid_body.inertia_kg_m2: must be symmetric positive definite")
+    return Scenario(data=checked, source=source)
+
+
+def _is_multiple(high, low):
+    ratio = high / low
+    return ratio >= 1.0 - 1e-9 and abs(ratio - round(ratio)) < 1e-9
+
+
+def load_scenario(path, overrides=()):
+    """Read, override and validate a scenario TOML file."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: scenario file not found")
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, expected a scenario .toml file")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a text file") from None
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(f"{path}: invalid TOML: {error}") from None
+    return validate(apply_overrides(data, overrides, str(path)), source=path.name)
+
+
+def scenario_from_dict(data, overrides=(), source="<dict>"):
+    """Validate a scenario given as a dictionary (the Python API's entry point)."""
+    return validate(apply_overrides(data, overrides, source), source=source)

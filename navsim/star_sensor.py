@@ -1,0 +1,108 @@
+"""Vector-fidelity star sensor: what the sensor would report, without images.
+
+Two measurement models (DESIGN.md, fidelity ``vector``):
+
+- :class:`StarVectorSensor` returns the catalog stars inside the circular field as noisy unit
+  vectors in the sensor frame S (one per identified star, brightest first);
+- :class:`AttitudeFixSensor` returns a noisy attitude q_IS with its covariance in S
+  (cross-boresight σ on x and y, roll σ about the boresight z).
+
+Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim import quaternion as quat
+
+
+def tangent_basis(s):
+    """Two orthonormal rows (N, 2, 3) spanning the plane perpendicular to each unit vector s (N, 3)."""
+    helper = np.zeros_like(s)
+    helper[np.arange(len(s)), np.argmin(np.abs(s), axis=1)] = 1.0
+    e1 = np.cross(s, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    return np.stack([e1, np.cross(s, e1)], axis=1)
+
+
+@dataclass(frozen=True)
+class StarFrames:
+    """Star measurements of many frames, concatenated: frame f owns rows offsets[f]:offsets[f+1]."""
+
+    offsets: np.ndarray
+    ref_I: np.ndarray
+    obs_S: np.ndarray
+    ids: np.ndarray
+
+    def frame(self, f):
+        """(ref_I (N, 3), obs_S (N, 3), ids (N,)) of frame f."""
+        rows = slice(self.offsets[f], self.offsets[f + 1])
+        return self.ref_I[rows], self.obs_S[rows], self.ids[rows]
+
+
+@dataclass(frozen=True)
+class StarVectorSensor:
+    """Stars brighter than the catalog cut inside the cone of half-angle fov/2 around +z_S.
+
+    ``star_vectors`` (M, 3) unit vectors in I, ``star_ids`` (M,), ``star_mags`` (M,);
+    ``fov`` full cone angle [rad]; ``sigma`` 1σ direction error per tangent axis [rad];
+    ``max_stars`` the most (brightest) stars reported; ``q_BS_true`` true mounting.
+    """
+
+    star_vectors: np.ndarray
+    star_ids: np.ndarray
+    star_mags: np.ndarray
+    fov: float
+    sigma: float
+    max_stars: int
+    q_BS_true: np.ndarray
+
+    def observe_frames(self, q_IB_true, rng, chunk=512):
+        """Noisy star vectors for every true attitude q_IB_true (F, 4) -> :class:`StarFrames`.
+
+        A star is seen when its angle from the boresight is at most fov/2; the ``max_stars``
+        brightest are reported, brightest first; the direction noise is isotropic in the plane
+        perpendicular to the true direction.
+        """
+        q_IS = quat.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
+        order = np.argsort(self.star_mags, kind="stable")
+        catalog = self.star_vectors[order]
+        boresight = quat.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
+        cos_half = np.cos(0.5 * self.fov)
+        frames, stars = [], []
+        for start in range(0, len(q_IS), chunk):
+            inside = boresight[start : start + chunk] @ catalog.T >= cos_half
+            inside &= np.cumsum(inside, axis=1) <= self.max_stars
+            f, k = np.nonzero(inside)
+            frames.append(f + start)
+            stars.append(k)
+        frame = np.concatenate(frames)
+        index = order[np.concatenate(stars)]
+        ref_I = self.star_vectors[index]
+        s_true = quat.rotate(quat.conjugate(q_IS[frame]), ref_I)
+        noise = np.einsum("nij,ni->nj", tangent_basis(s_true), self.sigma * rng.standard_normal((len(index), 2)))
+        obs = s_true + noise
+        obs /= np.linalg.norm(obs, axis=1, keepdims=True)
+        offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=len(q_IS)))])
+        return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index])
+
+
+@dataclass(frozen=True)
+class AttitudeFixSensor:
+    """A star tracker reporting q_IS with independent errors: σ_cross about x_S and y_S, σ_roll about z_S [rad]."""
+
+    sigma_cross: float
+    sigma_roll: float
+    q_BS_true: np.ndarray
+
+    @property
+    def R_S(self):
+        return np.diag([self.sigma_cross**2, self.sigma_cross**2, self.sigma_roll**2])
+
+    def observe_frames(self, q_IB_true, rng):
+        """Measured q_IS = q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true (F, 4)."""
+        q_IS = quat.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
+        sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
+        nu = sigma * rng.standard_normal((len(q_IS), 3))
+        return quat.multiply(q_IS, quat.from_rotation_vector(nu))

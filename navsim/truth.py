@@ -1,0 +1,138 @@
+"""Truth attitude motion: prescribed profiles and rigid-body dynamics.
+
+Every profile is an immutable strategy object with one method,
+``simulate(t, q0) -> (q_IB (N, 4), omega_B (N, 3))`` on a uniform time grid
+``t`` [s] starting at 0, with body rates [rad/s] in body axes
+(``q̇_IB = ½ q_IB ⊗ [ω_B, 0]``, DESIGN.md).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim import kernels
+from navsim import quaternion as quat
+
+
+def _uniform_step(t):
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise ValueError("time grid must be a 1-D array of at least two samples")
+    dt = t[1] - t[0]
+    if not np.allclose(np.diff(t), dt, rtol=1e-9, atol=1e-12):
+        raise ValueError("time grid must be uniform")
+    return t, dt
+
+
+@dataclass(frozen=True)
+class ConstantRate:
+    """Constant body rate ω [rad/s]: q(t) = q0 ⊗ exp(ω t / 2) (exact)."""
+
+    rate: tuple
+
+    def simulate(self, t, q0):
+        t, _ = _uniform_step(t)
+        omega = np.asarray(self.rate, dtype=float)
+        q = quat.multiply(q0, quat.from_rotation_vector(t[:, None] * omega))
+        return quat.normalize(q), np.broadcast_to(omega, (t.size, 3)).copy()
+
+
+@dataclass(frozen=True)
+class SinusoidalAxis:
+    """Rotation about a fixed axis l by θ(t) = θ0 + A sin(Ω t + φ) (the experiment of 000 §3-§5).
+
+    q_IB(t) = q0 ⊗ exp(l θ(t) / 2) and ω_B = θ̇ l, exact. 000 uses l = [√2/2, 1/2, 1/2],
+    θ0 = π/3 (the quaternion of its Table 2 at t = 0), A = π/6, Ω = 1 rad/s: peak rate 30 deg/s.
+    """
+
+    axis: tuple
+    theta0: float
+    amplitude: float
+    angular_frequency: float
+    phase: float = 0.0
+
+    def simulate(self, t, q0):
+        t, _ = _uniform_step(t)
+        axis = np.asarray(self.axis, dtype=float)
+        axis = axis / np.linalg.norm(axis)
+        arg = self.angular_frequency * t + self.phase
+        theta = self.theta0 + self.amplitude * np.sin(arg)
+        theta_dot = self.amplitude * self.angular_frequency * np.cos(arg)
+        q = quat.multiply(q0, quat.from_rotation_vector(theta[:, None] * axis))
+        return quat.normalize(q), theta_dot[:, None] * axis
+
+
+@dataclass(frozen=True)
+class RateSegments:
+    """Piecewise-constant body rates: ``segments`` of (duration [s], rate (3,) [rad/s]), exact.
+
+    The segments must cover the whole time grid.
+    """
+
+    segments: tuple
+
+    def simulate(self, t, q0):
+        t, _ = _uniform_step(t)
+        ends = np.cumsum([duration for duration, _ in self.segments])
+        if t[-1] > ends[-1] + 1e-9:
+            raise ValueError(f"rate segments cover {ends[-1]:g} s but the run lasts {t[-1]:g} s")
+        starts = np.concatenate([[0.0], ends[:-1]])
+        table = np.array([rate for _, rate in self.segments], dtype=float)
+        # Attitude at each segment start, then exact exponentials inside each segment.
+        seg = np.minimum(np.searchsorted(ends, t, side="right"), len(self.segments) - 1)
+        q_start = np.empty((len(self.segments), 4))
+        q = np.asarray(q0, dtype=float)
+        for k, (duration, _) in enumerate(self.segments):
+            q_start[k] = q
+            q = quat.multiply(q, quat.from_rotation_vector(table[k] * duration))
+        phi = table[seg] * (t - starts[seg])[:, None]
+        q_t = quat.multiply(q_start[seg], quat.from_rotation_vector(phi))
+        return quat.normalize(q_t), table[seg]
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """Rigid body under Euler's equations I ω̇ = τ − ω × I ω, integrated by RK4 on (q, ω).
+
+    ``inertia`` (3x3) [kg m²], ``initial_rate`` (3,) [rad/s] in body axes, ``torque_segments``
+    of (duration [s], torque (3,) [N m]) in body axes; no segments means torque-free.
+    The integration step is the grid step (choose a truth rate well above the motion's bandwidth);
+    the torque is held over each step at its mid-step value, so segment boundaries on the grid are exact.
+    """
+
+    inertia: tuple
+    initial_rate: tuple
+    torque_segments: tuple = ()
+
+    def torques(self, t_mid):
+        """Body torque (N, 3) [N m] at times t_mid (zero after the last segment)."""
+        if not self.torque_segments:
+            return np.zeros((len(t_mid), 3))
+        ends = np.cumsum([duration for duration, _ in self.torque_segments])
+        table = np.vstack([np.array([torque for _, torque in self.torque_segments], dtype=float), np.zeros(3)])
+        return table[np.searchsorted(ends, t_mid, side="right")]
+
+    def simulate(self, t, q0):
+        t, dt = _uniform_step(t)
+        return kernels.rigid_body_rk4(
+            np.asarray(q0, dtype=float),
+            np.asarray(self.initial_rate, dtype=float),
+            np.asarray(self.inertia, dtype=float),
+            self.torques(t[:-1] + 0.5 * dt),
+            dt,
+        )
+
+
+def interval_mean_rates(q_fine, factor, dt_gyro):
+    """Mean body rate over each gyro interval [t_k, t_(k+1)] of length dt_gyro [s].
+
+    ``q_fine`` (factor*M + 1, 4) is the truth attitude on a grid ``factor`` times denser. Each
+    truth step contributes the rotation vector of q_iᵀ ⊗ q_(i+1) (its delta angle, exact for a
+    rate held over the step, O(h³) coning otherwise); the gyro sample is their sum over the
+    interval divided by dt_gyro — an ideal rate-integrating gyro, exact at rate steps on the grid.
+    """
+    q_fine = np.asarray(q_fine, dtype=float)
+    n_intervals = (q_fine.shape[0] - 1) // factor
+    q = q_fine[: n_intervals * factor + 1]
+    delta = quat.to_rotation_vector(quat.multiply(quat.conjugate(q[:-1]), q[1:]))
+    return delta.reshape(n_intervals, factor, 3).sum(axis=1) / dt_gyro

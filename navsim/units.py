@@ -1,0 +1,42 @@
+"""Unit conversions at the edges (scenario files, reports, command line); SI inside."""
+
+import numpy as np
+
+DEG = np.pi / 180.0
+ARCSEC = DEG / 3600.0
+HOUR = 3600.0
+
+
+def deg_to_rad(x):
+    return np.asarray(x, dtype=float) * DEG
+
+
+def rad_to_deg(x):
+    return np.asarray(x, dtype=float) / DEG
+
+
+def arcsec_to_rad(x):
+    return np.asarray(x, dtype=float) * ARCSEC
+
+
+def rad_to_arcsec(x):
+    return np.asarray(x, dtype=float) / ARCSEC
+
+
+def deg_per_h_to_rad_per_s(x):
+    """Bias [deg/h] -> [rad/s]."""
+    return np.asarray(x, dtype=float) * DEG / HOUR
+
+
+def rad_per_s_to_deg_per_h(x):
+    return np.asarray(x, dtype=float) * HOUR / DEG
+
+
+def arw_to_si(x):
+    """Angle random walk [deg/√h] -> σ_v [rad/√s]."""
+    return np.asarray(x, dtype=float) * DEG / np.sqrt(HOUR)
+
+
+def rrw_to_si(x):
+    """Rate random walk [deg/h/√h] -> σ_u [rad/s^(3/2)]."""
+    return np.asarray(x, dtype=float) * DEG / HOUR / np.sqrt(HOUR)

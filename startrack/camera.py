@@ -1,0 +1,229 @@
+"""Pinhole camera of the star sensor with radial distortion (k1, k2).
+
+Frame convention (DESIGN.md, binding):
+
+* Sensor frame S: +z along the boresight (out of the lens, towards the sky),
+  +x along the image columns u (to the right), +y along the image rows v
+  (downwards); right-handed.
+* Image coordinates (u, v) in pixels, origin at the *centre* of the top-left
+  pixel, so pixel (row r, column c) covers u in [c - 1/2, c + 1/2] and v in
+  [r - 1/2, r + 1/2]; the principal point defaults to ((W-1)/2, (H-1)/2).
+* Ideal pinhole: x_n = x/z, y_n = y/z (normalised, tangent-plane coordinates),
+  u = cx + f x_n, v = cy + f y_n with f the focal length in pixels.
+* Radial distortion (Brown's polynomial, even terms):
+  (x_d, y_d) = (x_n, y_n) (1 + k1 r^2 + k2 r^4), r^2 = x_n^2 + y_n^2, and
+  u = cx + f x_d, v = cy + f y_d.  The inverse is solved for the radius by
+  Newton's method to machine precision; the constructor refuses (k1, k2)
+  whose distorted radius is not monotonic over the image.
+* Attitude: ``q_IS`` is the scalar-last quaternion (scipy convention) that
+  rotates S-frame vectors into the inertial frame I: v_I = R_IS v_S
+  (boresight RA/Dec/roll conversions in :mod:`startrack.attitude_angles`).
+* Field of view: ``fov_x`` is the full angle across the image width,
+  f = (W/2) / tan(fov_x/2).  With ``circular_fov`` the field is the cone of
+  half-angle fov_x/2 (the circle inscribed in the width, as in 000 and 004),
+  intersected with the image; otherwise the image rectangle.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from startrack.errors import InputError
+
+#: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
+_NEWTON_ITERATIONS = 12
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Pinhole camera: W x H pixels, focal length in pixels, principal point, k1, k2."""
+
+    width: int
+    height: int
+    focal_px: float
+    cx: float | None = None
+    cy: float | None = None
+    k1: float = 0.0
+    k2: float = 0.0
+    circular_fov: bool = False
+
+    def __post_init__(self):
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if int(value) != value or value < 1:
+                raise InputError(f"camera {name} must be a positive integer number of pixels, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if not np.isfinite(self.focal_px) or self.focal_px <= 0:
+            raise InputError(f"camera focal_px must be a positive number of pixels, got {self.focal_px!r}")
+        object.__setattr__(self, "focal_px", float(self.focal_px))
+        object.__setattr__(self, "cx", (self.width - 1) / 2.0 if self.cx is None else float(self.cx))
+        object.__setattr__(self, "cy", (self.height - 1) / 2.0 if self.cy is None else float(self.cy))
+        for name in ("cx", "cy", "k1", "k2"):
+            if not np.isfinite(getattr(self, name)):
+                raise InputError(f"camera {name} must be finite, got {getattr(self, name)!r}")
+        object.__setattr__(self, "k1", float(self.k1))
+        object.__setattr__(self, "k2", float(self.k2))
+        self._check_distortion_monotonic()
+
+    # ----------------------------------------------------------------- constructors
+    @classmethod
+    def from_fov(cls, fov_x_rad, width, height, **kw):
+        """Camera whose full field across the width is ``fov_x_rad``: f = (W/2)/tan(fov_x/2)."""
+        if not 0 < fov_x_rad < np.pi:
+            raise InputError(f"field of view must be in (0, 180) deg, got {np.degrees(fov_x_rad)!r} deg")
+        return cls(width, height, (width / 2.0) / np.tan(fov_x_rad / 2.0), **kw)
+
+    @classmethod
+    def from_pitch(cls, focal_length_m, pixel_pitch_m, width, height, **kw):
+        """Camera from the focal length and the pixel pitch [m]: f_px = focal / pitch."""
+        if not (focal_length_m > 0 and pixel_pitch_m > 0):
+            raise InputError(
+                f"focal length and pixel pitch must be positive, got {focal_length_m!r} m and {pixel_pitch_m!r} m"
+            )
+        return cls(width, height, focal_length_m / pixel_pitch_m, **kw)
+
+    # ----------------------------------------------------------------- field
+    @property
+    def fov_x(self):
+        """Full field angle across the width [rad] (pinhole, undistorted)."""
+        return 2.0 * np.arctan(self.width / (2.0 * self.focal_px))
+
+    @property
+    def fov_y(self):
+        """Full field angle across the height [rad]."""
+        return 2.0 * np.arctan(self.height / (2.0 * self.focal_px))
+
+    @property
+    def fov_diagonal(self):
+        """Full field angle across the diagonal [rad]."""
+        return 2.0 * np.arctan(np.hypot(self.width, self.height) / (2.0 * self.focal_px))
+
+    # ----------------------------------------------------------------- distortion
+    def _radial_factor(self, r2):
+        return 1.0 + self.k1 * r2 + self.k2 * r2 * r2
+
+    def _max_distorted_radius(self):
+        """Normalised distorted radius of the farthest image corner (pixel edges included)."""
+        du = max(self.cx + 0.5, self.width - 0.5 - self.cx)
+        dv = max(self.cy + 0.5, self.height - 0.5 - self.cy)
+        return np.hypot(du, dv) / self.focal_px
+
+    def _check_distortion_monotonic(self):
+        if self.k1 == 0.0 and self.k2 == 0.0:
+            return
+        rd_max = 1.05 * self._max_distorted_radius()
+        r = np.linspace(0.0, 4.0 * rd_max, 8001)
+        rd = r * self._radial_factor(r * r)
+        slope = 1.0 + 3.0 * self.k1 * r**2 + 5.0 * self.k2 * r**4
+        reached = np.flatnonzero(rd >= rd_max)
+        if reached.size == 0 or np.any(slope[: reached[0] + 1] <= 0.0):
+            raise InputError(
+                f"radial distortion k1={self.k1!r}, k2={self.k2!r} is not invertible over the image "
+                "(distorted radius not monotonic out to the corners)"
+            )
+
+    def distort(self, xy_n):
+        """Normalised ideal (x_n, y_n) (N,2) -> distorted (x_d, y_d) (Brown radial model)."""
+        xy_n = np.asarray(xy_n, dtype=float)
+        return xy_n * self._radial_factor(np.sum(xy_n * xy_n, axis=-1))[..., None]
+
+    def undistort(self, xy_d):
+        """Distorted normalised (x_d, y_d) -> ideal (x_n, y_n), Newton on the radius.
+
+        Solves r_d = r (1 + k1 r^2 + k2 r^4) for r per point, then scales
+        (x_d, y_d) by r / r_d; converges to machine precision in a few steps.
+        """
+        xy_d = np.asarray(xy_d, dtype=float)
+        if self.k1 == 0.0 and self.k2 == 0.0:
+            return xy_d.copy()
+        rd = np.sqrt(np.sum(xy_d * xy_d, axis=-1))
+        r = rd.copy()
+        for _ in range(_NEWTON_ITERATIONS):
+            r2 = r * r
+            g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd
+            dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2
+            step = g / dg
+            r = r - step
+            if np.all(np.abs(step) <= 1e-16 * np.maximum(r, 1.0)):
+                break
+        scale = np.ones_like(rd)
+        nonzero = rd > 0.0
+        scale[nonzero] = r[nonzero] / rd[nonzero]
+        return xy_d * scale[..., None]
+
+    # ----------------------------------------------------------------- projection
+    def _project(self, v_S):
+        """(uv, normalised ideal x_n y_n, in-front mask) of directions (N,3) in S; NaN behind the lens."""
+        front = v_S[:, 2] > 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xy_n = v_S[:, :2] / np.where(front, v_S[:, 2], np.nan)[:, None]
+        return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy]), xy_n, front
+
+    def project_body(self, vectors_S):
+        """(uv (N,2) px, visible (N,) bool) of directions (N,3) given in S.
+
+        visible: in front of the lens (z > 0), inside the image (pixel edges
+        included) and, for a circular field, within fov_x/2 of the boresight.
+        Points behind the lens get NaN coordinates.
+        """
+        v = np.atleast_2d(np.asarray(vectors_S, dtype=float))
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise InputError(f"direction vectors must have shape (N, 3), got {np.shape(vectors_S)}")
+        uv, xy_n, front = self._project(v)
+        return uv, self._visible(uv, xy_n, front, 0.0)
+
+    def project(self, q_IS, vectors_I):
+        """(uv, visible) of inertial directions (N,3) for the attitude q_IS (S -> I)."""
+        return self.project_body(self.to_sensor(q_IS, vectors_I))
+
+    @staticmethod
+    def to_sensor(q_IS, vectors_I):
+        """Inertial directions (N,3) expressed in S: v_S = R_IS^T v_I."""
+        q = np.asarray(q_IS, dtype=float)
+        if q.shape != (4,) or not np.all(np.isfinite(q)) or np.linalg.norm(q) == 0:
+            raise InputError(f"attitude quaternion q_IS must be 4 finite numbers, not all zero, got {q_IS!r}")
+        return np.atleast_2d(np.asarray(vectors_I, dtype=float)) @ Rotation.from_quat(q).as_matrix()
+
+    def unproject(self, uv):
+        """Unit vectors (N,3) in S of image points (N,2) [px] (distortion removed)."""
+        uv = np.atleast_2d(np.asarray(uv, dtype=float))
+        if uv.ndim != 2 or uv.shape[1] != 2:
+            raise InputError(f"image points must have shape (N, 2), got {uv.shape}")
+        xy_n = self.undistort((uv - np.array([self.cx, self.cy])) / self.focal_px)
+        v = np.concatenate([xy_n, np.ones((len(uv), 1))], axis=1)
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    def stars_in_field(self, q_IS, vectors_I, margin_px=0.0):
+        """Indices of the directions inside the field grown by ``margin_px`` pixels."""
+        uv, xy_n, front = self._project(self.to_sensor(q_IS, vectors_I))
+        return np.flatnonzero(self._visible(uv, xy_n, front, float(margin_px)))
+
+    def _visible(self, uv, xy_n, front, margin_px):
+        with np.errstate(invalid="ignore"):
+            inside = (
+                front
+                & (uv[:, 0] >= -0.5 - margin_px)
+                & (uv[:, 0] <= self.width - 0.5 + margin_px)
+                & (uv[:, 1] >= -0.5 - margin_px)
+                & (uv[:, 1] <= self.height - 0.5 + margin_px)
+            )
+            if self.circular_fov:
+                radius = self.width / 2.0 + margin_px
+                inside &= np.sum(xy_n * xy_n, axis=1) * self.focal_px**2 <= radius * radius
+        return inside
+
+    def angular_velocity_track(self, q_IS_mid, omega_S, times_s, vectors_I):
+        """Image tracks (N, K, 2) of inertial directions at ``times_s`` (K,) from mid-exposure.
+
+        Constant body rate omega_S [rad/s] in S: R_IS(t) = R_IS(0) exp([omega x] t),
+        so v_S(t) = exp([omega x] t)^T v_S(0).
+        """
+        v_S0 = self.to_sensor(q_IS_mid, vectors_I)
+        rotvecs = np.asarray(times_s, dtype=float)[:, None] * np.asarray(omega_S, dtype=float)[None, :]
+        mats = Rotation.from_rotvec(rotvecs).as_matrix()  # (K,3,3) S(t) -> S(0)
+        v_S = np.einsum("nj,kji->nki", v_S0, mats)  # R^T v
+        z = v_S[..., 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xy_n = v_S[..., :2] / np.where(z > 0, z, np.nan)[..., None]
+        return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy])

@@ -1,0 +1,33 @@
+"""Directions on the celestial sphere: RA/Dec <-> unit vectors, angular distance.
+
+Conventions (DESIGN.md): inertial frame I = ICRS; RA = atan2(y, x) in [0, 2 pi),
+Dec = asin(z); radians everywhere.
+"""
+
+import numpy as np
+
+
+def radec_to_vector(ra, dec):
+    """Unit vectors (..., 3) from right ascension and declination [rad]."""
+    ra = np.asarray(ra, dtype=float)
+    dec = np.asarray(dec, dtype=float)
+    cos_dec = np.cos(dec)
+    return np.stack([cos_dec * np.cos(ra), cos_dec * np.sin(ra), np.sin(dec)], axis=-1)
+
+
+def vector_to_radec(v):
+    """(RA in [0, 2 pi), Dec in [-pi/2, pi/2]) [rad] of vectors (..., 3); need not be unit."""
+    v = np.asarray(v, dtype=float)
+    norm = np.linalg.norm(v, axis=-1)
+    ra = np.mod(np.arctan2(v[..., 1], v[..., 0]), 2.0 * np.pi)
+    dec = np.arcsin(np.clip(v[..., 2] / norm, -1.0, 1.0))
+    return ra, dec
+
+
+def angular_distance(a, b):
+    """Angle [rad] between direction arrays (..., 3), accurate at 0 and pi (atan2 form)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    cross = np.linalg.norm(np.cross(a, b), axis=-1)
+    dot = np.sum(a * b, axis=-1)
+    return np.arctan2(cross, dot)
