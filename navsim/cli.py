@@ -10,7 +10,7 @@ import sys
 
 from navsim.output import write_run
 from navsim.simulation import run
-from startrack.errors import InputError
+from startrack.errors import run_command
 
 
 def _print_summary(summary, out):
@@ -52,17 +52,8 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except InputError as error:
-        print(f"navsim: error: {error}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("navsim: interrupted", file=sys.stderr)
-        return 130
+def main(argv=None) -> int:
+    return run_command("navsim", build_parser(), argv)
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ class UpdateResult:
 
     @property
     def n_accepted(self):
-        return int(self.accepted.sum())
+        return int(np.count_nonzero(self.accepted))
 
     @property
     def n_rejected(self):
@@ -101,9 +101,10 @@ class AttitudeFilter:
     def predict(self, omega_measured, dt):
         """Propagate q (RK4) and P (Φ P Φᵀ + Q) over one gyro sample (3,) or several
         consecutive samples (m, 3), each held for dt [s] (:func:`navsim.kernels.predict`)."""
+        if np.ndim(omega_measured) != 2:
+            omega_measured = np.atleast_2d(np.asarray(omega_measured, dtype=float))
         self.q, self.P = kernels.predict(
-            self.q, self.P, self.b, self.s,
-            np.atleast_2d(np.asarray(omega_measured, dtype=float)), dt,
+            self.q, self.P, self.b, self.s, omega_measured, dt,
             self.arw, self.rrw, self.scale_factor_rw, self.process_noise_scale, self.sf_start,
         )
 
@@ -112,8 +113,8 @@ class AttitudeFilter:
         (:func:`navsim.kernels.attitude_update`: z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes,
         H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ), gated at 3 dof."""
         self.q, self.b, self.s, q_BS, self.P, z, nis, accepted = kernels.attitude_update(
-            self.q, self.b, self.s, self.q_BS, self.P, np.asarray(q_IS, dtype=float),
-            np.asarray(R_S, dtype=float), self.gate[3], self.sf_start, self.mis_start,
+            self.q, self.b, self.s, self.q_BS, self.P, np.asarray(q_IS, dtype=float), R_S,
+            self.gate[3], self.sf_start, self.mis_start,
         )
         self._set_mounting(q_BS)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))

@@ -109,14 +109,14 @@ def run(scenario, seed=None, overrides=(), star_catalog=None):
             result = filt.update_stars(ref_I, obs_S, sigma) if len(ref_I) else None
         if result is not None:
             accepted = result.accepted
-            n_accepted = int(accepted.sum())
+            n_accepted = np.count_nonzero(accepted)
             log["n_measurements"][j] = accepted.size
             log["n_accepted"][j] = n_accepted
             if n_accepted:
-                z = result.z[accepted]
-                log["nis"][j] = result.nis[accepted].sum()
+                z = result.z[accepted].ravel()
+                log["nis"][j] = np.dot(result.nis, accepted)
                 log["nis_dof"][j] = (3 if fix_mode else 2) * n_accepted
-                log["innovation_rms"][j] = np.sqrt((z * z).sum() / z.size)
+                log["innovation_rms"][j] = np.sqrt(np.dot(z, z) / z.size)
         log["q_est"][j] = filt.q
         log["bias_est"][j] = filt.b
         log["P"][j] = filt.P

@@ -8,7 +8,7 @@ import argparse
 import importlib
 import sys
 
-from startrack.errors import InputError
+from startrack.errors import run_command
 
 #: Sub-command modules under ``startrack.commands``, in the order ``--help`` lists them.
 COMMANDS = ("catalog", "address", "render", "detect")
@@ -26,16 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except InputError as error:
-        print(f"startrack: error: {error}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("startrack: interrupted", file=sys.stderr)
-        return 130
+    return run_command("startrack", build_parser(), argv)
 
 
 if __name__ == "__main__":
