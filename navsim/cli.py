@@ -1,16 +1,20 @@
 """``navsim`` command line (contract in DESIGN.md).
 
-    navsim run SCENARIO.toml --out DIR [--seed N] [--set key=value ...]
+    navsim run SCENARIO.toml --out DIR [--seed N] [--set key=value ...] [--report [FILE.pdf]]
+    navsim report DIR -o FILE.pdf
+    navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
 
 import argparse
 import sys
+from pathlib import Path
 
+from navsim.montecarlo import run_campaign
 from navsim.output import write_run
 from navsim.simulation import run
-from startrack.errors import run_command
+from startrack.errors import InputError, run_command
 
 
 def _print_summary(summary, out):
@@ -33,10 +37,45 @@ def _print_summary(summary, out):
 
 
 def _run(args):
+    if args.report and Path(args.report).suffix.lower() != ".pdf":
+        raise InputError(f"--report {args.report}: the report file name must end in .pdf.")
     result = run(args.scenario, seed=args.seed, overrides=args.set or ())
     out = write_run(args.out, result)
     _print_summary(result.summary, out)
+    if args.report is not None:
+        from navsim.report import write_report
+
+        pdf = write_report(out, args.report or Path(out) / "report.pdf")
+        print(f"report              {pdf}")
     return 0
+
+
+def _report(args):
+    from navsim.report import write_report
+
+    print(write_report(args.directory, args.output))
+    return 0
+
+
+def _montecarlo(args):
+    if args.workers is not None and args.scheduler is not None:
+        raise InputError("give either --workers or --scheduler, not both")
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers must be at least 1, got {args.workers}")
+    summary = run_campaign(args.scenario, args.runs, args.out, base_seed=args.seed, overrides=args.set or (),
+                           workers=args.workers, scheduler=args.scheduler)
+    cross, roll, nees = summary.get("cross_boresight_rms_arcsec", {}), summary.get("roll_rms_arcsec", {}), summary.get("nees", {})
+    print(f"campaign            {summary['scenario']}: {summary['runs_finished']} of {summary['runs_requested']} runs "
+          f"finished, {summary['runs_failed']} failed")
+    if cross:
+        print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
+    if nees:
+        print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof; {100 * nees['fraction_in_band']:.1f} % of frames "
+              f"inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
+    if summary.get("divergent_runs"):
+        print(f"divergent runs      {summary['divergent_runs']}")
+    print(f"written to          {args.out}")
+    return 0 if summary["runs_failed"] == 0 else 1
 
 
 def build_parser():
@@ -48,7 +87,23 @@ def build_parser():
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a scenario value, e.g. --set gyro.rate_hz=200 (repeatable)")
+    p.add_argument("--report", nargs="?", const="", default=None, metavar="FILE.pdf",
+                   help="also write a PDF report (default file: DIR/report.pdf)")
     p.set_defaults(func=_run)
+    p = sub.add_parser("report", help="typeset the PDF report of a run or Monte Carlo campaign directory")
+    p.add_argument("directory", help="run directory (navsim run --out) or campaign directory (navsim montecarlo)")
+    p.add_argument("-o", "--output", required=True, metavar="FILE.pdf", help="PDF file to write")
+    p.set_defaults(func=_report)
+
+    p = sub.add_parser("montecarlo", help="run (or resume) a seeded campaign of one scenario")
+    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("--runs", type=int, required=True, help="number of runs")
+    p.add_argument("--out", required=True, help="campaign directory (finished runs there are kept)")
+    p.add_argument("--seed", type=int, default=None, help="base seed (default: the scenario's)")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask distributed scheduler")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.set_defaults(func=_montecarlo)
     return parser
 
 

@@ -1,4 +1,5 @@
-"""Run outputs: ``summary.json`` and ``timeseries.npz``, byte-identical for the same inputs.
+"""Run outputs: ``scenario.json`` (the validated scenario), ``summary.json`` and ``timeseries.npz``,
+byte-identical for the same inputs (but for ``wall_seconds``).
 
 ``np.savez`` stamps the current time into the zip; :func:`write_npz` writes the same format
 (a zip of ``.npy`` members, readable by ``np.load(..., allow_pickle=False)``) with a fixed
@@ -37,10 +38,20 @@ def write_json(path, payload):
     Path(path).write_text(json.dumps(payload, indent=2, sort_keys=True) + "\n", encoding="utf-8")
 
 
-def write_run(directory, result):
-    """Write a :class:`~navsim.simulation.RunResult` into ``directory`` (created if needed)."""
+def write_run(directory, result, max_frames=None):
+    """Write a :class:`~navsim.simulation.RunResult` into ``directory`` (created if needed).
+
+    ``max_frames`` keeps every k-th frame of the time series so that at most that many remain
+    (campaigns keep envelopes, not every frame, of thousands of runs); the summary is unchanged.
+    """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
+    write_json(directory / "scenario.json", result.scenario)
     write_json(directory / "summary.json", result.summary)
-    write_npz(directory / "timeseries.npz", result.series)
+    series = result.series
+    frames = len(series["t"])
+    if max_frames is not None and frames > max_frames:
+        stride = -(-frames // max_frames)
+        series = {k: (v[stride - 1 :: stride] if v.shape[:1] == (frames,) else v) for k, v in series.items()}
+    write_npz(directory / "timeseries.npz", series)
     return directory

@@ -6,13 +6,14 @@ a pool or a cluster.
 """
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
 
-from navsim import build
+from navsim import build, kernels
 from navsim import quaternion as quat
 from navsim import units
 from navsim.scenario import Scenario, load_scenario, scenario_from_dict
@@ -25,10 +26,12 @@ NEES_DOF = 6
 
 @dataclass(frozen=True)
 class RunResult:
-    """``summary``: JSON-ready metrics; ``series``: arrays logged at every star-sensor frame."""
+    """``summary``: JSON-ready metrics; ``series``: arrays logged at every star-sensor frame;
+    ``scenario``: the validated scenario (units in key names) the run used."""
 
     summary: dict
     series: dict
+    scenario: dict
 
 
 def resolve_scenario(scenario, overrides=()):
@@ -42,6 +45,75 @@ def resolve_scenario(scenario, overrides=()):
     return load_scenario(Path(scenario), overrides)
 
 
+@dataclass(frozen=True)
+class Prepared:
+    """The seed-free part of a scenario, computed once and shared by all runs of a batch:
+    the truth on the gyro grid, the interval-mean rates the gyro integrates, and the models."""
+
+    scenario: Scenario
+    t_gyro: np.ndarray
+    q_true: np.ndarray
+    omega_mean: np.ndarray
+    ratio: int
+    dt: float
+    n_frames: int
+    gyro: object
+    sensor: object
+    R_BS: np.ndarray
+
+
+def prepare(scenario, overrides=(), star_catalog=None):
+    """Validate ``scenario`` and compute everything that does not depend on the seed."""
+    scenario = resolve_scenario(scenario, overrides)
+    gyro_hz = scenario["gyro"]["rate_hz"]
+    ratio = int(round(gyro_hz / scenario["star_sensor"]["rate_hz"]))
+    factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
+    n_gyro = int(round(scenario["duration_s"] * gyro_hz))
+    dt = 1.0 / gyro_hz
+    q0 = quat.normalize(scenario["truth"]["initial_q_IB"])
+    t_truth = np.arange(n_gyro * factor + 1) / (gyro_hz * factor)
+    q_truth, _ = build.truth_profile(scenario).simulate(t_truth, q0)
+    if scenario["star_sensor"]["measurement"] == "stars" and star_catalog is None:
+        star_catalog = load_star_catalog(epoch=scenario["epoch_jyear"])
+    q_BS, _ = build.mounting(scenario)
+    return Prepared(
+        scenario=scenario,
+        t_gyro=np.arange(n_gyro + 1) * dt,
+        q_true=q_truth[::factor],
+        omega_mean=interval_mean_rates(q_truth, factor, dt),
+        ratio=ratio,
+        dt=dt,
+        n_frames=n_gyro // ratio,
+        gyro=build.gyro_model(scenario),
+        sensor=build.star_sensor(scenario, star_catalog),
+        R_BS=quat.to_matrix(q_BS),
+    )
+
+
+def simulate(prepared, seed):
+    """The seeded part of one run on a :class:`Prepared` scenario. Returns a :class:`RunResult`."""
+    started = time.perf_counter()
+    p = prepared
+    scenario = p.scenario
+    gyro_ss, sensor_ss, init_ss = np.random.SeedSequence(seed).spawn(3)
+    record = p.gyro.measure(p.omega_mean, gyro_ss)
+    P0 = build.initial_covariance(scenario, p.gyro)
+    dtheta0 = np.sqrt(np.diag(P0)[0:3]) * np.random.default_rng(init_ss).standard_normal(3)
+    filt = build.attitude_filter(scenario, p.gyro, quat.multiply(p.q_true[0], quat.from_rotation_vector(dtheta0)), P0)
+    frame_k = np.arange(1, p.n_frames + 1) * p.ratio  # gyro sample index of each frame
+    measurements = p.sensor.observe_frames(p.q_true[frame_k], np.random.default_rng(sensor_ss))
+    log = {"t": p.t_gyro[frame_k], "q_true": p.q_true[frame_k], "bias_true": record.bias[frame_k - 1]}
+    meas_scale = scenario["filter"]["measurement_noise_scale"] ** 2
+    log.update(run_vector_filter(filt, record.omega[: p.n_frames * p.ratio], p.ratio, p.dt, p.sensor, measurements, meas_scale))
+    log["attitude_error"] = quat.attitude_error(log["q_est"], log["q_true"])
+    summary = summarize(scenario, seed, log, p.R_BS)
+    summary["wall_seconds"] = round(time.perf_counter() - started, 4)
+    series = {key: value for key, value in log.items() if key != "P"}
+    series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()
+    series["nees"] = nees(log)
+    return RunResult(summary=summary, series=series, scenario=scenario.data)
+
+
 def run(scenario, seed=None, overrides=(), star_catalog=None):
     """Simulate one run; ``seed`` overrides the scenario's. Returns a :class:`RunResult`.
 
@@ -49,84 +121,51 @@ def run(scenario, seed=None, overrides=(), star_catalog=None):
     ``star_catalog`` (a startrack StarCatalog) is loaded from the scenario epoch when needed.
     """
     started = time.perf_counter()
-    scenario = resolve_scenario(scenario, overrides)
-    seed = scenario["seed"] if seed is None else int(seed)
-    gyro_ss, sensor_ss, init_ss = np.random.SeedSequence(seed).spawn(3)
+    prepared = prepare(scenario, overrides, star_catalog)
+    result = simulate(prepared, prepared.scenario["seed"] if seed is None else int(seed))
+    result.summary["wall_seconds"] = round(time.perf_counter() - started, 4)
+    return result
 
-    gyro_hz = scenario["gyro"]["rate_hz"]
-    ratio = int(round(gyro_hz / scenario["star_sensor"]["rate_hz"]))
-    factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
-    n_gyro = int(round(scenario["duration_s"] * gyro_hz))
-    n_frames = n_gyro // ratio
-    dt = 1.0 / gyro_hz
 
-    q0 = quat.normalize(scenario["truth"]["initial_q_IB"])
-    t_truth = np.arange(n_gyro * factor + 1) / (gyro_hz * factor)
-    q_truth, _ = build.truth_profile(scenario).simulate(t_truth, q0)
-    gyro = build.gyro_model(scenario)
-    record = gyro.measure(interval_mean_rates(q_truth, factor, dt), gyro_ss)
-    q_true = q_truth[::factor]
+def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
+    """Many runs of one scenario sharing its seed-free part (truth, models, catalog): a batch of
+    one equals :func:`run` with that seed. The compiled filter loop releases the GIL, so
+    ``threads`` > 1 runs members concurrently. Returns the list of :class:`RunResult`."""
+    prepared = prepare(scenario, overrides, star_catalog)
+    if threads <= 1:
+        return [simulate(prepared, int(seed)) for seed in seeds]
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        return list(pool.map(lambda seed: simulate(prepared, int(seed)), seeds))
 
-    if scenario["star_sensor"]["measurement"] == "stars" and star_catalog is None:
-        star_catalog = load_star_catalog(epoch=scenario["epoch_jyear"])
-    sensor = build.star_sensor(scenario, star_catalog)
-    q_BS, _ = build.mounting(scenario)
-    R_BS = quat.to_matrix(q_BS)
 
-    P0 = build.initial_covariance(scenario, gyro)
-    init_rng = np.random.default_rng(init_ss)
-    dtheta0 = np.sqrt(np.diag(P0)[0:3]) * init_rng.standard_normal(3)
-    filt = build.attitude_filter(scenario, gyro, quat.multiply(q_true[0], quat.from_rotation_vector(dtheta0)), P0)
-    sensor_rng = np.random.default_rng(sensor_ss)
-    meas_scale = scenario["filter"]["measurement_noise_scale"] ** 2
+def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1.0):
+    """Run ``filt`` over a whole record in compiled code (:func:`navsim.kernels.run_filter`).
 
-    n = filt.n
-    frame_k = np.arange(1, n_frames + 1) * ratio  # gyro sample index of each frame
-    measurements = sensor.observe_frames(q_true[frame_k], sensor_rng)
+    ``omega`` (F*ratio, 3) gyro samples; ``measurements``: the sensor's ``observe_frames`` output
+    (q_IS per frame for an :class:`AttitudeFixSensor`, else :class:`StarFrames`); the sensor's
+    noise is scaled by ``meas_scale`` (variance factor) in the filter's R. Returns the per-frame
+    log arrays and leaves ``filt`` in its final state.
+    """
     fix_mode = isinstance(sensor, AttitudeFixSensor)
-    R_S = meas_scale * sensor.R_S if fix_mode else None
-    sigma = np.sqrt(meas_scale) * sensor.sigma if not fix_mode else None
-    log = {
-        "t": frame_k * dt,
-        "q_true": q_true[frame_k],
-        "q_est": np.empty((n_frames, 4)),
-        "bias_true": record.bias[frame_k - 1],
-        "bias_est": np.empty((n_frames, 3)),
-        "P": np.empty((n_frames, n, n)),
-        "n_measurements": np.zeros(n_frames, dtype=np.int32),
-        "n_accepted": np.zeros(n_frames, dtype=np.int32),
-        "nis": np.full(n_frames, np.nan),
-        "nis_dof": np.zeros(n_frames, dtype=np.int32),
-        "innovation_rms": np.full(n_frames, np.nan),
-    }
-    omega = record.omega
-    for j in range(n_frames):
-        filt.predict(omega[j * ratio : (j + 1) * ratio], dt)
-        if fix_mode:
-            result = filt.update_attitude(measurements[j], R_S)
-        else:
-            ref_I, obs_S, _ = measurements.frame(j)
-            result = filt.update_stars(ref_I, obs_S, sigma) if len(ref_I) else None
-        if result is not None:
-            accepted = result.accepted
-            n_accepted = np.count_nonzero(accepted)
-            log["n_measurements"][j] = accepted.size
-            log["n_accepted"][j] = n_accepted
-            if n_accepted:
-                z = result.z[accepted].ravel()
-                log["nis"][j] = np.dot(result.nis, accepted)
-                log["nis_dof"][j] = (3 if fix_mode else 2) * n_accepted
-                log["innovation_rms"][j] = np.sqrt(np.dot(z, z) / z.size)
-        log["q_est"][j] = filt.q
-        log["bias_est"][j] = filt.b
-        log["P"][j] = filt.P
-    log["attitude_error"] = quat.attitude_error(log["q_est"], log["q_true"])
-    summary = summarize(scenario, seed, log, R_BS)
-    summary["wall_seconds"] = round(time.perf_counter() - started, 4)
-    series = {key: value for key, value in log.items() if key != "P"}
-    series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()
-    series["nees"] = nees(log)
-    return RunResult(summary=summary, series=series)
+    n_frames = omega.shape[0] // ratio
+    if fix_mode:
+        q_meas, R_S = np.ascontiguousarray(measurements), meas_scale * sensor.R_S
+        offsets, ref_I, obs_S, variance = np.zeros(n_frames + 1, dtype=np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)
+    else:
+        q_meas, R_S = np.zeros((n_frames, 4)), np.zeros((3, 3))
+        offsets = measurements.offsets.astype(np.int64)
+        ref_I = np.ascontiguousarray(measurements.ref_I)
+        obs_S = np.ascontiguousarray(measurements.obs_S)
+        variance = np.full(len(ref_I), meas_scale * sensor.sigma**2)
+    out = kernels.run_filter(
+        filt.q, filt.b, filt.s, filt.q_BS, filt.P, np.ascontiguousarray(omega), ratio, dt,
+        filt.arw, filt.rrw, filt.scale_factor_rw, filt.process_noise_scale, filt.sf_start, filt.mis_start,
+        fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, filt.gate[3 if fix_mode else 2],
+    )
+    names = ("q_est", "bias_est", "P", "n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms")
+    log = dict(zip(names, out))
+    filt.q, filt.b, filt.P = log["q_est"][-1].copy(), log["bias_est"][-1].copy(), log["P"][-1].copy()
+    return log
 
 
 def nees(log):

@@ -4,6 +4,7 @@ Raising :class:`InputError` anywhere below a command-line entry point ends the
 program with its message on one line and exit status 2, never a traceback.
 """
 
+import os
 import sys
 
 
@@ -22,3 +23,6 @@ def run_command(prog, parser, argv=None) -> int:
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into a reader that stopped early (| head)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141

@@ -1,0 +1,61 @@
+"""Run startrack's star identifier on benchmark frames; runs in the project's own .venv.
+
+Catalog: the navigation catalog of 000 (:func:`startrack.navigation_catalog.load_navigation_catalog`)
+for V <= ``--mag``, the 16 deg field and the frames' epoch, other parameters at their defaults;
+built once and cached in :func:`startrack.cache.cache_dir`.  Identifier:
+``StarIdentifier(catalog, camera, centroid_sigma_px=...)`` with the benchmark's pinhole camera and
+its stated centroid noise, other options at their defaults.
+
+Frames without a prior: ``solve(uv, flux)`` (lost-in-space).  Frames with a prior: an identifier
+restricted to the prior-based strategies (tracking, then the predicted sub-catalog with its
+redundant neighbours), no lost-in-space fall-back -- the counterpart of tetra3rs's strict hint --
+called with ``Prior(q_IS=prior)``.  Exit status 3 when the identifier is not importable yet.
+"""
+
+import sys
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from runner_io import common_arguments, read_frames, run_frames, timed
+
+NOT_IMPORTABLE = 3
+
+
+def main():
+    parser = common_arguments(__doc__.splitlines()[0])
+    parser.add_argument("--mag", type=float, required=True, help="catalog magnitude limit m_t [V mag]")
+    parser.add_argument("--epoch", type=float, required=True, help="catalog epoch [Julian year]")
+    parser.add_argument("--centroid-sigma-px", type=float, required=True, help="centroid noise per axis [px]")
+    args = parser.parse_args()
+    try:
+        from startrack.identify.identifier import Prior, StarIdentifier
+    except ImportError as error:
+        print(f"startrack identifier not importable: {error}", file=sys.stderr)
+        return NOT_IMPORTABLE
+    from startrack.camera import Camera
+    from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+
+    fov = np.radians(args.fov_deg)
+    camera = Camera.from_fov(fov, args.width, args.height)
+    catalog = load_navigation_catalog(NavigationCatalogParams(mag_limit=args.mag, fov=fov, epoch=args.epoch))
+    frames = read_frames(args.frames)
+    tracking = any("prior_q_IS" in frame for frame in frames)
+    identifier = StarIdentifier(catalog, camera, centroid_sigma_px=args.centroid_sigma_px,
+                                **({"methods": ("tracking", "subcatalog")} if tracking else {}))
+
+    def solve(frame):
+        centroids = np.array(frame["centroids"], dtype=float).reshape(-1, 3)
+        prior = Prior(q_IS=np.array(frame["prior_q_IS"])) if "prior_q_IS" in frame else None
+        result, ms = timed(identifier.solve, centroids[:, :2], centroids[:, 2], prior)
+        if not result.ok:
+            return result.status, None, [], ms, result.method or None
+        R_IS = Rotation.from_quat(result.q_IS).as_matrix()
+        return "ok", R_IS, result.matches.tolist(), ms, result.method
+
+    run_frames(frames, solve, args.out, "startrack")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,40 @@
+"""Run every benchmark script of benchmarks/ in turn (``make bench``); each writes benchmarks/results/<name>.json.
+
+Each script runs in its own process from the repository root with this interpreter; a script that
+fails is reported and the others still run.  The exit status is 1 when any script failed (a crash,
+not a slow result: benchmarks measure, they never assert).  The star-identification peers need
+their virtualenvs first: ``sh benchmarks/peers/setup_venvs.sh`` (``make bench`` does it).
+
+Run:  python benchmarks/run_all.py [--only star_id catalog_build ...]
+"""
+
+import argparse
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+#: The benchmark scripts, cheapest first.
+SCRIPTS = ("attitude_solvers", "catalog_build", "image_chain", "closed_loop", "star_id")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=SCRIPTS, help="run only these scripts")
+    args = parser.parse_args()
+    outcomes = []
+    for name in args.only or SCRIPTS:
+        print(f"=== benchmarks/{name}.py", flush=True)
+        start = time.perf_counter()
+        status = subprocess.run([sys.executable, str(HERE / f"{name}.py")], cwd=ROOT).returncode
+        outcomes.append((name, status, time.perf_counter() - start))
+    print("\n=== summary")
+    for name, status, seconds in outcomes:
+        print(f"  {name:<18} {'ok' if status == 0 else f'FAILED (exit {status})':<18} {seconds:8.1f} s")
+    return 1 if any(status != 0 for _, status, _ in outcomes) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

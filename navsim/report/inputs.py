@@ -1,0 +1,202 @@
+"""Read what a report is made from: a run directory or a Monte Carlo campaign directory.
+
+A run directory holds ``summary.json`` and ``timeseries.npz`` (and usually ``scenario.json``;
+optionally ``frame.npy`` with ``frame_detections.json``). A campaign directory holds
+``campaign.json`` and ``runs/run_NNNNN/`` run directories (a run that raised leaves
+``error.json`` instead), with the aggregate in ``summary.json``. Only the arrays a report
+draws are checked; everything optional may be absent. Bad input raises
+:class:`~startrack.errors.InputError` with one sentence naming the file and the problem.
+"""
+
+import json
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from startrack.errors import InputError
+
+#: Arrays every run must have; the report cannot say anything without them.
+REQUIRED_SERIES = ("t", "attitude_error")
+#: Per-frame arrays and the trailing shape each must have when present (() for one number per frame).
+SERIES_SHAPES = {
+    "t": (),
+    "attitude_error": (3,),
+    "P_diag": None,  # (F, n) with n >= 6
+    "bias_true": (3,),
+    "bias_est": (3,),
+    "nees": (),
+    "nis": (),
+    "nis_dof": (),
+    "n_measurements": (),
+    "n_accepted": (),
+    "innovation_rms": (),
+    "mode": (),
+    "n_detected": (),
+    "n_identified": (),
+    "n_stacked": (),
+    "id_ms": (),
+    "boresight_radec": (2,),
+    "subcatalog_index": (),
+    "subcatalog_address": (2,),
+}
+#: The arrays a campaign report reads from each run (the rest are not loaded).
+CAMPAIGN_SERIES = ("t", "attitude_error", "P_diag", "nees", "mode", "n_identified", "n_stacked", "n_accepted")
+
+
+@dataclass
+class RunData:
+    """One run: its summary, per-frame series (SI units), scenario and optional rendered frame."""
+
+    directory: Path
+    summary: dict
+    series: dict
+    scenario: dict | None = None
+    frame: np.ndarray | None = None
+    detections: list | None = None
+
+    @property
+    def frames(self) -> int:
+        return int(self.series["t"].size)
+
+
+@dataclass
+class FailedRun:
+    name: str
+    message: str
+
+
+@dataclass
+class CampaignData:
+    """A campaign: its description, aggregate summary, finished runs (in name order) and failures."""
+
+    directory: Path
+    campaign: dict
+    summary: dict | None
+    runs: list = field(default_factory=list)
+    failed: list = field(default_factory=list)
+    scenario: dict | None = None
+
+
+def read_json(path: Path) -> dict:
+    try:
+        payload = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise InputError(f"{path}: cannot read it as JSON ({error}).") from None
+    if not isinstance(payload, dict):
+        raise InputError(f"{path}: expected a JSON object, got {type(payload).__name__}.")
+    return payload
+
+
+def read_series(path: Path, names=None) -> dict:
+    """The arrays of ``timeseries.npz`` (all, or those of ``names`` present), shape-checked."""
+    if not zipfile.is_zipfile(path):
+        raise InputError(f"{path}: not an .npz array file (not a zip archive).")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            present = [n for n in data.files if names is None or n in names]
+            series = {name: data[name] for name in present}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+        raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
+    for name in REQUIRED_SERIES:
+        if name not in series:
+            raise InputError(f"{path}: the array '{name}' is missing.")
+    n = series["t"].shape[0] if series["t"].ndim == 1 else -1
+    if n < 1:
+        raise InputError(f"{path}: 't' must be a non-empty 1-D array of frame times, got shape {series['t'].shape}.")
+    for name, trailing in SERIES_SHAPES.items():
+        if name not in series:
+            continue
+        shape = series[name].shape
+        ok = shape[:1] == (n,) and (len(shape) == 2 and shape[1] >= 6 if trailing is None else shape[1:] == trailing)
+        if not ok:
+            expected = f"({n}, >= 6)" if trailing is None else str((n, *trailing))
+            raise InputError(f"{path}: array '{name}' has shape {shape}, expected {expected} (one row per frame).")
+        if series[name].dtype.kind not in "biuf":
+            raise InputError(f"{path}: array '{name}' is not numeric (dtype {series[name].dtype}).")
+    return series
+
+
+def directory_kind(directory: Path) -> str:
+    """'run' or 'campaign'; anything else is an InputError."""
+    if not directory.exists():
+        raise InputError(f"{directory}: no such directory.")
+    if not directory.is_dir():
+        raise InputError(f"{directory}: is not a directory (expected a run or campaign output directory).")
+    if (directory / "campaign.json").is_file():
+        return "campaign"
+    if (directory / "timeseries.npz").is_file() and (directory / "summary.json").is_file():
+        return "run"
+    raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz) "
+                     "nor a campaign directory (campaign.json).")
+
+
+def load_run(directory: Path) -> RunData:
+    summary = read_json(directory / "summary.json")
+    series = read_series(directory / "timeseries.npz")
+    scenario_path = directory / "scenario.json"
+    scenario = read_json(scenario_path) if scenario_path.is_file() else None
+    frame, detections = None, None
+    if (directory / "frame.npy").is_file():
+        frame = _read_frame(directory / "frame.npy")
+        detections_path = directory / "frame_detections.json"
+        if detections_path.is_file():
+            detections = _read_detections(detections_path)
+    return RunData(directory, summary, series, scenario, frame, detections)
+
+
+def _read_frame(path: Path) -> np.ndarray:
+    try:
+        frame = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, EOFError) as error:
+        raise InputError(f"{path}: cannot read it as a .npy image ({error}).") from None
+    if frame.ndim != 2 or frame.dtype.kind not in "biuf" or min(frame.shape) < 1:
+        raise InputError(f"{path}: expected a 2-D numeric image, got shape {frame.shape} dtype {frame.dtype}.")
+    return frame
+
+
+def _read_detections(path: Path) -> list:
+    try:
+        payload = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise InputError(f"{path}: cannot read it as JSON ({error}).") from None
+    if isinstance(payload, dict):
+        payload = payload.get("detections")
+    if not isinstance(payload, list):
+        raise InputError(f"{path}: expected a list of {{u, v, hip}} detections.")
+    detections = []
+    for i, item in enumerate(payload):
+        try:
+            u, v = float(item["u"]), float(item["v"])
+            hip = item.get("hip")
+            hip = None if hip is None else int(hip)
+        except (TypeError, KeyError, ValueError):
+            raise InputError(f"{path}: detection {i} is not an object with numbers u, v and hip (or null).") from None
+        detections.append((u, v, hip))
+    return detections
+
+
+def load_campaign(directory: Path) -> CampaignData:
+    campaign = read_json(directory / "campaign.json")
+    summary_path = directory / "summary.json"
+    summary = read_json(summary_path) if summary_path.is_file() else None
+    scenario_path = directory / "scenario.json"
+    scenario = read_json(scenario_path) if scenario_path.is_file() else None
+    if scenario is None and isinstance(campaign.get("scenario"), dict):
+        scenario = campaign["scenario"]
+    data = CampaignData(directory, campaign, summary, scenario=scenario)
+    runs_dir = directory / "runs"
+    run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir()) if runs_dir.is_dir() else []
+    for run_dir in run_dirs:
+        if (run_dir / "error.json").is_file():
+            error = read_json(run_dir / "error.json")
+            message = error.get("error") or error.get("message") or json.dumps(error, sort_keys=True)
+            data.failed.append(FailedRun(run_dir.name, str(message)))
+        elif (run_dir / "summary.json").is_file() and (run_dir / "timeseries.npz").is_file():
+            series = read_series(run_dir / "timeseries.npz", CAMPAIGN_SERIES)
+            data.runs.append(RunData(run_dir, read_json(run_dir / "summary.json"), series))
+    if not data.runs:
+        raise InputError(f"{directory}: the campaign has no finished runs under runs/ "
+                         f"({len(data.failed)} failed); nothing to report.")
+    return data

@@ -1,0 +1,309 @@
+"""The numbers a report quotes and draws, computed once from a run or a campaign.
+
+Units at this edge: attitude in arcsec, gyro bias in deg/h, times in seconds and milliseconds.
+The consistency bands are the two-sided 95 % chi-square intervals of Bar-Shalom, Li and
+Kirubarajan (Estimation with Applications to Tracking and Navigation, §5.4.2): for a
+consistent filter the NEES of one run is χ²(n), and the NEES averaged over M independent
+runs, ε̄ = (1/M) Σ εᵢ, satisfies M ε̄ ~ χ²(M n).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from navsim import units
+from startrack import address
+from startrack.errors import InputError
+
+BAND_PROBABILITY = 0.95
+#: A frame counts as identified when at least this many stars were identified (two fix an attitude).
+MIN_IDENTIFIED = 2
+#: Error of the attitude states is rows 0:3 of the filter state, the gyro bias rows 3:6.
+ATTITUDE, BIAS = slice(0, 3), slice(3, 6)
+NEES_DOF = 6
+
+
+def chi2_band(dof, runs=1, probability=BAND_PROBABILITY):
+    """Two-sided ``probability`` interval of the NEES averaged over ``runs`` runs of ``dof`` dof each."""
+    tail = (1.0 - probability) / 2.0
+    total = np.multiply(dof, runs)
+    return chi2.ppf(tail, total) / runs, chi2.ppf(1.0 - tail, total) / runs
+
+
+def mode_names(summary, codes):
+    """Display names of the mode codes: ``summary["modes"][code]`` when given, else "mode <code>"."""
+    names = summary.get("modes") if summary else None
+    out = {}
+    for code in np.unique(codes):
+        code = int(code)
+        ok = isinstance(names, list) and 0 <= code < len(names) and isinstance(names[code], str)
+        out[code] = names[code] if ok else f"mode {code}"
+    return out
+
+
+def mode_segments(t, mode):
+    """Consecutive frames in one mode as (code, t_start, t_end), each frame lasting one frame period."""
+    period = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    change = np.flatnonzero(np.diff(mode)) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [t.size]])
+    return [(int(mode[s]), float(t[s]), float(t[e - 1]) + period) for s, e in zip(starts, ends)]
+
+
+@dataclass(frozen=True)
+class ModeRow:
+    """Per-mode statistics of one run: frames spent, identified stars and identification time."""
+
+    name: str
+    frames: int
+    fraction: float
+    identified_mean: float | None
+    id_ms_median: float | None
+    id_ms_p95: float | None
+    id_ms_max: float | None
+
+
+def mode_table(run):
+    """One :class:`ModeRow` per mode present in ``run.series["mode"]`` (empty list without modes)."""
+    s = run.series
+    if "mode" not in s:
+        return []
+    names = mode_names(run.summary, s["mode"])
+    rows = []
+    for code, name in names.items():
+        sel = s["mode"] == code
+        ident = s["n_identified"][sel] if "n_identified" in s else None
+        ms = s["id_ms"][sel] if "id_ms" in s else None
+        ms = ms[np.isfinite(ms)] if ms is not None else None
+        has_ms = ms is not None and ms.size > 0
+        rows.append(ModeRow(
+            name=name,
+            frames=int(sel.sum()),
+            fraction=float(sel.mean()),
+            identified_mean=float(ident.mean()) if ident is not None else None,
+            id_ms_median=float(np.median(ms)) if has_ms else None,
+            id_ms_p95=float(np.percentile(ms, 95)) if has_ms else None,
+            id_ms_max=float(ms.max()) if has_ms else None,
+        ))
+    return rows
+
+
+def declination_divisions(run):
+    """n_d of the base-point grid the run addressed, or None.
+
+    Taken from a key ``n_d`` anywhere in scenario.json or summary.json; otherwise the n_d for
+    which the logged addresses (l_d, l_ra) and flat indices agree (eq. 7-8 and the flat index
+    of document 000), searched over the grids whose ring count covers the largest l_d.
+    """
+    for source in (run.scenario, run.summary):
+        found = _find_key(source, "n_d")
+        if found is not None:
+            return found
+    s = run.series
+    if "subcatalog_address" not in s or "subcatalog_index" not in s:
+        return None
+    l_d = s["subcatalog_address"][:, 0].astype(np.int64)
+    l_ra = s["subcatalog_address"][:, 1].astype(np.int64)
+    index = s["subcatalog_index"].astype(np.int64)
+    if l_d.min() < 1 or l_ra.min() < 1:
+        return None
+    for n_d in range(max(3, int(l_d.max()) + 1), 2001):
+        offsets = address.ring_offsets(n_d)
+        if np.array_equal(offsets[l_d - 1] + l_ra - 1, index) and np.all(l_ra <= address.ring_sizes(n_d)[l_d - 1]):
+            return n_d
+    return None
+
+
+def _find_key(tree, key):
+    if isinstance(tree, dict):
+        value = tree.get(key)
+        if isinstance(value, int) and not isinstance(value, bool) and 3 <= value <= 2000:
+            return value
+        children = tree.values()
+    elif isinstance(tree, list):
+        children = tree
+    else:
+        return None
+    for child in children:
+        found = _find_key(child, key)
+        if found is not None:
+            return found
+    return None
+
+
+# --------------------------------------------------------------------------- campaigns
+
+
+@dataclass(frozen=True)
+class Envelopes:
+    """Attitude error [arcsec] across M runs at each frame (F frames, 3 body axes)."""
+
+    t: np.ndarray  # (F,)
+    runs: int
+    mean: np.ndarray  # (F, 3)
+    std: np.ndarray  # (F, 3), run-to-run sample standard deviation
+    p05: np.ndarray
+    p50: np.ndarray
+    p95: np.ndarray
+    rms: np.ndarray  # (F, 3), root mean square across runs
+    sigma3_filter: np.ndarray | None  # (F, 3), 3 sqrt(mean over runs of P_ii)
+    final: np.ndarray  # (M, 3) error at the last frame
+    final_sigma_filter: np.ndarray | None  # (3,) sqrt(mean over runs of P_ii) at the last frame
+
+
+def common_frames(campaign):
+    """The frame times shared by all finished runs (the shortest run's), checked to coincide."""
+    n = min(r.frames for r in campaign.runs)
+    t = campaign.runs[0].series["t"][:n]
+    for r in campaign.runs[1:]:
+        if not np.allclose(r.series["t"][:n], t, rtol=0.0, atol=1e-9):
+            raise InputError(f"{r.directory}: frame times differ from those of {campaign.runs[0].directory.name}; "
+                             "the runs are not of one scenario.")
+    return t
+
+
+def envelopes(campaign):
+    t = common_frames(campaign)
+    n = t.size
+    err = units.rad_to_arcsec(np.stack([r.series["attitude_error"][:n] for r in campaign.runs]))
+    ddof = 1 if len(campaign.runs) > 1 else 0
+    p05, p50, p95 = np.percentile(err, [5, 50, 95], axis=0)
+    sigma3, final_sigma = None, None
+    if all("P_diag" in r.series for r in campaign.runs):
+        var = np.mean(np.stack([r.series["P_diag"][:n, ATTITUDE] for r in campaign.runs]), axis=0)
+        sigma = units.rad_to_arcsec(np.sqrt(var))
+        sigma3, final_sigma = 3.0 * sigma, sigma[-1]
+    return Envelopes(
+        t=t, runs=err.shape[0], mean=err.mean(axis=0), std=err.std(axis=0, ddof=ddof),
+        p05=p05, p50=p50, p95=p95, rms=np.sqrt(np.mean(err**2, axis=0)),
+        sigma3_filter=sigma3, final=err[:, -1, :], final_sigma_filter=final_sigma,
+    )
+
+
+@dataclass(frozen=True)
+class AveragedNees:
+    t: np.ndarray
+    runs: int
+    dof: int
+    mean: np.ndarray  # (F,) NEES averaged over the runs
+    band: tuple  # (lo, hi) for the average of ``runs`` runs
+    settle_s: float
+    fraction_in_band: float  # over the frames after settle_s
+    mean_after_settle: float
+
+
+def averaged_nees(campaign):
+    """NEES averaged over the runs with its chi-square band for M runs, or None if not logged."""
+    if not all("nees" in r.series for r in campaign.runs):
+        return None
+    t = common_frames(campaign)
+    mean = np.mean(np.stack([r.series["nees"][: t.size] for r in campaign.runs]), axis=0)
+    m = len(campaign.runs)
+    dof = int(campaign.runs[0].summary.get("nees", {}).get("dof", NEES_DOF))
+    lo, hi = chi2_band(dof, m)
+    settle = float(campaign.runs[0].summary.get("settle_s", 0.0))
+    steady = t >= settle
+    if not steady.any():
+        steady = np.ones_like(t, dtype=bool)
+    inside = (mean[steady] >= lo) & (mean[steady] <= hi)
+    return AveragedNees(t, m, dof, mean, (float(lo), float(hi)), settle, float(inside.mean()),
+                        float(mean[steady].mean()))
+
+
+@dataclass(frozen=True)
+class SuccessRow:
+    name: str
+    frames: int
+    identified: int
+
+    @property
+    def fraction(self):
+        return self.identified / self.frames if self.frames else float("nan")
+
+
+def identification_success(campaign):
+    """Frames with at least MIN_IDENTIFIED identified stars, pooled over runs, per mode.
+
+    Returns (rows, criterion). Without per-frame identification counts the rows count frames
+    with at least one accepted star measurement instead, and ``criterion`` says so.
+    """
+    runs = campaign.runs
+    if all("n_identified" in r.series for r in runs):
+        criterion = f"frames with at least {MIN_IDENTIFIED} identified stars"
+        hits = [r.series["n_identified"] >= MIN_IDENTIFIED for r in runs]
+    elif all("n_accepted" in r.series for r in runs):
+        criterion = "frames with at least one accepted star measurement"
+        hits = [r.series["n_accepted"] >= 1 for r in runs]
+    else:
+        return [], None
+    if not all("mode" in r.series for r in runs):
+        frames = sum(h.size for h in hits)
+        return [SuccessRow("all frames", frames, int(sum(h.sum() for h in hits)))], criterion
+    codes = np.unique(np.concatenate([r.series["mode"] for r in runs]))
+    names = mode_names(campaign_modes_source(campaign), codes)
+    rows = []
+    for code in codes:
+        frames = sum(int(np.count_nonzero(r.series["mode"] == code)) for r in runs)
+        good = sum(int(np.count_nonzero(h & (r.series["mode"] == code))) for r, h in zip(runs, hits))
+        rows.append(SuccessRow(names[int(code)], frames, good))
+    return rows, criterion
+
+
+def campaign_modes_source(campaign):
+    """The summary that names the modes: the aggregate's if it has ``modes``, else the first run's."""
+    if campaign.summary and isinstance(campaign.summary.get("modes"), list):
+        return campaign.summary
+    return campaign.runs[0].summary
+
+
+#: Per-run metrics tabulated across a campaign: (label, unit, path in summary.json).
+RUN_METRICS = (
+    ("cross-boresight RMS", "arcsec", ("cross_boresight_rms_arcsec",)),
+    ("roll RMS", "arcsec", ("roll_rms_arcsec",)),
+    ("x RMS", "arcsec", ("attitude_error_rms_arcsec", "x")),
+    ("y RMS", "arcsec", ("attitude_error_rms_arcsec", "y")),
+    ("z RMS", "arcsec", ("attitude_error_rms_arcsec", "z")),
+    ("NEES mean", "", ("nees", "mean")),
+    ("NEES in 95 % band", "%", ("nees", "fraction_in_band")),
+    ("NIS mean per dof", "", ("nis", "mean_per_dof")),
+    ("wall time", "s", ("wall_seconds",)),
+)
+
+
+@dataclass(frozen=True)
+class MetricRow:
+    label: str
+    unit: str
+    runs: int
+    mean: float
+    std: float
+    median: float
+    p95: float
+    maximum: float
+
+
+def metric_table(campaign):
+    """Across-run statistics of each per-run metric found in the run summaries."""
+    rows = []
+    for label, unit, path in RUN_METRICS:
+        values = [_lookup(r.summary, path) for r in campaign.runs]
+        values = np.array([v for v in values if v is not None], dtype=float)
+        if values.size == 0:
+            continue
+        if unit == "%":
+            values = 100.0 * values
+        rows.append(MetricRow(label, unit, values.size, float(values.mean()),
+                              float(values.std(ddof=1)) if values.size > 1 else 0.0,
+                              float(np.median(values)), float(np.percentile(values, 95)), float(values.max())))
+    return rows
+
+
+def _lookup(tree, path):
+    for key in path:
+        if not isinstance(tree, dict) or key not in tree:
+            return None
+        tree = tree[key]
+    if isinstance(tree, bool) or not isinstance(tree, (int, float)) or not np.isfinite(tree):
+        return None
+    return float(tree)

@@ -1,0 +1,220 @@
+"""The star identifier: one call per frame, strategies tried in the order of DESIGN.md's closed loop.
+
+``StarIdentifier(catalog, camera, ...)`` holds the navigation catalog (guide stars, pattern pairs,
+k-vector, sub-catalogs), the field stars used for verification (every Hipparcos star to the
+catalog's magnitude limit) and three strategies, each an object with ``identify(frame, prior)``:
+
+* :class:`~startrack.identify.tracking.Tracking` -- needs ``prior.q_IS`` (and optionally a rate);
+* :class:`~startrack.identify.subcatalog.SubCatalog` -- needs a prior boresight (from ``prior.q_IS``
+  or ``prior.boresight``);
+* :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing.
+
+``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
+vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
+and never raise for the content of a frame (NaN, too few or off-sensor centroids give a status and a
+reason); a wrong configuration raises :class:`startrack.errors.InputError` at construction.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from startrack.attitude import cramer_rao_covariance
+from startrack.attitude_angles import quaternion_from_matrix, radec_roll_from_matrix
+from startrack.errors import InputError
+from startrack.identify.features import FrameFeatures
+from startrack.identify.lost_in_space import LostInSpace, PatternMatcher
+from startrack.identify.result import IdentificationResult
+from startrack.identify.subcatalog import SubCatalog
+from startrack.identify.tracking import Tracking, propagate
+from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
+
+#: Strategy names in the order they are tried.
+METHODS = ("tracking", "subcatalog", "lost_in_space")
+
+
+@dataclass(frozen=True)
+class Prior:
+    """What is known before the frame: an attitude estimate and rate, or only a boresight.
+
+    q_IS: (4,) attitude estimate at the prior's time (scalar-last, S -> I); rate_S: (3,) body rate
+    [rad/s] in sensor axes; dt: time from the prior to the frame [s]; boresight: (ra, dec) [rad],
+    used when q_IS is None; tracked_hip: HIP numbers tracked in the previous frame (for the lost and
+    entering stars of tracking).
+    """
+
+    q_IS: np.ndarray | None = None
+    rate_S: np.ndarray | None = None
+    dt: float = 0.0
+    boresight: tuple[float, float] | None = None
+    tracked_hip: np.ndarray | None = None
+
+    def boresight_radec(self):
+        """(ra, dec) [rad] of the predicted boresight, or None."""
+        if self.q_IS is not None:
+            ra, dec, _ = radec_roll_from_matrix(propagate(self.q_IS, self.rate_S, self.dt))
+            return float(ra), float(dec)
+        if self.boresight is not None:
+            return float(self.boresight[0]), float(self.boresight[1])
+        return None
+
+
+def _positive(name, value, upper=math.inf):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(value) or not 0.0 < value <= upper:
+        raise InputError(f"star identifier option {name} = {value!r} must be a number in (0, {upper:g}].")
+    return float(value)
+
+
+class StarIdentifier:
+    """Star identification over a navigation catalog for one camera.
+
+    catalog: :class:`startrack.navigation_catalog.NavigationCatalog`; camera: :class:`startrack.camera.Camera`;
+    centroid_sigma_px: centroid noise per axis [px] (covariance and gates); delta_sigmas: the error
+    bound delta of 001 §4.3.1 in units of it (3); gate_sigmas: verification match radius in units of it
+    (5); pattern_stars: brightest centroids searched first (10); max_stars: centroids used at all
+    (None: all); max_groups: four-star groups searched for (4); max_triangles: triangles kept for frames
+    without a group (8); false_match_threshold: acceptance threshold
+    (1e-6); tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
+    :data:`METHODS`; neighbours: search the 4 redundant sub-catalogs; field_stars: a
+    :class:`~startrack.identify.verify.FieldStars` (default: every Hipparcos star with V <= field_mag_limit,
+    by default the catalog's magnitude limit).
+    """
+
+    def __init__(self, catalog, camera, centroid_sigma_px=0.2, delta_sigmas=3.0, gate_sigmas=5.0,
+                 pattern_stars=10, max_stars=None, max_groups=4, max_triangles=8,
+                 false_match_threshold=DEFAULT_FALSE_MATCH_THRESHOLD, tracking_window_px=20.0,
+                 methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None):
+        self.catalog = catalog
+        self.camera = camera
+        self.centroid_sigma_px = _positive("centroid_sigma_px", centroid_sigma_px, 100.0)
+        self.delta_px = _positive("delta_sigmas", delta_sigmas, 100.0) * self.centroid_sigma_px
+        self.verify_gate = _positive("gate_sigmas", gate_sigmas, 100.0) * self.centroid_sigma_px / camera.focal_px
+        for name, value, least in (("pattern_stars", pattern_stars, 4), ("max_groups", max_groups, 1),
+                                   ("max_triangles", max_triangles, 1)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+                raise InputError(f"star identifier option {name} = {value!r} must be an integer >= {least}.")
+        if max_stars is not None and (isinstance(max_stars, bool) or not isinstance(max_stars, (int, np.integer))
+                                      or max_stars < 3):
+            raise InputError(f"star identifier option max_stars = {max_stars!r} must be an integer >= 3 or None.")
+        self.pattern_stars = int(pattern_stars)
+        self.max_stars = None if max_stars is None else int(max_stars)
+        self.false_match_threshold = _positive("false_match_threshold", false_match_threshold, 1.0)
+        unknown = [m for m in methods if m not in METHODS]
+        if unknown or not methods:
+            raise InputError(f"star identifier methods {tuple(methods)!r} must be a non-empty subset of {METHODS}.")
+        if field_stars is None:
+            from startrack.star_catalog import load_star_catalog
+
+            field_stars = FieldStars.from_star_catalog(
+                catalog, camera, load_star_catalog(catalog.params.epoch),
+                catalog.params.mag_limit if field_mag_limit is None else _positive("field_mag_limit", field_mag_limit, 20.0))
+        self.field = field_stars
+        matcher = PatternMatcher(catalog, self.field, self.pattern_stars, int(max_groups), int(max_triangles),
+                                 self.false_match_threshold)
+        available = {
+            "tracking": Tracking(self.field, _positive("tracking_window_px", tracking_window_px, 1e4),
+                                 self.false_match_threshold),
+            "subcatalog": SubCatalog(catalog, matcher, neighbours),
+            "lost_in_space": LostInSpace(catalog, matcher),
+        }
+        self.strategies = [available[m] for m in METHODS if m in methods]
+
+    # ------------------------------------------------------------------ public calls
+    def solve(self, uv, flux=None, prior: Prior | None = None) -> IdentificationResult:
+        """Identify centroids ``uv`` (n, 2) [px] (``flux`` (n,) optional: brightest first; else given order)."""
+        start = time.perf_counter()
+        uv = np.asarray(uv, dtype=float) if _numeric(uv) else None
+        if uv is None or uv.ndim != 2 or uv.shape[1] != 2:
+            return _failed("error", "centroids must be an array of shape (n, 2) of numbers", start)
+        if not np.all(np.isfinite(uv)):
+            return _failed("error", "a centroid coordinate is NaN or infinite", start)
+        cam = self.camera
+        inside = (uv[:, 0] >= -0.5) & (uv[:, 0] <= cam.width - 0.5) & (uv[:, 1] >= -0.5) & (uv[:, 1] <= cam.height - 0.5)
+        if uv.shape[0] and not inside.any():
+            return _failed("error", f"all {uv.shape[0]} centroids lie outside the {cam.width} x {cam.height} px sensor", start)
+        index = np.flatnonzero(inside)
+        flux = self._checked_flux(flux, uv.shape[0])
+        if isinstance(flux, str):
+            return _failed("error", flux, start)
+        obs_S = cam.unproject(uv[index]) if index.size else np.zeros((0, 3))
+        return self._solve(obs_S, index, None if flux is None else flux[index], prior, start)
+
+    def solve_vectors(self, obs_S, flux=None, prior: Prior | None = None) -> IdentificationResult:
+        """Identify directions ``obs_S`` (n, 3) in the sensor frame (normalised here), brightest first unless ``flux``."""
+        start = time.perf_counter()
+        obs = np.asarray(obs_S, dtype=float) if _numeric(obs_S) else None
+        if obs is None or obs.ndim != 2 or obs.shape[1] != 3:
+            return _failed("error", "directions must be an array of shape (n, 3) of numbers", start)
+        norms = np.linalg.norm(obs, axis=1)
+        if not (np.all(np.isfinite(obs)) and np.all(norms > 0.0)):
+            return _failed("error", "a direction is NaN, infinite or zero", start)
+        flux = self._checked_flux(flux, obs.shape[0])
+        if isinstance(flux, str):
+            return _failed("error", flux, start)
+        return self._solve(obs / norms[:, None], np.arange(obs.shape[0]), flux, prior, start)
+
+    # ------------------------------------------------------------------ internals
+    @staticmethod
+    def _checked_flux(flux, n):
+        if flux is None:
+            return None
+        flux = np.asarray(flux, dtype=float) if _numeric(flux) else None
+        if flux is None or flux.shape != (n,):
+            return f"flux must be one number per centroid ({n})"
+        if not np.all(np.isfinite(flux)):
+            return "a flux value is NaN or infinite"
+        return flux
+
+    def _solve(self, obs_S, index, flux, prior, start):
+        if flux is not None:
+            order = np.argsort(-flux, kind="stable")
+            obs_S, index = obs_S[order], index[order]
+        if self.max_stars is not None:
+            obs_S, index = obs_S[: self.max_stars], index[: self.max_stars]
+        if len(obs_S) < 3:
+            return _failed("too_few", f"{len(obs_S)} usable centroids; at least 3 are needed", start)
+        frame = FrameFeatures.build(obs_S, index, self.camera.focal_px, self.delta_px, self.verify_gate,
+                                    2 * self.pattern_stars)
+        for strategy in self.strategies:
+            verified = strategy.identify(frame, prior)
+            if verified is not None:
+                return self._result(frame, verified, strategy, prior, start)
+        tried = ", ".join(s.name for s in self.strategies if s.name == "lost_in_space" or prior is not None)
+        return _failed("no_match", f"no star pattern was verified ({tried or 'no method applicable'})", start)
+
+    def _result(self, frame, verified, strategy, prior, start):
+        ref = self.field.vectors[verified.star_index]
+        obs = frame.obs_S[verified.obs_index]
+        R_IS = verified.R_IS
+        chord = obs - ref @ R_IS
+        residuals = 2.0 * np.arcsin(np.minimum(0.5 * np.sqrt(np.einsum("ij,ij->i", chord, chord)), 1.0))
+        covariance = cramer_rao_covariance(obs, self.centroid_sigma_px / self.camera.focal_px)
+        centroid = frame.index[verified.obs_index]
+        order = np.argsort(centroid)
+        hip = self.field.hip[verified.star_index]
+        lost = entered = np.zeros(0, np.int64)
+        if strategy.name == "tracking":
+            lost, entered = strategy.lost_and_entered(prior, R_IS, hip)
+        return IdentificationResult(
+            status="ok", q_IS=quaternion_from_matrix(R_IS),
+            matches=np.column_stack([centroid[order], hip[order]]).astype(np.int64),
+            residuals=residuals[order], covariance=covariance,
+            false_match_probability=verified.false_match_probability, method=strategy.name,
+            solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered)
+
+
+def _numeric(value) -> bool:
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError):
+        return False
+    return array.dtype.kind in "biuf"
+
+
+def _failed(status, reason, start):
+    return IdentificationResult(status=status, reason=reason + ".", solve_ms=1e3 * (time.perf_counter() - start))

@@ -1,0 +1,316 @@
+"""Star-pattern search: triangles and four-star groups on the pair table (001 ch. 4, pyramid-style).
+
+For the brightest centroids of a frame (brightest first):
+
+1. every observed pair (a, b) gives an interval [beta_ab - e_ab, beta_ab + e_ab] (e_ab the gate of
+   001 §4.3.1, :mod:`startrack.identify.features`); the pair table returns the catalog pairs inside it
+   (the k-vector of 000 eq. 3-5 for the full sky, a binary search in a sub-catalog);
+2. triangles (001 §4.4.2): catalog pairs matched to the observed pairs (i, j) and (i, k) that share
+   the catalog star A of i form a candidate triangle (A, B, C); it is kept when the distance (B, C)
+   lies within the gate of (j, k) and it has the handedness of the observed triangle (a mirror image
+   is not a rotation);
+3. higher-order star groups (001 §4.4.3; the fourth star of the pyramid algorithm): a triangle is
+   extended by any other centroid r with a catalog star D matched to (i, r) whose distances to B and
+   C also lie within the gates of (j, r) and (k, r): the four-star group ijkr, all six distances
+   consistent.  Stars outside every group (false stars, stars missing from the guide catalog) never
+   enter a hypothesis; missing stars only remove triangles, they cannot create a wrong one.
+
+The search (a compiled kernel; the per-frame hot loop) takes anchors i brightest first, then j, then
+k, so the brightest triangles come first; it stops after a few groups.  The groups found are then
+ordered by the sum of their brightness ranks and, among equals, best conditioned first (smallest sum
+of the six gates, which grow for short and badly measured pairs); groups of four before triangles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from startrack.identify.verify import verify, wahba_svd
+from startrack.jit import njit
+
+
+@dataclass(frozen=True, eq=False)
+class PairTable:
+    """Catalog star pairs sorted by angular distance: ``theta`` [rad], guide-star indices ``first``, ``second``.
+
+    With a k-vector (``k`` int64, ``slope`` m and ``intercept`` q of eq. 3-4 of 000; the full table)
+    a distance interval is found by eq. 5; without one (``k`` empty: the sub-catalog tables, a few
+    hundred pairs) by a binary search.
+    """
+
+    theta: np.ndarray
+    first: np.ndarray
+    second: np.ndarray
+    k: np.ndarray
+    slope: float = 1.0
+    intercept: float = 0.0
+
+    @classmethod
+    def full_sky(cls, catalog) -> "PairTable":
+        """Every pattern pair of the navigation catalog, searched with its k-vector."""
+        kv = catalog.kvector
+        return cls(catalog.pair_theta, catalog.pair_i, catalog.pair_j, kv.k.astype(np.int64), float(kv.slope),
+                   float(kv.intercept))
+
+    @classmethod
+    def subset(cls, catalog, pair_index) -> "PairTable":
+        """The pattern pairs ``pair_index`` (ascending, hence sorted by distance), e.g. a sub-catalog's."""
+        return cls(catalog.pair_theta[pair_index], catalog.pair_i[pair_index], catalog.pair_j[pair_index],
+                   np.zeros(0, np.int64))
+
+
+@njit
+def _pair_range(theta, k, slope, intercept, low, high):
+    """[lo, hi) indices of the pairs with theta in [low, high]; k-vector superset, or exact without one.
+
+    With the k-vector: eq. 5 of 000 widened by one bucket each side, k(j_start) .. k(j_end)
+    (Mortari); the caller tests theta of each pair, which trims the few just outside.
+    """
+    n = k.size
+    if n == 0:
+        return np.searchsorted(theta, low), np.searchsorted(theta, high, side="right")
+    start = min(max(np.floor((low - intercept) / slope) - 1.0, 1.0), float(n))
+    stop = min(max(np.ceil((high - intercept) / slope) + 1.0, 1.0), float(n))
+    return k[int(start) - 1], k[int(stop) - 1]
+
+
+@dataclass(frozen=True)
+class Hypotheses:
+    """Star-group hypotheses in search order: observed indices (h, s) and guide-star indices (h, s).
+
+    ``groups`` have s = 4 stars, ``triangles`` s = 3; ``n_pair_matches`` is the number of oriented
+    catalog pairs that matched an observed pair within its gate (N_h of :mod:`startrack.identify.verify`).
+    """
+
+    groups_obs: np.ndarray
+    groups_cat: np.ndarray
+    triangles_obs: np.ndarray
+    triangles_cat: np.ndarray
+    n_pair_matches: int
+
+    def ordered(self):
+        """(observed indices, guide indices) of every hypothesis, groups of four first, duplicates dropped."""
+        seen = set()
+        for obs_rows, cat_rows in ((self.groups_obs, self.groups_cat), (self.triangles_obs, self.triangles_cat)):
+            for obs, cat in zip(obs_rows, cat_rows):
+                key = frozenset(zip(obs.tolist(), cat.tolist()))
+                if key not in seen:
+                    seen.add(key)
+                    yield obs, cat
+
+
+@njit
+def _inside(guide, x, y, cos_low, cos_high):
+    """cos_low <= guide[x] . guide[y] <= cos_high (the angle lies inside its gate)."""
+    c = guide[x, 0] * guide[y, 0] + guide[x, 1] * guide[y, 1] + guide[x, 2] * guide[y, 2]
+    return cos_low <= c <= cos_high
+
+
+@njit
+def _triple(p, q, r):
+    """p . (q x r) of three 3-vectors."""
+    return (p[0] * (q[1] * r[2] - q[2] * r[1]) + p[1] * (q[2] * r[0] - q[0] * r[2])
+            + p[2] * (q[0] * r[1] - q[1] * r[0]))
+
+
+@njit
+def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, guide, max_groups,
+                  max_triangles, head):  # pragma: no cover  (compiled)
+    """Triangles and four-star groups (module text); returns (groups (g, 8), triangles (t, 6), N_h).
+
+    For each anchor star i (brightest first) the catalog pairs matched to every observed pair (i, t)
+    are chained per (t, catalog star of i) in linked lists, so that a triangle (i, j, k) is found by
+    following, for each catalog assignment (A, B) of (i, j), the list of (k, A) and testing the
+    distance (B, C) against the gate of (j, k) and the handedness; each triangle is extended to a group
+    by the lists of every other star r.  Stops after ``max_groups`` groups.  ``head`` (>= n, n_guide)
+    is a work array of -1 (the list heads), returned as found.
+    """
+    n = obs.shape[0]
+    n_guide = guide.shape[0]
+    low = beta - gate
+    high = beta + gate
+    cos_high = np.cos(np.minimum(np.maximum(low, 0.0), np.pi))
+    cos_low = np.cos(np.minimum(np.maximum(high, 0.0), np.pi))
+    lo = np.zeros((n, n), np.int64)
+    hi = np.zeros((n, n), np.int64)
+    n_matches = 0
+    for s in range(n):
+        for t in range(s + 1, n):
+            lo[s, t], hi[s, t] = _pair_range(theta, k, slope, intercept, low[s, t], high[s, t])
+            for q in range(lo[s, t], hi[s, t]):
+                if low[s, t] <= theta[q] <= high[s, t]:
+                    n_matches += 1
+    groups = np.empty((max_groups, 8), np.int64)
+    triangles = np.empty((max_triangles, 6), np.int64)
+    n_groups = 0
+    n_triangles = 0
+    capacity = 4 * n_matches + 1
+    entry_other = np.empty(capacity, np.int64)
+    entry_next = np.empty(capacity, np.int64)
+    entry_partner = np.empty(capacity, np.int64)
+    entry_anchor = np.empty(capacity, np.int64)
+    for i in range(n):
+        m = 0
+        for t in range(n):
+            if t == i:
+                continue
+            s0, t0 = min(i, t), max(i, t)
+            for q in range(lo[s0, t0], hi[s0, t0]):
+                if not low[s0, t0] <= theta[q] <= high[s0, t0]:
+                    continue
+                for orientation in range(2):
+                    a_cat = first[q] if orientation == 0 else second[q]
+                    entry_other[m] = second[q] if orientation == 0 else first[q]
+                    entry_next[m] = head[t, a_cat]
+                    entry_partner[m] = t
+                    entry_anchor[m] = a_cat
+                    head[t, a_cat] = m
+                    m += 1
+        done = False
+        for j in range(i + 1, n):
+            for q in range(lo[i, j], hi[i, j]):
+                if done or not low[i, j] <= theta[q] <= high[i, j]:
+                    continue
+                for orientation in range(2):
+                    if done:
+                        break
+                    a_cat = first[q] if orientation == 0 else second[q]
+                    b_cat = second[q] if orientation == 0 else first[q]
+                    for k in range(j + 1, n):
+                        if done:
+                            break
+                        e = head[k, a_cat]
+                        while e >= 0 and not done:
+                            c_cat = entry_other[e]
+                            e = entry_next[e]
+                            if c_cat == b_cat or not _inside(guide, b_cat, c_cat, cos_low[j, k], cos_high[j, k]):
+                                continue
+                            if _triple(obs[i], obs[j], obs[k]) * _triple(guide[a_cat], guide[b_cat], guide[c_cat]) <= 0.0:
+                                continue
+                            if n_triangles < max_triangles:
+                                triangles[n_triangles, 0] = i
+                                triangles[n_triangles, 1] = j
+                                triangles[n_triangles, 2] = k
+                                triangles[n_triangles, 3] = a_cat
+                                triangles[n_triangles, 4] = b_cat
+                                triangles[n_triangles, 5] = c_cat
+                                n_triangles += 1
+                            for r in range(n):
+                                if r == i or r == j or r == k or done:
+                                    continue
+                                jr0, jr1 = min(j, r), max(j, r)
+                                kr0, kr1 = min(k, r), max(k, r)
+                                f = head[r, a_cat]
+                                while f >= 0:
+                                    d_cat = entry_other[f]
+                                    f = entry_next[f]
+                                    if d_cat == b_cat or d_cat == c_cat:
+                                        continue
+                                    if not _inside(guide, b_cat, d_cat, cos_low[jr0, jr1], cos_high[jr0, jr1]):
+                                        continue
+                                    if not _inside(guide, c_cat, d_cat, cos_low[kr0, kr1], cos_high[kr0, kr1]):
+                                        continue
+                                    groups[n_groups, 0] = i
+                                    groups[n_groups, 1] = j
+                                    groups[n_groups, 2] = k
+                                    groups[n_groups, 3] = r
+                                    groups[n_groups, 4] = a_cat
+                                    groups[n_groups, 5] = b_cat
+                                    groups[n_groups, 6] = c_cat
+                                    groups[n_groups, 7] = d_cat
+                                    n_groups += 1
+                                    if n_groups == max_groups:
+                                        done = True
+                                    break
+        for e in range(m):
+            head[entry_partner[e], entry_anchor[e]] = -1
+        if done:
+            break
+    return groups[:n_groups], triangles[:n_triangles], 2 * n_matches
+
+
+def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int = 4,
+           max_triangles: int = 8, workspace=None) -> Hypotheses:
+    """Triangles and four-star groups of the centroid directions ``obs_S`` (n, 3), brightest first.
+
+    ``beta`` (n, n) observed angular distances and ``gate`` (n, n) their bounds e_ij [rad];
+    ``table`` the catalog pairs to search; ``guide_vectors`` (n_g, 3) the guide stars in I.  The
+    search stops after ``max_groups`` four-star groups; up to ``max_triangles`` triangles found on the
+    way are kept for frames without a group.  ``workspace``: an int64 array of -1 of shape
+    (>= n, n_g) reused between calls (left as found), allocated when None.
+    """
+    if workspace is None or workspace.shape[0] < len(obs_S):
+        workspace = np.full((len(obs_S), len(guide_vectors)), -1, np.int64)
+    groups, triangles, n_matches = _group_search(
+        np.ascontiguousarray(obs_S), beta, gate, table.theta, table.first, table.second, table.k, table.slope,
+        table.intercept, guide_vectors, max_groups, max_triangles, workspace)
+    groups = groups[_ranked(groups[:, :4], gate)]
+    triangles = triangles[_ranked(triangles[:, :3], gate)]
+    return Hypotheses(groups[:, :4], groups[:, 4:], triangles[:, :3], triangles[:, 3:], int(n_matches))
+
+
+def _ranked(stars, gate):
+    """Order of star groups (rows of observed indices): smallest rank sum, then smallest sum of gates."""
+    if len(stars) < 2:
+        return np.arange(len(stars))
+    a, b = _PAIRS_OF[stars.shape[1]]
+    gate_sum = gate[stars[:, a], stars[:, b]].sum(axis=1)
+    return np.lexsort((gate_sum, stars.sum(axis=1)))
+
+
+#: Index pairs (a, b) of the pairs of a triangle and of a four-star group.
+_PAIRS_OF = {3: np.triu_indices(3, 1), 4: np.triu_indices(4, 1)}
+
+
+class PatternMatcher:
+    """Hypotheses from :func:`search` on a pair table, each verified until one is accepted.
+
+    The brightest ``pattern_stars`` centroids are searched first; if no hypothesis is accepted and
+    the frame has more, the search is repeated with twice as many (false stars or stars missing from
+    the guide catalog among the brightest).  Holds a work array: one matcher per thread.
+    """
+
+    def __init__(self, catalog, field, pattern_stars: int, max_groups: int, max_triangles: int, threshold: float):
+        self.guide_vectors = np.ascontiguousarray(catalog.guide_vectors)
+        self.field = field
+        self.pattern_stars = pattern_stars
+        self.max_groups = max_groups
+        self.max_triangles = max_triangles
+        self.threshold = threshold
+        self._workspace = np.full((2 * pattern_stars, len(self.guide_vectors)), -1, np.int64)
+
+    def match(self, frame, table: PairTable):
+        """A :class:`startrack.identify.verify.Verified` for ``frame`` (:class:`FrameFeatures`) or None."""
+        first = min(len(frame), self.pattern_stars)
+        sizes = (first,) if len(frame) <= first else (first, min(len(frame), 2 * first))
+        tried = set()
+        for n in sizes:
+            hypotheses = search(frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n], table,
+                                self.guide_vectors, self.max_groups, self.max_triangles, self._workspace)
+            for obs_index, cat_index in hypotheses.ordered():
+                key = frozenset(zip(obs_index.tolist(), cat_index.tolist()))
+                if key in tried:
+                    continue
+                tried.add(key)
+                R_IS = wahba_svd(self.guide_vectors[cat_index], frame.obs_S[obs_index])
+                verified = verify(frame.obs_S, R_IS, self.field, frame.verify_gate,
+                                  hypotheses.n_pair_matches, self.threshold)
+                if verified is not None:
+                    return verified
+        return None
+
+
+class LostInSpace:
+    """Full-sky lost-in-space identification: the pattern search over every pair of the guide catalog."""
+
+    name = "lost_in_space"
+
+    def __init__(self, catalog, matcher: PatternMatcher):
+        self.table = PairTable.full_sky(catalog)
+        self.matcher = matcher
+
+    def identify(self, frame, prior):
+        """Verified hypothesis or None; ``prior`` is not used."""
+        return self.matcher.match(frame, self.table)

@@ -1,0 +1,116 @@
+"""The result record of a star identification (one per frame).
+
+Angles are radians inside (``ra``, ``dec``, ``roll``, ``residuals``, ``covariance``); :meth:`to_dict`
+gives the JSON form of the ``startrack solve`` contract (DESIGN.md) with degrees and arcseconds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from startrack.attitude_angles import radec_roll_from_quaternion
+
+#: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
+#: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
+STATUSES = ("ok", "no_match", "too_few", "error")
+
+_ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
+
+
+@dataclass(frozen=True, eq=False)
+class IdentificationResult:
+    """Outcome of one identification.
+
+    status: one of :data:`STATUSES`; reason: one sentence when status is not "ok" ("" otherwise).
+    q_IS: (4,) scalar-last quaternion rotating sensor-frame vectors into the inertial frame (NaN unless ok);
+        :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
+    matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number).
+    residuals: (M,) angle between each matched centroid's direction and its refitted prediction [rad].
+    covariance: (3, 3) attitude-error covariance in sensor axes [rad^2] (x, y cross-boresight, z roll):
+        the Cramer-Rao bound of the matched stars (SVD solution of Wahba's problem).
+    false_match_probability: chance that a wrong attitude hypothesis explains as many centroids
+        (:func:`startrack.identify.verify.false_match_probability`); NaN when nothing was verified.
+    method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space") or "" if none.
+    solve_ms: wall-clock time of the whole call [ms].
+    lost_hip / entered_hip: tracking only -- previously tracked stars predicted inside the field but not
+        found, and stars identified now that were not tracked before (HIP numbers).
+    """
+
+    status: str
+    reason: str = ""
+    q_IS: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))
+    matches: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    covariance: np.ndarray = field(default_factory=lambda: np.full((3, 3), np.nan))
+    false_match_probability: float = math.nan
+    method: str = ""
+    solve_ms: float = math.nan
+    lost_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    entered_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+
+    def __post_init__(self):
+        if self.status not in STATUSES:
+            raise ValueError(f"identification status {self.status!r} is not one of {STATUSES}")
+
+    @property
+    def ok(self) -> bool:
+        """True when the frame was identified."""
+        return self.status == "ok"
+
+    @functools.cached_property
+    def _radec_roll(self):
+        return tuple(float(x) for x in radec_roll_from_quaternion(self.q_IS))
+
+    @property
+    def ra(self) -> float:
+        """Boresight right ascension [rad] in [0, 2 pi) (NaN unless ok)."""
+        return self._radec_roll[0]
+
+    @property
+    def dec(self) -> float:
+        """Boresight declination [rad] (NaN unless ok)."""
+        return self._radec_roll[1]
+
+    @property
+    def roll(self) -> float:
+        """Roll about the boresight [rad] in [-pi, pi), 003 §1.1 (NaN unless ok)."""
+        return self._radec_roll[2]
+
+    @property
+    def matched_hip(self) -> np.ndarray:
+        """HIP numbers of the matched stars, in the order of :attr:`matches`."""
+        return self.matches[:, 1]
+
+    def with_time(self, solve_ms: float) -> "IdentificationResult":
+        """The same result with ``solve_ms`` set."""
+        return dataclasses.replace(self, solve_ms=float(solve_ms))
+
+    def to_dict(self, frame_id=None) -> dict:
+        """JSON-ready dict of the ``startrack solve --json`` contract (degrees, arcseconds)."""
+        out = {"id": frame_id, "status": self.status}
+        if self.reason:
+            out["reason"] = self.reason
+        if self.ok:
+            sigma = np.sqrt(np.clip(np.diag(self.covariance), 0.0, None)) * _ARCSEC_PER_RAD
+            out.update(
+                q_IS=[float(x) for x in self.q_IS],
+                ra_deg=math.degrees(self.ra),
+                dec_deg=math.degrees(self.dec),
+                roll_deg=math.degrees(self.roll),
+                matches=[[int(i), int(h)] for i, h in self.matches],
+                residuals_arcsec=[round(float(r) * _ARCSEC_PER_RAD, 4) for r in self.residuals],
+                sigma_arcsec=[float(s) for s in sigma],
+                false_match_probability=float(self.false_match_probability),
+            )
+            if self.method == "tracking":
+                out["lost_hip"] = [int(h) for h in self.lost_hip]
+                out["entered_hip"] = [int(h) for h in self.entered_hip]
+        out["method"] = self.method
+        out["solve_ms"] = round(float(self.solve_ms), 4)
+        return out
+

@@ -1,0 +1,52 @@
+"""Recognition in the predicted sub-catalog and its 4 redundant neighbours (§4 of document 000).
+
+When tracking fails, the attitude predicted from the last fix (or the navigation filter) still gives
+the boresight (alpha, delta) to within some error.  The sub-catalog at its eq. 7-8 address holds
+every guide star within rho_sub = ceil(s_max)/2 + max(delta) + theta_FOV/2 of its base point and the
+pattern pairs among them (000 §2.3), so the same pattern matcher as the full-sky search runs on a
+few hundred pairs instead of tens of thousands.  If it finds nothing, the four redundant
+sub-catalogs at the boresights moved by rho_sub east, west, north and south are searched in turn
+(:meth:`startrack.navigation_catalog.NavigationCatalog.redundant_neighbours`); 000 states that this
+tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000 §5).  The caller
+(:class:`startrack.identify.StarIdentifier`) falls back to the full sky when this fails too.
+"""
+
+from __future__ import annotations
+
+import math
+
+from startrack.identify.lost_in_space import PairTable, PatternMatcher
+
+
+class SubCatalog:
+    """Pattern matching restricted to the predicted sub-catalog (and, with ``neighbours``, its 4 redundant ones)."""
+
+    name = "subcatalog"
+
+    def __init__(self, catalog, matcher: PatternMatcher, neighbours: bool = True):
+        self.catalog = catalog
+        self.matcher = matcher
+        self.neighbours = bool(neighbours)
+
+    def cells(self, ra: float, dec: float) -> list[int]:
+        """Sub-catalog indices to search for a predicted boresight (ra, dec) [rad], predicted one first."""
+        cells = [int(self.catalog.sub_catalog_index(ra, dec))]
+        if self.neighbours:
+            for b in self.catalog.redundant_neighbours(ra, dec).tolist():
+                if b not in cells:
+                    cells.append(int(b))
+        return cells
+
+    def identify(self, frame, prior):
+        """Verified hypothesis or None; needs ``prior.boresight_radec()``."""
+        boresight = prior.boresight_radec() if prior is not None else None
+        if boresight is None:
+            return None
+        ra, dec = boresight
+        if not (math.isfinite(ra) and math.isfinite(dec)):
+            return None
+        for b in self.cells(ra, dec):
+            verified = self.matcher.match(frame, PairTable.subset(self.catalog, self.catalog.sub_catalog_pairs(b)))
+            if verified is not None:
+                return verified
+        return None

@@ -1,0 +1,288 @@
+"""Verification of an attitude hypothesis against every star that can appear in the field.
+
+Steps (the verification of the issue; the same for lost-in-space, sub-catalog and tracking):
+
+1. predict: rotate the field stars near the hypothesised boresight into the sensor frame and keep
+   those that project inside the image (:class:`FieldStars`);
+2. match: each centroid to its nearest predicted star and back (mutual nearest neighbours, so the
+   matching is one-to-one), kept only within the gate; outliers are the centroids outside it;
+3. refit: the attitude by SVD (Wahba's problem, Markley 1988) with every matched star, then match
+   again with a gate three times narrower (3 r, then r) and refit each time; matches the last refit
+   puts outside r are dropped and the attitude refitted once more;
+4. accept: only if the false-match probability (:func:`false_match_probability`) is below a threshold.
+
+Probability model.  Under a *wrong* attitude hypothesis the centroids are unrelated to the predicted
+stars.  The predicted stars form a Poisson field of density rho = n_field / Omega_field on the sky
+(n_field predicted stars in the field's solid angle Omega_field, i.e. the local density), so a given
+centroid falls within the gate r of some predicted star with probability
+
+    p = 1 - exp(-rho * 2 pi (1 - cos r)).
+
+The two stars that seeded the hypothesis match by construction; each of the other n_other centroids
+matches independently with probability p, so the number K of chance matches is Binomial(n_other, p).
+A search that generated N_h hypotheses (every catalog pair that matched an observed pair within its
+gate, both orientations) can be fooled by any of them, hence (Bonferroni)
+
+    P_false = min(1, N_h * P[Binomial(n_other, p) >= K]).
+
+A hypothesis is accepted when P_false <= threshold (default 1e-6).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from startrack.jit import njit
+from startrack.navigation_catalog import chord
+
+#: Default acceptance threshold of the false-match probability.
+DEFAULT_FALSE_MATCH_THRESHOLD = 1e-6
+
+
+@njit
+def wahba_svd(ref_I, obs_S):  # pragma: no cover  (compiled)
+    """R_IS (3, 3) minimising sum |obs_i - R_IS^T ref_i|^2, equal weights (SVD, Markley 1988).
+
+    B = sum obs_i ref_i^T = U S V^T, A = U diag(1, 1, det U det V) V^T (I -> S), R_IS = A^T; the same
+    solution as :class:`startrack.attitude.SvdWahba` without its validation and covariance (used for
+    every fit inside the identification).
+    """
+    U, _, Vt = np.linalg.svd(obs_S.T @ ref_I)
+    if np.linalg.det(U) * np.linalg.det(Vt) < 0.0:
+        U[:, 2] = -U[:, 2]
+    return (U @ Vt).T
+
+
+def binomial_tail(n: int, k: int, p: float) -> float:
+    """P[Binomial(n, p) >= k], summed term by term from k upwards (accurate for tiny p)."""
+    if k <= 0:
+        return 1.0
+    if k > n or p <= 0.0:
+        return 0.0
+    if p >= 1.0:
+        return 1.0
+    log_term = math.lgamma(n + 1) - math.lgamma(k + 1) - math.lgamma(n - k + 1) + k * math.log(p) \
+        + (n - k) * math.log1p(-p)
+    term = math.exp(log_term)
+    total = term
+    ratio = p / (1.0 - p)
+    for j in range(k, n):
+        term *= (n - j) / (j + 1) * ratio
+        total += term
+        if term < 1e-17 * total:
+            break
+    return min(total, 1.0)
+
+
+def false_match_probability(n_other: int, n_matched_other: int, gate: float, density: float,
+                            n_hypotheses: int) -> float:
+    """P_false of the module model: min(1, N_h P[Binomial(n_other, p) >= K]).
+
+    n_other: centroids besides the two seed stars; n_matched_other: K, those matched; gate: r [rad];
+    density: rho, predicted stars per steradian; n_hypotheses: N_h.
+    """
+    p = -math.expm1(-density * 2.0 * math.pi * (1.0 - math.cos(gate)))
+    return min(1.0, max(n_hypotheses, 1) * binomial_tail(n_other, n_matched_other, p))
+
+
+@njit
+def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
+    """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [rad]."""
+    n, m = obs_S.shape[0], pred_S.shape[0]
+    cos_gate = np.cos(gate)
+    best_pred = np.full(n, -1, np.int64)
+    best_pred_cos = np.full(n, -2.0)
+    best_obs = np.full(m, -1, np.int64)
+    best_obs_cos = np.full(m, -2.0)
+    for i in range(n):
+        for j in range(m):
+            c = obs_S[i, 0] * pred_S[j, 0] + obs_S[i, 1] * pred_S[j, 1] + obs_S[i, 2] * pred_S[j, 2]
+            if c > best_pred_cos[i]:
+                best_pred_cos[i] = c
+                best_pred[i] = j
+            if c > best_obs_cos[j]:
+                best_obs_cos[j] = c
+                best_obs[j] = i
+    count = 0
+    obs_index = np.empty(n, np.int64)
+    pred_index = np.empty(n, np.int64)
+    for i in range(n):
+        j = best_pred[i]
+        if j >= 0 and best_obs[j] == i and best_pred_cos[i] >= cos_gate:
+            obs_index[count] = i
+            pred_index[count] = j
+            count += 1
+    return obs_index[:count], pred_index[:count]
+
+
+@njit
+def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (compiled)
+    """(indices, directions in S (m, 3)) of the stars ``stars_I`` (N, 3) imaged inside the field for R_IS.
+
+    ``camera_params`` = (f, cx, cy, W, H, k1, k2, circular) [px]; the image (and, if circular, the
+    inscribed circle of the width) is grown by ``margin_px``.  Pinhole with Brown radial distortion as
+    :class:`startrack.camera.Camera`.
+    """
+    focal, cx, cy, width, height, k1, k2, circular = camera_params
+    v_S = stars_I @ R_IS
+    keep = np.empty(v_S.shape[0], np.int64)
+    count = 0
+    radius = width / 2.0 + margin_px
+    for s in range(v_S.shape[0]):
+        z = v_S[s, 2]
+        if z <= 0.0:
+            continue
+        x, y = v_S[s, 0] / z, v_S[s, 1] / z
+        factor = 1.0 + k1 * (x * x + y * y) + k2 * (x * x + y * y) ** 2
+        u = cx + focal * x * factor
+        v = cy + focal * y * factor
+        if u < -0.5 - margin_px or u > width - 0.5 + margin_px or v < -0.5 - margin_px or v > height - 0.5 + margin_px:
+            continue
+        if circular > 0.0 and (u - cx) ** 2 + (v - cy) ** 2 > radius * radius:
+            continue
+        keep[count] = s
+        count += 1
+    return keep[:count], v_S[keep[:count]]
+
+
+@njit
+def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px):  # pragma: no cover  (compiled)
+    """Predict, match (mutual nearest within each gate of ``pass_gates`` [rad] in turn) and refit by SVD.
+
+    Each pass predicts with the field grown by its gate, matches, and refits with every match; a last
+    check drops matches outside the final gate and refits.  Returns (ok, R_IS, obs indices, star
+    indices, number of stars predicted in the field); ok is False below 3 matches.
+    """
+    empty = np.zeros(0, np.int64)
+    n_predicted = 0
+    obs_index = empty
+    star_index = empty
+    for gate in pass_gates:
+        index, pred_S = predict(stars_I, R_IS, camera_params, gate * focal_px)
+        n_predicted = index.size
+        obs_index, pred_index = match_nearest(obs_S, pred_S, gate)
+        if obs_index.size < 3:
+            return False, R_IS, empty, empty, n_predicted
+        star_index = index[pred_index]
+        R_IS = wahba_svd(stars_I[star_index], obs_S[obs_index])
+    cos_gate = np.cos(pass_gates[-1])
+    keep = np.empty(obs_index.size, np.bool_)
+    for m in range(obs_index.size):
+        p = stars_I[star_index[m]] @ R_IS
+        o = obs_S[obs_index[m]]
+        keep[m] = p[0] * o[0] + p[1] * o[1] + p[2] * o[2] >= cos_gate
+    if not keep.all():
+        obs_index, star_index = obs_index[keep], star_index[keep]
+        if obs_index.size < 3:
+            return False, R_IS, empty, empty, n_predicted
+        R_IS = wahba_svd(stars_I[star_index], obs_S[obs_index])
+    return True, R_IS, obs_index, star_index, n_predicted
+
+
+def _field_radius(camera) -> float:
+    """Largest angle [rad] between the boresight and an image corner (pixel edges included)."""
+    corners = np.array([[-0.5, -0.5], [camera.width - 0.5, -0.5], [-0.5, camera.height - 0.5],
+                        [camera.width - 0.5, camera.height - 0.5]])
+    return float(np.arccos(np.min(camera.unproject(corners)[:, 2])))
+
+
+def _field_solid_angle(camera, blocks: int = 128) -> float:
+    """Solid angle [sr] of the sensor's field: sum of f^-2 z^3 dA over a grid of image blocks."""
+    u = (np.arange(blocks) + 0.5) * camera.width / blocks - 0.5
+    v = (np.arange(blocks) + 0.5) * camera.height / blocks - 0.5
+    uu, vv = np.meshgrid(u, v)
+    directions = camera.unproject(np.column_stack([uu.ravel(), vv.ravel()]))
+    inside = np.ones(len(directions), bool)
+    if camera.circular_fov:
+        inside = directions[:, 2] >= math.cos(camera.fov_x / 2.0)
+    area = camera.width * camera.height / blocks**2
+    return float(np.sum(directions[inside, 2] ** 3) * area / camera.focal_px**2)
+
+
+class FieldStars:
+    """The stars a frame can show (every star to the sensor's magnitude limit), indexed by sky cell.
+
+    Cells are the sub-catalogs' base points of the navigation catalog: cell ``b`` lists the stars
+    within the field radius (boresight to image corner) plus ``s_max`` (the largest base-point
+    spacing, which bounds the distance from a boresight to the base point eq. 7-8 assigns to it) of
+    base point ``b``; a boresight's cell is its eq. 7-8 address.
+    """
+
+    def __init__(self, catalog, camera, vectors, hip, v_mag):
+        self.catalog = catalog
+        self.camera = camera
+        self.vectors = np.ascontiguousarray(vectors, dtype=float)
+        self.hip = np.asarray(hip, dtype=np.int64)
+        self.v_mag = np.asarray(v_mag, dtype=float)
+        self.field_radius = _field_radius(camera)
+        self.solid_angle = _field_solid_angle(camera)
+        radius = self.field_radius + catalog.s_max
+        pairs = cKDTree(catalog.base_vectors).sparse_distance_matrix(
+            cKDTree(self.vectors), float(chord(radius)), output_type="ndarray")
+        order = np.lexsort((pairs["j"], pairs["i"]))
+        self._cell_star = pairs["j"][order].astype(np.int64)
+        self._cell_offsets = np.concatenate(
+            [[0], np.cumsum(np.bincount(pairs["i"], minlength=catalog.n_base))]).astype(np.int64)
+        self.camera_params = np.array([camera.focal_px, camera.cx, camera.cy, camera.width, camera.height,
+                                       camera.k1, camera.k2, float(camera.circular_fov)])
+
+    @classmethod
+    def from_star_catalog(cls, catalog, camera, stars, mag_limit: float):
+        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) with V <= mag_limit."""
+        keep = stars.v_mag <= mag_limit
+        return cls(catalog, camera, stars.vectors[keep], stars.hip[keep], stars.v_mag[keep])
+
+    def __len__(self):
+        return int(self.hip.size)
+
+    def cell(self, boresight_I) -> np.ndarray:
+        """Indices of the stars listed for the cell of the boresight direction (3,) in I."""
+        x, y, z = boresight_I
+        ra = math.atan2(y, x) % (2.0 * math.pi)
+        dec = math.asin(max(-1.0, min(1.0, z)))
+        b = self.catalog.sub_catalog_index(ra, dec)
+        return self._cell_star[self._cell_offsets[b]:self._cell_offsets[b + 1]]
+
+    def in_field(self, R_IS, margin_px: float = 0.0):
+        """(star indices, their directions in S (m, 3)) of the stars imaged inside the field for R_IS."""
+        cell = self.cell(R_IS[:, 2])
+        index, v_S = predict(self.vectors[cell], np.ascontiguousarray(R_IS), self.camera_params, float(margin_px))
+        return cell[index], v_S
+
+
+@dataclass(frozen=True)
+class Verified:
+    """An accepted hypothesis: refitted R_IS, matched (centroid, field-star) indices, P_false."""
+
+    R_IS: np.ndarray
+    obs_index: np.ndarray
+    star_index: np.ndarray
+    false_match_probability: float
+    n_predicted: int
+
+
+def verify(obs_S, R_IS, field: FieldStars, gate: float, n_hypotheses: int, threshold: float,
+           n_seed: int = 2, first_gate: float | None = None):
+    """Verify the attitude hypothesis R_IS for the centroid directions obs_S (n, 3); a :class:`Verified` or None.
+
+    Matches in passes with the gates ``first_gate`` (if given, e.g. a tracking window), 3 r and r
+    [rad], refitting by SVD after each (:func:`match_and_refit`), and accepts when P_false <=
+    ``threshold`` (module model; ``n_seed`` stars seeded the hypothesis; ``n_hypotheses`` N_h).
+    """
+    cell = field.cell(R_IS[:, 2])
+    gates = np.array([3.0 * gate, gate] if first_gate is None else [first_gate, 3.0 * gate, gate])
+    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
+        obs_S, field.vectors[cell], np.ascontiguousarray(R_IS), field.camera_params, gates, field.camera.focal_px)
+    if not ok:
+        return None
+    probability = false_match_probability(
+        n_other=max(len(obs_S) - n_seed, 0), n_matched_other=max(int(obs_index.size) - n_seed, 0), gate=gate,
+        density=max(n_predicted, 1) / field.solid_angle, n_hypotheses=n_hypotheses)
+    if not probability <= threshold:
+        return None
+    return Verified(R_IS=R_IS, obs_index=obs_index, star_index=cell[star_index],
+                    false_match_probability=probability, n_predicted=int(n_predicted))

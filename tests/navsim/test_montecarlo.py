@@ -1,0 +1,128 @@
+"""Campaigns: resumable after SIGKILL, failures recorded, same results on every backend; batches."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import navsim.montecarlo as mc
+from navsim.simulation import run, run_batch
+from startrack.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def write_scenario(path, base):
+    import copy
+
+    data = copy.deepcopy(base)
+    data.update(duration_s=20.0)
+    lines = []
+
+    def emit(prefix, table):
+        scalars = {k: v for k, v in table.items() if not isinstance(v, dict)}
+        if prefix:
+            lines.append(f"[{prefix}]")
+        for key, value in scalars.items():
+            lines.append(f"{key} = {json.dumps(value)}")
+        for key, value in table.items():
+            if isinstance(value, dict):
+                emit(f"{prefix}.{key}" if prefix else key, value)
+
+    emit("", data)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_seeds_do_not_depend_on_the_campaign_size():
+    assert [mc.run_seed(7, k) for k in range(3)] == [mc.run_seed(7, k) for k in range(5)][:3]
+    assert len({mc.run_seed(7, k) for k in range(100)}) == 100
+
+
+def test_killed_campaign_resumes_to_the_same_summary(tmp_path, base_scenario):
+    scenario = write_scenario(tmp_path / "s.toml", base_scenario)
+    reference = mc.run_campaign(scenario, 10, tmp_path / "reference", workers=1, progress=False)
+    out = tmp_path / "killed"
+    command = [sys.executable, "-m", "navsim.cli", "montecarlo", str(scenario), "--runs", "10", "--out", str(out),
+               "--workers", "1"]
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                               start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        finished = list((out / "runs").glob("run_*/summary.json")) if (out / "runs").exists() else []
+        if len(finished) >= 3:
+            break
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    finished_before = len(list((out / "runs").glob("run_*/summary.json")))
+    assert 3 <= finished_before < 10
+    assert not (out / "summary.json").exists()
+    resumed = mc.run_campaign(scenario, 10, out, workers=1, progress=False)
+    assert resumed == reference
+    assert not list((out / "runs").glob("*.partial"))
+
+
+def test_a_run_that_raises_is_recorded_and_the_others_finish(tmp_path, base_scenario, monkeypatch):
+    bad_seed = mc.run_seed(0, 2)
+    real_simulate = mc.simulate
+
+    def flaky(prepared, seed):
+        if seed == bad_seed:
+            raise RuntimeError("sensor model exploded")
+        return real_simulate(prepared, seed)
+
+    monkeypatch.setattr(mc, "simulate", flaky)
+    summary = mc.run_campaign(base_scenario, 4, tmp_path / "c", base_seed=0, workers=1, progress=False)
+    assert summary["runs_finished"] == 3 and summary["runs_failed"] == 1
+    assert summary["failures"] == [{"run": 2, "error": "RuntimeError: sensor model exploded"}]
+    assert (tmp_path / "c" / "runs" / "run_00002" / "error.json").exists()
+
+
+def test_pool_and_dask_give_identical_results(tmp_path, base_scenario):
+    distributed = pytest.importorskip("distributed")
+    base_scenario.update(duration_s=10.0)
+    pooled = mc.run_campaign(base_scenario, 6, tmp_path / "pool", workers=2, progress=False)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+                                  processes=True) as cluster, distributed.Client(cluster) as client:
+        dasked = mc.run_campaign(base_scenario, 6, tmp_path / "dask", scheduler=client, progress=False)
+    assert pooled == dasked
+    for k in range(6):
+        a = np.load(tmp_path / "pool" / "runs" / f"run_{k:05d}" / "timeseries.npz")
+        b = np.load(tmp_path / "dask" / "runs" / f"run_{k:05d}" / "timeseries.npz")
+        np.testing.assert_array_equal(a["q_est"], b["q_est"])
+
+
+def test_a_directory_holding_another_campaign_is_refused(tmp_path, base_scenario):
+    base_scenario.update(duration_s=2.0)
+    mc.run_campaign(base_scenario, 1, tmp_path / "c", workers=1, progress=False)
+    base_scenario["gyro"]["rate_hz"] = 20.0
+    with pytest.raises(InputError, match="holds a different campaign"):
+        mc.run_campaign(base_scenario, 1, tmp_path / "c", workers=1, progress=False)
+
+
+def test_campaign_statistics_follow_the_runs(tmp_path, base_scenario):
+    summary = mc.run_campaign(base_scenario, 8, tmp_path / "c", workers=1, progress=False)
+    assert summary["runs_finished"] == 8
+    lo, hi = summary["nees"]["band_95"]
+    assert lo < summary["nees"]["mean"] < hi
+    per_run = [json.loads(p.read_text())["cross_boresight_rms_arcsec"]
+               for p in sorted((tmp_path / "c" / "runs").glob("run_*/summary.json"))]
+    assert summary["cross_boresight_rms_arcsec"]["mean"] == pytest.approx(np.mean(per_run))
+    assert summary["divergent_runs"] == []
+
+
+def test_batch_of_one_equals_a_single_run(base_scenario):
+    single = run(base_scenario, seed=11)
+    [batched] = run_batch(base_scenario, [11])
+    for key in single.series:
+        np.testing.assert_array_equal(single.series[key], batched.series[key])
+    threaded = run_batch(base_scenario, [11, 12, 13], threads=2)
+    np.testing.assert_array_equal(threaded[0].series["q_est"], single.series["q_est"])
+    np.testing.assert_array_equal(threaded[2].series["q_est"], run(base_scenario, seed=13).series["q_est"])
