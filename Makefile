@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: setup
-	$(VENV)/bin/navsim run scenarios/demo.toml --out reports/out/demo
+	$(VENV)/bin/navsim run scenarios/demo.toml --out reports/out/demo --report reports/out/demo.pdf
 
 test: setup
 	$(PY) -m pytest $(PYTEST_ARGS)
@@ -26,7 +26,9 @@ test-all: setup
 	$(PY) -m pytest -m "" $(PYTEST_ARGS)
 
 bench: setup
+	sh benchmarks/peers/setup_venvs.sh $(PYTHON)
+	$(PY) -m pip install --quiet -e '.[test,bench]'
 	$(PY) benchmarks/run_all.py
 
 clean:
-	rm -rf $(VENV) .cache .pytest_cache .hypothesis reports/out
+	rm -rf $(VENV) .cache .pytest_cache .hypothesis reports/out benchmarks/.venv-cedar benchmarks/.venv-tetra3rs benchmarks/work

@@ -1,9 +1,12 @@
 """Run every benchmark script of benchmarks/ in turn (``make bench``); each writes benchmarks/results/<name>.json.
 
-Each script runs in its own process from the repository root with this interpreter; a script that
-fails is reported and the others still run.  The exit status is 1 when any script failed (a crash,
-not a slow result: benchmarks measure, they never assert).  The star-identification peers need
-their virtualenvs first: ``sh benchmarks/peers/setup_venvs.sh`` (``make bench`` does it).
+The scripts are the ``benchmarks/*.py`` files with a ``__main__`` block other than this one
+(helper modules such as star_id_frames.py have none), found afresh on every run so a new
+benchmark is picked up without editing this file.  Each runs in its own process from the
+repository root with this interpreter; a script that fails is reported and the others still run.
+The exit status is 1 when any script failed (a crash, not a slow result: benchmarks measure, they
+never assert).  The star-identification peers need their virtualenvs first:
+``sh benchmarks/peers/setup_venvs.sh`` (``make bench`` does it).
 
 Run:  python benchmarks/run_all.py [--only star_id catalog_build ...]
 """
@@ -16,16 +19,23 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-#: The benchmark scripts, cheapest first.
-SCRIPTS = ("attitude_solvers", "catalog_build", "image_chain", "closed_loop", "star_id")
+
+
+def benchmark_scripts():
+    """Names (without .py) of the runnable benchmark scripts in benchmarks/, alphabetical."""
+    return sorted(
+        path.stem for path in HERE.glob("*.py")
+        if path.name != Path(__file__).name and 'if __name__ == "__main__":' in path.read_text()
+    )
 
 
 def main():
+    scripts = benchmark_scripts()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", nargs="+", choices=SCRIPTS, help="run only these scripts")
+    parser.add_argument("--only", nargs="+", choices=scripts, help="run only these scripts")
     args = parser.parse_args()
     outcomes = []
-    for name in args.only or SCRIPTS:
+    for name in args.only or scripts:
         print(f"=== benchmarks/{name}.py", flush=True)
         start = time.perf_counter()
         status = subprocess.run([sys.executable, str(HERE / f"{name}.py")], cwd=ROOT).returncode

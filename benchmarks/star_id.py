@@ -51,6 +51,7 @@ import struct
 import subprocess
 import sys
 import time
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -187,7 +188,7 @@ def evaluate(frames, results, stars, camera, rng):
     """Metrics of one solver on one frame list (see the module docstring)."""
     vector_of = dict(zip(stars.hip.tolist(), stars.vectors))
     by_id = {r["id"]: r for r in results}
-    errors, bounds, draws, times, matched = [], [], [], [], []
+    errors, bounds, draws, bounded, times, matched = [], [], [], [], [], []
     n_success = n_false = n_far = n_missing_result = 0
     statuses, methods, first_error = {}, {}, None
     for frame in frames:
@@ -223,6 +224,7 @@ def evaluate(frames, results, stars, camera, rng):
             b_S = R_true.inv().apply(np.array([vector_of[h] for _, h in right]))
             P = pixel_crb(b_S, camera.focal_px, sif.CENTROID_SIGMA_PX)
             bounds.append(np.diag(P))
+            bounded.append(len(errors) - 1)
             draws.append(rng.multivariate_normal(np.zeros(3), P, size=CRB_DRAWS_PER_FRAME))
     n = len(frames)
     metrics = {
@@ -247,11 +249,12 @@ def evaluate(frames, results, stars, camera, rng):
         metrics["roll_arcsec"] = _percentiles(roll, ARCSEC)
         if bounds:
             bounds, draws = np.array(bounds), np.concatenate(draws)
+            cross_b, roll_b = cross[bounded], roll[bounded]  # the frames with a bound
             metrics["crb_cross_boresight_arcsec"] = _percentiles(np.hypot(draws[:, 0], draws[:, 1]), ARCSEC)
             metrics["crb_roll_arcsec"] = _percentiles(np.abs(draws[:, 2]), ARCSEC)
             metrics["rms_over_crb_cross_boresight"] = float(
-                np.sqrt(np.mean(cross**2) / np.mean(bounds[:, 0] + bounds[:, 1])))
-            metrics["rms_over_crb_roll"] = float(np.sqrt(np.mean(roll**2) / np.mean(bounds[:, 2])))
+                np.sqrt(np.mean(cross_b**2) / np.mean(bounds[:, 0] + bounds[:, 1])))
+            metrics["rms_over_crb_roll"] = float(np.sqrt(np.mean(roll_b**2) / np.mean(bounds[:, 2])))
     return metrics
 
 
@@ -360,13 +363,19 @@ def print_tables(results, tracking, solvers, set_names):
             cells = [f"{sets[p]['success_rate']:6.1%} ({sets[p]['false_rate']:4.1%}) "
                      f"{_fmt(sets[p]['solve_ms']['median'], '.2f')}" if p in sets else "-" for p in priors]
             print(f"{name:<12} " + " ".join(f"{c:>16}" for c in cells))
+            answered = {}
+            for p in priors:
+                for method, count in sets[p]["success_methods"].items():
+                    answered.setdefault(method, []).append(f"{p}: {count}")
+            if len(answered) > 1:
+                print(f"{'':<12} successes by method: " + "; ".join(f"{m} ({', '.join(c)})" for m, c in answered.items()))
 
 
 # ----------------------------------------------------------------------------------- main
-def _run_solver(name, info, frames_path, out_path, args, catalog_folder, work):
+def _run_solver(name, info, frames_path, out_path, args, catalog_folder):
     command = [str(info["python"]), str(info["runner"]), "--frames", str(frames_path), "--out", str(out_path),
                "--fov-deg", str(sif.FOV_DEG), "--fov-max-error-deg", str(args.fov_max_error_deg),
-               "--width", str(sif.WIDTH_PX), "--height", str(sif.HEIGHT_PX), "--work", str(work)]
+               "--width", str(sif.WIDTH_PX), "--height", str(sif.HEIGHT_PX), "--work", str(args.work)]
     if info["catalog"] is not None:
         command += ["--catalog", str(catalog_folder / info["catalog"]), "--mag", str(sif.V_MAX)]
     else:
@@ -385,12 +394,36 @@ def _run_solver(name, info, frames_path, out_path, args, catalog_folder, work):
     return records, None
 
 
-def _write_if_changed(path, records):
-    """Write JSON Lines ``records`` to ``path`` unless it already holds exactly them (keeps its mtime)."""
-    text = "".join(json.dumps(record) + "\n" for record in records)
-    if not path.is_file() or path.read_text() != text:
-        path.write_text(text)
-    return path
+def _crb_rng(seed, solver, set_name):
+    """The generator of the Cramer-Rao draws of one (solver, set): independent of the other solvers run."""
+    return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(f"{solver}/{set_name}".encode())]))
+
+
+def run_and_score(name, info, frame_sets, frame_paths, args, catalog_folder, stars, camera):
+    """({set: metrics, "tracking": {prior: metrics}}, None) of one solver, or (None, why it could not run)."""
+    scored = {}
+    for set_name in list(SET_NAMES) + (["tracking"] if info["tracking"] else []):
+        frames_path = frame_paths[set_name]
+        out_path = args.work / f"results-{name}-{set_name}-seed{args.seed}.jsonl"
+        if args.reuse and out_path.is_file() and out_path.stat().st_mtime > frames_path.stat().st_mtime:
+            print(f"reusing {out_path.name}", flush=True)
+            records = sif.read_jsonl(out_path)
+        else:
+            print(f"running {name} on {set_name} ({len(frame_sets[set_name])} frames)", flush=True)
+            records, failure = _run_solver(name, info, frames_path, out_path, args, catalog_folder)
+            if records is None:
+                return None, failure
+        if set_name == "tracking":
+            scored["tracking"] = {}
+            for error_deg in sif.TRACKING_PRIOR_ERRORS_DEG:
+                subset = [f for f in frame_sets["tracking"] if f["prior_error_deg"] == error_deg]
+                label = f"{error_deg:g}"
+                scored["tracking"][label] = evaluate(subset, records, stars, camera,
+                                                     _crb_rng(args.seed, name, f"tracking{label}"))
+        else:
+            scored[set_name] = evaluate(frame_sets[set_name], records, stars, camera,
+                                        _crb_rng(args.seed, name, set_name))
+    return scored, None
 
 
 def main():
@@ -407,8 +440,7 @@ def main():
     parser.add_argument("--work", type=Path, default=HERE / "work" / "star_id")
     args = parser.parse_args()
     n_tracking = args.frames if args.tracking_frames is None else args.tracking_frames
-    work = args.work
-    work.mkdir(parents=True, exist_ok=True)
+    args.work.mkdir(parents=True, exist_ok=True)
 
     print(f"generating frames: {args.frames} per set, {n_tracking} x {len(sif.TRACKING_PRIOR_ERRORS_DEG)} "
           f"tracking, seed {args.seed}", flush=True)
@@ -419,52 +451,34 @@ def main():
     if n_tracking > len(main_frames):
         main_frames = sif.generate_frames("main", n_tracking, args.seed, stars, camera)
     frame_sets["tracking"] = sif.tracking_frames(main_frames[:n_tracking], seed=args.seed)
-    frame_paths = {name: _write_if_changed(work / f"frames-{name}-seed{args.seed}.jsonl", frames)
+    frame_paths = {name: sif.write_jsonl(args.work / f"frames-{name}-seed{args.seed}.jsonl", frames)
                    for name, frames in frame_sets.items()}
-    catalog_folder = write_peer_catalogs(work, sif.CATALOG_EPOCH)
+    catalog_folder = write_peer_catalogs(args.work, sif.CATALOG_EPOCH)
 
     table = _solver_table()
-    chosen = [s.strip() for s in args.solvers.split(",") if s.strip()]
-    solvers, results, tracking, raw = {}, {}, {}, {}
-    rng = np.random.default_rng(np.random.SeedSequence([args.seed, 99]))
-    for name in chosen:
-        info = dict(table[name])
-        info["available"], info["reason"] = True, None
+    solvers, results, tracking = {}, {}, {}
+    for name in [s.strip() for s in args.solvers.split(",") if s.strip()]:
+        info = dict(table[name], available=True, reason=None)
         if not info["python"].exists():
             info["available"], info["reason"] = False, f"no virtualenv at {info['python'].parent.parent}: run {info['setup']}"
-        elif "distribution" in info:
-            info["version"] = _peer_version(info["python"], info["distribution"])
-        if info["available"]:
-            results[name] = {}
-            for set_name in list(SET_NAMES) + (["tracking"] if info["tracking"] else []):
-                out_path = work / f"results-{name}-{set_name}-seed{args.seed}.jsonl"
-                if args.reuse and out_path.is_file() and out_path.stat().st_mtime > frame_paths[set_name].stat().st_mtime:
-                    print(f"reusing {out_path.name}", flush=True)
-                    records, failure = sif.read_jsonl(out_path), None
-                else:
-                    print(f"running {name} on {set_name} ({len(frame_sets[set_name])} frames)", flush=True)
-                    records, failure = _run_solver(name, info, frame_paths[set_name], out_path, args,
-                                                   catalog_folder, work)
-                if records is None:
-                    info["available"], info["reason"] = False, failure
-                    results.pop(name, None)
-                    tracking.pop(name, None)
-                    print(f"  {name}: not run ({failure})", flush=True)
-                    break
-                raw[(name, set_name)] = records
-                if set_name == "tracking":
-                    tracking[name] = {}
-                    for error_deg in sif.TRACKING_PRIOR_ERRORS_DEG:
-                        subset = [f for f in frame_sets["tracking"] if f["prior_error_deg"] == error_deg]
-                        tracking[name][f"{error_deg:g}"] = evaluate(subset, records, stars, camera, rng)
-                else:
-                    results[name][set_name] = evaluate(frame_sets[set_name], records, stars, camera, rng)
+        else:
+            if "distribution" in info:
+                info["version"] = _peer_version(info["python"], info["distribution"])
+            scored, failure = run_and_score(name, info, frame_sets, frame_paths, args, catalog_folder, stars, camera)
+            if scored is None:
+                info["available"], info["reason"] = False, failure
+                print(f"  {name}: not run ({failure})", flush=True)
+            else:
+                results[name] = {set_name: scored[set_name] for set_name in SET_NAMES}
+                if "tracking" in scored:
+                    tracking[name] = scored["tracking"]
         solvers[name] = {key: (os.path.relpath(value, HERE.parent) if isinstance(value, Path) else value)
                          for key, value in info.items()}
 
     results[REFERENCE] = {name: evaluate(frame_sets[name], reference_results(frame_sets[name], stars, camera),
-                                         stars, camera, rng) for name in SET_NAMES}
-    print()
+                                         stars, camera, _crb_rng(args.seed, REFERENCE, name)) for name in SET_NAMES}
+    print(f"\n{args.frames} frames per set, seed {args.seed}, FOV told to +-{args.fov_max_error_deg:g} deg; "
+          f"success/false over all frames; errors of the successes [arcsec]; solve ms of the solver call")
     print_tables(results, tracking, solvers, SET_NAMES)
     print(f"({REFERENCE}: every true star centroid with its true HIP, SVD refit -- the accuracy reference, not a solver)")
     goals = evaluate_goals(results, tracking)

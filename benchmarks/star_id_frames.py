@@ -203,12 +203,16 @@ def tracking_frames(frames: list[dict], prior_errors_deg=TRACKING_PRIOR_ERRORS_D
 
 
 def write_jsonl(path, records) -> Path:
-    """Write ``records`` (dicts) to ``path``, one JSON object per line."""
+    """Write ``records`` (dicts) to ``path``, one JSON object per line.
+
+    A file that already holds exactly these lines is left alone (its modification time tells the
+    harness whether results computed from it are current).
+    """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w") as stream:
-        for record in records:
-            stream.write(json.dumps(record) + "\n")
+    text = "".join(json.dumps(record) + "\n" for record in records)
+    if not path.is_file() or path.read_text() != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
     return path
 
 

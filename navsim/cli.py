@@ -3,15 +3,18 @@
     navsim run SCENARIO.toml --out DIR [--seed N] [--set key=value ...] [--report [FILE.pdf]]
     navsim report DIR -o FILE.pdf
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
+    navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
 from navsim.montecarlo import run_campaign
+from navsim.tuning import tune
 from navsim.output import write_run
 from navsim.simulation import run
 from startrack.errors import InputError, run_command
@@ -78,6 +81,25 @@ def _montecarlo(args):
     return 0 if summary["runs_failed"] == 0 else 1
 
 
+def _tune(args):
+    if args.runs < 1:
+        raise InputError(f"--runs must be at least 1, got {args.runs}")
+    result = tune(args.scenario, runs=args.runs, seed=args.seed, overrides=args.set or (), evaluations=args.evaluations)
+    if args.json:
+        print(json.dumps(result.as_dict(), indent=2))
+        return 0
+    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} {'cross RMS':>10} {'roll RMS':>9}")
+    for k, step in enumerate(result.steps):
+        print(f"{k:>4} {step.process_noise_scale:9.3f} {step.measurement_noise_scale:9.3f} {step.nees_per_dof:9.3f} "
+              f"{step.nis_per_dof:8.3f} {step.cross_boresight_rms_arcsec:9.2f}\" {step.roll_rms_arcsec:8.2f}\"")
+    first, last = result.steps[0], result.steps[-1]
+    print(f"before: NEES/dof {first.nees_per_dof:.2f}, NIS/dof {first.nis_per_dof:.2f}; "
+          f"after: NEES/dof {last.nees_per_dof:.2f}, NIS/dof {last.nis_per_dof:.2f}")
+    print(f"use: --set filter.process_noise_scale={last.process_noise_scale:.4g} "
+          f"--set filter.measurement_noise_scale={last.measurement_noise_scale:.4g}")
+    return 0
+
+
 def build_parser():
     parser = argparse.ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -104,6 +126,15 @@ def build_parser():
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask distributed scheduler")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_montecarlo)
+
+    p = sub.add_parser("tune", help="fit the filter's Q and R scale factors for NEES/NIS consistency")
+    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("--runs", type=int, default=20, help="seeded runs per iteration (default 20)")
+    p.add_argument("--evaluations", type=int, default=30, help="most batches evaluated (default 30)")
+    p.add_argument("--seed", type=int, default=None, help="first seed (default: the scenario's)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.add_argument("--json", action="store_true", help="print the iterations as JSON")
+    p.set_defaults(func=_tune)
     return parser
 
 

@@ -31,6 +31,8 @@ class Value:
     doc: str = ""
 
     def check(self, where, value):
+        if value is None and self.default is None:  # an optional value left unset (re-validation)
+            return None
         if self.kind == "float":
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise InputError(f"{where}: must be a number, got {value!r}")

@@ -11,7 +11,7 @@ import sys
 from startrack.errors import run_command
 
 #: Sub-command modules under ``startrack.commands``, in the order ``--help`` lists them.
-COMMANDS = ("catalog", "address", "render", "detect")
+COMMANDS = ("catalog", "address", "render", "detect", "solve")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -12,11 +12,13 @@ import tempfile
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 import typst
 
 from navsim import units
 from navsim.report import figures
 from navsim.report import statistics as stats
+from startrack import address
 
 PREAMBLE = """\
 #set document(title: {title}, author: "navsim", date: none)
@@ -48,16 +50,16 @@ def markup(value) -> str:
     return "".join(out)
 
 
-def number(x, digits=2) -> str:
-    """Fixed-point text of ``x`` (``digits`` decimals), 'n/a' for None or non-finite values."""
-    if x is None or not math.isfinite(x):
+def number(x, digits=2, scale=1.0) -> str:
+    """Fixed-point text of ``scale * x`` (``digits`` decimals); 'n/a' for anything not a finite number."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
         return "n/a"
-    return f"{x:.{digits}f}"
+    return f"{scale * x:.{digits}f}"
 
 
 def xyz(values, digits=2) -> str:
     """'x a, y b, z c' for three per-axis values."""
-    return ", ".join(f"{axis} {number(float(v) if v is not None else None, digits)}" for axis, v in zip("xyz", values))
+    return ", ".join(f"{axis} {number(None if v is None else float(v), digits)}" for axis, v in zip("xyz", values))
 
 
 def general(x) -> str:
@@ -104,9 +106,12 @@ class Document:
     def __init__(self, workdir: Path, title: str, header: str):
         self.workdir = workdir
         self.parts = [PREAMBLE.format(title=literal(title), header=literal(header))]
+        self.lead = []  # paragraphs kept on the page of the figure that follows them
         self.count = 0
 
     def add(self, source: str):
+        self.parts.extend(self.lead)
+        self.lead = []
         self.parts.append(source)
 
     def title(self, title, subtitle):
@@ -118,20 +123,22 @@ class Document:
 
     def paragraph(self, *sentences):
         """Sentences are markup already (build them with :func:`markup` and :func:`number`)."""
-        self.add(" ".join(s for s in sentences if s) + "\n\n")
+        self.lead.append(" ".join(s for s in sentences if s) + "\n\n")
 
     def figure(self, fig, caption):
-        """Save ``fig`` as SVG beside the source and place it; a None figure adds nothing."""
+        """Save ``fig`` as SVG beside the source and place it with the paragraphs just before it, on one page;
+        a None figure adds nothing."""
         if fig is None:
-            return False
+            return
         self.count += 1
         name = f"figure_{self.count:02d}.svg"
         figures.save(fig, self.workdir / name)
-        self.add(f"#figure(image({literal(name)}, width: 100%), caption: [{markup(caption)}])\n")
-        return True
+        lead, self.lead = "".join(self.lead), []
+        self.add(f"#block(breakable: false, width: 100%)[\n{lead}"
+                 f"#figure(image({literal(name)}, width: 100%), caption: [{markup(caption)}])\n]\n")
 
     def source(self) -> str:
-        return "".join(self.parts)
+        return "".join(self.parts + self.lead)
 
     def compile(self) -> bytes:
         path = self.workdir / "report.typ"
@@ -140,11 +147,9 @@ class Document:
 
 
 def _scenario_name(summary, scenario, directory):
-    for source in (summary, scenario):
-        if isinstance(source, dict):
-            name = source.get("scenario") if source is summary else source.get("name")
-            if isinstance(name, str) and name:
-                return name
+    for name in ((summary or {}).get("scenario"), (scenario or {}).get("name")):
+        if isinstance(name, str) and name:
+            return name
     return directory.name
 
 
@@ -178,53 +183,51 @@ def run_report(run) -> bytes:
 
 def _key_results(doc, run):
     summary = run.summary
+
+    def get(*path):
+        return stats.lookup(summary, path)
+
     doc.heading("Key results")
-    rms = summary.get("attitude_error_rms_arcsec", {})
-    settle = summary.get("settle_s")
     sentences = []
-    if "cross_boresight_rms_arcsec" in summary:
+    if get("cross_boresight_rms_arcsec") is not None:
         sentences.append(
-            f"After the settling time of {number(settle, 1)} s the cross-boresight attitude error RMS is "
-            f"{number(summary['cross_boresight_rms_arcsec'])} arcsec and the roll (about the boresight) error RMS "
-            f"is {number(summary.get('roll_rms_arcsec'))} arcsec.")
-    if rms:
-        sentences.append(f"Per body axis the RMS errors are {xyz([rms.get(a) for a in 'xyz'])} arcsec.")
-    nees = summary.get("nees", {})
-    if nees:
-        band = nees.get("band_95", [math.nan, math.nan])
+            f"After the settling time of {number(get('settle_s'), 1)} s the cross-boresight attitude error RMS is "
+            f"{number(get('cross_boresight_rms_arcsec'))} arcsec and the roll (about the boresight) error RMS "
+            f"is {number(get('roll_rms_arcsec'))} arcsec.")
+    rms = [get("attitude_error_rms_arcsec", axis) for axis in "xyz"]
+    if any(v is not None for v in rms):
+        sentences.append(f"Per body axis the RMS errors are {xyz(rms)} arcsec.")
+    dof = get("nees", "dof") or stats.NEES_DOF
+    if get("nees", "mean") is not None:
+        band = summary["nees"].get("band_95")
+        band = band if isinstance(band, list) and len(band) == 2 else stats.chi2_band(dof)
         sentences.append(
-            f"The NEES ({nees.get('dof', stats.NEES_DOF)} dof) averages {number(nees.get('mean'))} and "
-            f"{number(100 * nees.get('fraction_in_band', math.nan), 1)} % of the frames lie inside the 95 % "
+            f"The NEES ({dof:g} dof) averages {number(get('nees', 'mean'))} and "
+            f"{number(get('nees', 'fraction_in_band'), 1, 100)} % of the frames lie inside the 95 % "
             f"chi-square band [{number(band[0])}, {number(band[1])}].")
-    nis = summary.get("nis", {})
-    if "mean_per_dof" in nis:
-        sentences.append(f"The NIS per degree of freedom averages {number(nis['mean_per_dof'], 3)} (expected 1).")
-    upd = summary.get("updates", {})
-    if upd:
-        sentences.append(f"The gate accepted {upd.get('accepted', 'n/a')} of {upd.get('measurements', 'n/a')} "
-                         f"star measurements in {upd.get('frames_with_measurements', 'n/a')} frames.")
+    if get("nis", "mean_per_dof") is not None:
+        sentences.append(f"The NIS per degree of freedom averages {number(get('nis', 'mean_per_dof'), 3)} "
+                         "(expected 1).")
+    if get("updates", "measurements") is not None:
+        sentences.append(f"The gate accepted {number(get('updates', 'accepted'), 0)} of "
+                         f"{number(get('updates', 'measurements'), 0)} star measurements in "
+                         f"{number(get('updates', 'frames_with_measurements'), 0)} frames.")
     doc.paragraph(*(markup(x) for x in sentences))
-    rows = []
-    for label, key, unit in (("cross-boresight RMS", "cross_boresight_rms_arcsec", "arcsec"),
-                             ("roll RMS", "roll_rms_arcsec", "arcsec")):
-        if key in summary:
-            rows.append((label, number(summary[key]), unit))
-    for axis in "xyz":
-        if axis in rms:
-            rows.append((f"RMS error {axis}", number(rms[axis]), "arcsec"))
-    sig = summary.get("attitude_sigma_final_arcsec")
-    if isinstance(sig, list) and len(sig) == 3:
-        rows.append(("final filter 1σ x, y, z", ", ".join(number(v) for v in sig), "arcsec"))
-    bias = summary.get("bias_error_final_deg_per_h")
-    if isinstance(bias, list) and len(bias) == 3:
-        rows.append(("final bias error x, y, z", ", ".join(number(v, 4) for v in bias), "deg/h"))
-    if nees:
-        rows.append(("NEES mean", number(nees.get("mean")), f"{nees.get('dof', stats.NEES_DOF)} dof"))
-        rows.append(("NEES inside 95 % band", number(100 * nees.get("fraction_in_band", math.nan), 1), "%"))
-    if "mean_per_dof" in nis:
-        rows.append(("NIS mean per dof", number(nis["mean_per_dof"], 3), ""))
-    if "wall_seconds" in summary:
-        rows.append(("wall time", number(summary["wall_seconds"]), "s"))
+    quantities = [  # (label, value or per-axis values, unit, decimals)
+        ("cross-boresight RMS", get("cross_boresight_rms_arcsec"), "arcsec", 2),
+        ("roll RMS", get("roll_rms_arcsec"), "arcsec", 2),
+        *((f"RMS error {axis}", v, "arcsec", 2) for axis, v in zip("xyz", rms)),
+        ("final filter 1σ", [get("attitude_sigma_final_arcsec", i) for i in range(3)], "arcsec", 2),
+        ("final bias error", [get("bias_error_final_deg_per_h", i) for i in range(3)], "deg/h", 4),
+        ("NEES mean", get("nees", "mean"), f"{dof:g} dof", 2),
+        ("NEES inside 95 % band", None if get("nees", "fraction_in_band") is None
+         else 100 * get("nees", "fraction_in_band"), "%", 1),
+        ("NIS mean per dof", get("nis", "mean_per_dof"), "", 3),
+        ("wall time", get("wall_seconds"), "s", 2),
+    ]
+    rows = [(label, xyz(v, digits) if isinstance(v, list) else number(v, digits), unit)
+            for label, v, unit, digits in quantities
+            if (any(x is not None for x in v) if isinstance(v, list) else v is not None)]
     if rows:
         doc.add(table(("Quantity", "Value", "Unit"), rows, ("left", "right", "left")))
 
@@ -313,14 +316,17 @@ def _address_section(doc, run):
     if fig is None:
         return
     doc.heading("Boresight track and sub-catalog addresses")
-    s = run.series
-    text = (f"The predicted boresight is addressed on the base-point grid of n_d = {n_d} declination divisions "
-            f"(eq. 1-2 and 7-8 of document 000) at every frame.")
-    if "subcatalog_index" in s:
-        index = s["subcatalog_index"]
-        text += (f" The run used {len(set(index.tolist()))} distinct sub-catalogs and changed address "
-                 f"{int((index[1:] != index[:-1]).sum())} times.")
-    doc.paragraph(markup(text))
+    if n_d is None:
+        doc.paragraph(markup("The run names no base-point grid (no n_d) and logs no sub-catalog addresses, "
+                             "so the boresight track is drawn without the grid."))
+        doc.figure(fig, "Boresight track (left: whole sky; right: the track).")
+        return
+    index = stats.sub_catalog_indices(run.series, n_d)
+    doc.paragraph(markup(
+        f"The predicted boresight is addressed on the base-point grid of n_d = {n_d} declination divisions "
+        f"({address.base_point_count(n_d)} base points; eq. 1-2 and 7-8 of document 000) at every frame. "
+        f"The run used {np.unique(index).size} distinct sub-catalogs and changed address "
+        f"{int(np.count_nonzero(index[1:] != index[:-1]))} times."))
     doc.figure(fig, "Boresight track over the base-point grid (left: whole sky; right: the track with the "
                     "addresses (l_d, l_ra) of the sub-catalogs used).")
 
@@ -336,7 +342,8 @@ def _frame_section(doc, run):
     doc.paragraph(markup(f"One {w} x {h} frame as rendered and processed: {len(det)} detections, "
                          f"{identified} identified (green, labelled with their Hipparcos numbers), "
                          f"{len(det) - identified} not identified (red)."))
-    doc.figure(fig, "Rendered frame (asinh stretch of the brightness above the median) with detections and identifications.")
+    doc.figure(fig, "Rendered frame (asinh stretch of the brightness above the median) with detections and "
+                    "identifications.")
 
 
 def _comparison_section(doc, comparison):
@@ -415,13 +422,15 @@ def campaign_report(campaign) -> bytes:
                              f"after {number(avg.settle_s, 1)} s and {number(100 * avg.fraction_in_band, 1)} % of "
                              f"those frames lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] "
                              f"for {avg.runs} runs of {avg.dof} dof.")
-        for r in success:
-            sentences.append(f"Identification success in {r.name}: {number(100 * r.fraction, 1)} % "
-                             f"({r.identified} of {r.frames} frames).")
+        if success:
+            sentences.append(f"Success ({criterion}): " + "; ".join(
+                f"{r.name} {number(100 * r.fraction, 1)} % ({r.identified} of {r.frames} frames)" for r in success)
+                + ".")
         doc.paragraph(*(markup(x) for x in sentences))
 
         doc.heading("Campaign")
-        doc.add(table(("Setting", "Value"), [(k, _short(general(v))) for k, v in flatten(campaign.campaign)],
+        settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}  # scenario: next section
+        doc.add(table(("Setting", "Value"), [(k, _short(general(v))) for k, v in flatten(settings)],
                       ("left", "left")))
         _scenario_section(doc, campaign.scenario)
 

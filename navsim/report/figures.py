@@ -216,40 +216,47 @@ def identification_time(run):
 
 
 def boresight_track(run, n_d):
-    """Boresight RA/Dec over the base-point grid (eq. 1-2 of 000), with the sub-catalog addresses used."""
+    """Boresight RA/Dec over the base-point grid (eq. 1-2 of 000), with the addresses (eq. 7-8) used.
+
+    Without a known ``n_d`` the track is drawn alone. The sub-catalogs used are the logged flat
+    indices, else the logged addresses, else eq. 7-8 applied to the logged boresight.
+    """
     s = run.series
-    if "boresight_radec" not in s or n_d is None:
+    if "boresight_radec" not in s:
         return None
     ra_b, dec_b = np.degrees(s["boresight_radec"][:, 0]), np.degrees(s["boresight_radec"][:, 1])
-    ra_g, dec_g = (np.degrees(a) for a in address.base_points_radec(n_d))
     fig, axes = new_figure(3.4, 1, 2, sharex=False)
     overview, zoom = axes[0]
-    overview.scatter(ra_g, dec_g, s=0.3, color="0.6", lw=0)
-    overview.plot(ra_b, dec_b, ".", ms=1.5, color="tab:red")
-    overview.set(xlim=(360, 0), ylim=(-90, 90), xlabel="RA [deg]", ylabel="Dec [deg]",
-                 title=f"whole sky, n_d = {n_d} ({address.base_point_count(n_d)} base points)")
     # Zoom: RA unwrapped about the track's circular mean so a track across RA = 0 stays in one piece.
     centre = np.degrees(np.angle(np.mean(np.exp(1j * np.radians(ra_b)))))
-    ra_t = centre + (ra_b - centre + 180.0) % 360.0 - 180.0
-    ra_gz = centre + (ra_g - centre + 180.0) % 360.0 - 180.0
+
+    def unwrap(ra):
+        return centre + (ra - centre + 180.0) % 360.0 - 180.0
+
+    ra_t = unwrap(ra_b)
     pad = max(5.0, 0.15 * max(np.ptp(ra_t), np.ptp(dec_b)))
     box = (ra_t.min() - pad, ra_t.max() + pad, max(dec_b.min() - pad, -90.0), min(dec_b.max() + pad, 90.0))
-    near = (ra_gz >= box[0]) & (ra_gz <= box[1]) & (dec_g >= box[2]) & (dec_g <= box[3])
-    zoom.scatter(ra_gz[near], dec_g[near], s=4, color="0.6", lw=0, label="base points")
-    zoom.plot(ra_t, dec_b, "-", lw=0.8, color="tab:red", label="boresight (predicted)")
-    if "subcatalog_index" in s:
-        used, counts = np.unique(s["subcatalog_index"].astype(np.int64), return_counts=True)
-        used = used[(used >= 0) & (used < ra_g.size)]
-        ra_u = centre + (ra_g[used] - centre + 180.0) % 360.0 - 180.0
-        zoom.scatter(ra_u, dec_g[used], s=14, facecolor="none", edgecolor="tab:blue", lw=0.8,
+    title = "whole sky"
+    if n_d is not None:
+        ra_g, dec_g = (np.degrees(a) for a in address.base_points_radec(n_d))
+        overview.scatter(ra_g, dec_g, s=0.3, color="0.6", lw=0)
+        title += f", n_d = {n_d} ({address.base_point_count(n_d)} base points)"
+        ra_gz = unwrap(ra_g)
+        near = (ra_gz >= box[0]) & (ra_gz <= box[1]) & (dec_g >= box[2]) & (dec_g <= box[3])
+        zoom.scatter(ra_gz[near], dec_g[near], s=4, color="0.6", lw=0, label="base points")
+        used = np.unique(stats.sub_catalog_indices(s, n_d))
+        zoom.scatter(ra_gz[used], dec_g[used], s=14, facecolor="none", edgecolor="tab:blue", lw=0.8,
                      label=f"sub-catalogs used ({used.size})")
-        if "subcatalog_address" in s and used.size <= 40:
+        if used.size <= 40:
             l_d, l_ra = address.address_of_index(used, n_d)
-            for x, y, a, b in zip(ra_u, dec_g[used], np.atleast_1d(l_d), np.atleast_1d(l_ra)):
+            for x, y, a, b in zip(ra_gz[used], dec_g[used], l_d, l_ra):
                 zoom.annotate(f"({a},{b})", (x, y), xytext=(3, 3), textcoords="offset points", fontsize=5,
                               color="tab:blue")
+    overview.plot(ra_b, dec_b, ".", ms=1.5, color="tab:red")
+    overview.set(xlim=(360, 0), ylim=(-90, 90), xlabel="RA [deg]", ylabel="Dec [deg]", title=title)
+    zoom.plot(ra_t, dec_b, "-", lw=0.8, color="tab:red", label="boresight")
     zoom.set(xlim=(box[1], box[0]), ylim=(box[2], box[3]), xlabel="RA [deg]", ylabel="Dec [deg]",
-             title="track, with addresses (l_d, l_ra)")
+             title="track" + (", with addresses (l_d, l_ra)" if n_d is not None else ""))
     zoom.legend(loc="lower left", fontsize=6)
     return fig
 
@@ -339,8 +346,8 @@ def final_error_histogram(env):
 
 
 def identification_success(rows, criterion):
-    """Pooled fraction of identified frames per mode."""
-    if not rows:
+    """Pooled fraction of identified frames per mode (None for fewer than two modes: the table says it all)."""
+    if len(rows) < 2:
         return None
     fig, axes = new_figure(2.2)
     ax = axes[0, 0]

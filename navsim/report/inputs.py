@@ -183,8 +183,9 @@ def load_campaign(directory: Path) -> CampaignData:
     summary = read_json(summary_path) if summary_path.is_file() else None
     scenario_path = directory / "scenario.json"
     scenario = read_json(scenario_path) if scenario_path.is_file() else None
-    if scenario is None and isinstance(campaign.get("scenario"), dict):
-        scenario = campaign["scenario"]
+    for key in ("scenario_data", "scenario"):  # the validated scenario may be embedded in campaign.json
+        if scenario is None and isinstance(campaign.get(key), dict):
+            scenario = campaign[key]
     data = CampaignData(directory, campaign, summary, scenario=scenario)
     runs_dir = directory / "runs"
     run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir()) if runs_dir.is_dir() else []

@@ -115,6 +115,18 @@ def declination_divisions(run):
     return None
 
 
+def sub_catalog_indices(series, n_d):
+    """Flat sub-catalog index of every frame: logged, from the logged address, or by eq. 7-8 of 000."""
+    if "subcatalog_index" in series:
+        index = series["subcatalog_index"].astype(np.int64)
+    elif "subcatalog_address" in series:
+        a = series["subcatalog_address"].astype(np.int64)
+        index = address.base_index(a[:, 0], a[:, 1], n_d)
+    else:
+        index = address.sub_catalog_index(series["boresight_radec"][:, 0], series["boresight_radec"][:, 1], n_d)
+    return index[(index >= 0) & (index < address.base_point_count(n_d))]
+
+
 def _find_key(tree, key):
     if isinstance(tree, dict):
         value = tree.get(key)
@@ -287,7 +299,7 @@ def metric_table(campaign):
     """Across-run statistics of each per-run metric found in the run summaries."""
     rows = []
     for label, unit, path in RUN_METRICS:
-        values = [_lookup(r.summary, path) for r in campaign.runs]
+        values = [lookup(r.summary, path) for r in campaign.runs]
         values = np.array([v for v in values if v is not None], dtype=float)
         if values.size == 0:
             continue
@@ -299,11 +311,15 @@ def metric_table(campaign):
     return rows
 
 
-def _lookup(tree, path):
+def lookup(tree, path):
+    """The finite number at ``path`` (keys or list indices) in nested JSON, else None."""
     for key in path:
-        if not isinstance(tree, dict) or key not in tree:
+        if isinstance(tree, dict) and key in tree:
+            tree = tree[key]
+        elif isinstance(tree, list) and isinstance(key, int) and -len(tree) <= key < len(tree):
+            tree = tree[key]
+        else:
             return None
-        tree = tree[key]
     if isinstance(tree, bool) or not isinstance(tree, (int, float)) or not np.isfinite(tree):
         return None
     return float(tree)

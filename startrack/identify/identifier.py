@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.attitude import cramer_rao_covariance
 from startrack.attitude_angles import quaternion_from_matrix, radec_roll_from_matrix
 from startrack.errors import InputError
 from startrack.identify.features import FrameFeatures
@@ -76,7 +75,7 @@ class StarIdentifier:
     catalog: :class:`startrack.navigation_catalog.NavigationCatalog`; camera: :class:`startrack.camera.Camera`;
     centroid_sigma_px: centroid noise per axis [px] (covariance and gates); delta_sigmas: the error
     bound delta of 001 §4.3.1 in units of it (3); gate_sigmas: verification match radius in units of it
-    (5); pattern_stars: brightest centroids searched first (10); max_stars: centroids used at all
+    (5); pattern_stars: brightest centroids searched first (16); max_stars: centroids used at all
     (None: all); max_groups: four-star groups searched for (4); max_triangles: triangles kept for frames
     without a group (8); false_match_threshold: acceptance threshold
     (1e-6); tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
@@ -86,7 +85,7 @@ class StarIdentifier:
     """
 
     def __init__(self, catalog, camera, centroid_sigma_px=0.2, delta_sigmas=3.0, gate_sigmas=5.0,
-                 pattern_stars=10, max_stars=None, max_groups=4, max_triangles=8,
+                 pattern_stars=16, max_stars=None, max_groups=4, max_triangles=8,
                  false_match_threshold=DEFAULT_FALSE_MATCH_THRESHOLD, tracking_window_px=20.0,
                  methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None):
         self.catalog = catalog
@@ -188,24 +187,22 @@ class StarIdentifier:
         return _failed("no_match", f"no star pattern was verified ({tried or 'no method applicable'})", start)
 
     def _result(self, frame, verified, strategy, prior, start):
-        ref = self.field.vectors[verified.star_index]
-        obs = frame.obs_S[verified.obs_index]
-        R_IS = verified.R_IS
-        chord = obs - ref @ R_IS
-        residuals = 2.0 * np.arcsin(np.minimum(0.5 * np.sqrt(np.einsum("ij,ij->i", chord, chord)), 1.0))
-        covariance = cramer_rao_covariance(obs, self.centroid_sigma_px / self.camera.focal_px)
         centroid = frame.index[verified.obs_index]
         order = np.argsort(centroid)
-        hip = self.field.hip[verified.star_index]
-        lost = entered = np.zeros(0, np.int64)
+        star_index = verified.star_index[order]
+        hip = self.field.hip[star_index]
+        lost = entered = _NO_STARS
         if strategy.name == "tracking":
-            lost, entered = strategy.lost_and_entered(prior, R_IS, hip)
+            lost, entered = strategy.lost_and_entered(prior, verified.R_IS, hip)
         return IdentificationResult(
-            status="ok", q_IS=quaternion_from_matrix(R_IS),
-            matches=np.column_stack([centroid[order], hip[order]]).astype(np.int64),
-            residuals=residuals[order], covariance=covariance,
+            status="ok", q_IS=quaternion_from_matrix(verified.R_IS),
+            matches=np.column_stack([centroid[order], hip]), obs_S=frame.obs_S[verified.obs_index[order]],
+            ref_I=self.field.vectors[star_index], sigma=self.centroid_sigma_px / self.camera.focal_px,
             false_match_probability=verified.false_match_probability, method=strategy.name,
             solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered)
+
+
+_NO_STARS = np.zeros(0, np.int64)
 
 
 def _numeric(value) -> bool:

@@ -47,6 +47,12 @@ class PairTable:
     slope: float = 1.0
     intercept: float = 0.0
 
+    def __post_init__(self):
+        for name in ("theta", "first", "second"):  # one array type for every table: one compiled kernel
+            array = np.ascontiguousarray(getattr(self, name))
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+
     @classmethod
     def full_sky(cls, catalog) -> "PairTable":
         """Every pattern pair of the navigation catalog, searched with its k-vector."""
@@ -121,7 +127,8 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
     """Triangles and four-star groups (module text); returns (groups (g, 8), triangles (t, 6), N_h).
 
     For each anchor star i (brightest first) the catalog pairs matched to every observed pair (i, t)
-    are chained per (t, catalog star of i) in linked lists, so that a triangle (i, j, k) is found by
+    are chained per (t, catalog star of i) in linked lists (with a bit mask per catalog star of the
+    partners t whose list is not empty; at most 63 stars), so that a triangle (i, j, k) is found by
     following, for each catalog assignment (A, B) of (i, j), the list of (k, A) and testing the
     distance (B, C) against the gate of (j, k) and the handedness; each triangle is extended to a group
     by the lists of every other star r.  Stops after ``max_groups`` groups.  ``head`` (>= n, n_guide)
@@ -146,6 +153,7 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
     triangles = np.empty((max_triangles, 6), np.int64)
     n_groups = 0
     n_triangles = 0
+    partners = np.zeros(n_guide, np.int64)  # bit t set: the list (t, A) is not empty
     capacity = 4 * n_matches + 1
     entry_other = np.empty(capacity, np.int64)
     entry_next = np.empty(capacity, np.int64)
@@ -167,6 +175,7 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
                     entry_partner[m] = t
                     entry_anchor[m] = a_cat
                     head[t, a_cat] = m
+                    partners[a_cat] |= np.int64(1) << t
                     m += 1
         done = False
         for j in range(i + 1, n):
@@ -178,9 +187,14 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
                         break
                     a_cat = first[q] if orientation == 0 else second[q]
                     b_cat = second[q] if orientation == 0 else first[q]
-                    for k in range(j + 1, n):
-                        if done:
-                            break
+                    later = partners[a_cat] >> (j + 1)
+                    k = j
+                    while later != 0 and not done:
+                        k += 1
+                        present = later & 1
+                        later >>= 1
+                        if present == 0:
+                            continue
                         e = head[k, a_cat]
                         while e >= 0 and not done:
                             c_cat = entry_other[e]
@@ -198,7 +212,7 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
                                 triangles[n_triangles, 5] = c_cat
                                 n_triangles += 1
                             for r in range(n):
-                                if r == i or r == j or r == k or done:
+                                if r == i or r == j or r == k or done or (partners[a_cat] >> r) & 1 == 0:
                                     continue
                                 jr0, jr1 = min(j, r), max(j, r)
                                 kr0, kr1 = min(k, r), max(k, r)
@@ -226,6 +240,7 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
                                     break
         for e in range(m):
             head[entry_partner[e], entry_anchor[e]] = -1
+            partners[entry_anchor[e]] = 0
         if done:
             break
     return groups[:n_groups], triangles[:n_triangles], 2 * n_matches
@@ -244,7 +259,7 @@ def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int =
     if workspace is None or workspace.shape[0] < len(obs_S):
         workspace = np.full((len(obs_S), len(guide_vectors)), -1, np.int64)
     groups, triangles, n_matches = _group_search(
-        np.ascontiguousarray(obs_S), beta, gate, table.theta, table.first, table.second, table.k, table.slope,
+        np.ascontiguousarray(obs_S), np.ascontiguousarray(beta), np.ascontiguousarray(gate), table.theta, table.first, table.second, table.k, table.slope,
         table.intercept, guide_vectors, max_groups, max_triangles, workspace)
     groups = groups[_ranked(groups[:, :4], gate)]
     triangles = triangles[_ranked(triangles[:, :3], gate)]

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from startrack.attitude_angles import radec_roll_from_quaternion
+from startrack.attitude import cramer_rao_covariance
+from startrack.attitude_angles import matrix_from_quaternion, radec_roll_from_quaternion
 
 #: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
 #: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
@@ -29,10 +30,10 @@ class IdentificationResult:
     status: one of :data:`STATUSES`; reason: one sentence when status is not "ok" ("" otherwise).
     q_IS: (4,) scalar-last quaternion rotating sensor-frame vectors into the inertial frame (NaN unless ok);
         :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
-    matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number).
-    residuals: (M,) angle between each matched centroid's direction and its refitted prediction [rad].
-    covariance: (3, 3) attitude-error covariance in sensor axes [rad^2] (x, y cross-boresight, z roll):
-        the Cramer-Rao bound of the matched stars (SVD solution of Wahba's problem).
+    matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number), by centroid index.
+    obs_S, ref_I: (M, 3) the matched centroid directions in S and their catalog directions in I (the
+        measurements a filter uses); sigma: their per-axis angular noise [rad].
+        :attr:`residuals` and :attr:`covariance` are derived from them when asked.
     false_match_probability: chance that a wrong attitude hypothesis explains as many centroids
         (:func:`startrack.identify.verify.false_match_probability`); NaN when nothing was verified.
     method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space") or "" if none.
@@ -45,8 +46,9 @@ class IdentificationResult:
     reason: str = ""
     q_IS: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))
     matches: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
-    residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    covariance: np.ndarray = field(default_factory=lambda: np.full((3, 3), np.nan))
+    obs_S: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    ref_I: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    sigma: float = math.nan
     false_match_probability: float = math.nan
     method: str = ""
     solve_ms: float = math.nan
@@ -80,6 +82,25 @@ class IdentificationResult:
     def roll(self) -> float:
         """Roll about the boresight [rad] in [-pi, pi), 003 §1.1 (NaN unless ok)."""
         return self._radec_roll[2]
+
+    @functools.cached_property
+    def residuals(self) -> np.ndarray:
+        """(M,) angle [rad] between each matched direction and its prediction R_IS^T ref_I."""
+        if not self.ok:
+            return np.zeros(0)
+        chord = self.obs_S - self.ref_I @ matrix_from_quaternion(self.q_IS)
+        return 2.0 * np.arcsin(np.minimum(0.5 * np.sqrt(np.einsum("ij,ij->i", chord, chord)), 1.0))
+
+    @functools.cached_property
+    def covariance(self) -> np.ndarray:
+        """(3, 3) attitude-error covariance in sensor axes [rad^2] (x, y cross-boresight, z roll).
+
+        The Cramer-Rao bound of the matched stars, which the SVD solution of Wahba's problem attains
+        (:func:`startrack.attitude.cramer_rao_covariance`); NaN unless ok.
+        """
+        if not self.ok:
+            return np.full((3, 3), np.nan)
+        return cramer_rao_covariance(self.obs_S, self.sigma)
 
     @property
     def matched_hip(self) -> np.ndarray:

@@ -44,17 +44,86 @@ DEFAULT_FALSE_MATCH_THRESHOLD = 1e-6
 
 
 @njit
+def _symmetric_eigen(M):  # pragma: no cover  (compiled)
+    """(eigenvalues (3,), eigenvectors (3, 3) as columns) of a symmetric 3x3 matrix by cyclic Jacobi sweeps."""
+    A = M.copy()
+    V = np.eye(3)
+    for _ in range(64):
+        off = A[0, 1] ** 2 + A[0, 2] ** 2 + A[1, 2] ** 2
+        if off <= 1e-34 * (A[0, 0] ** 2 + A[1, 1] ** 2 + A[2, 2] ** 2):
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            if A[p, q] == 0.0:
+                continue
+            theta = (A[q, q] - A[p, p]) / (2.0 * A[p, q])
+            t = 1.0 / (theta + np.sqrt(theta * theta + 1.0)) if theta >= 0.0 else -1.0 / (-theta + np.sqrt(theta * theta + 1.0))
+            c = 1.0 / np.sqrt(t * t + 1.0)
+            s = t * c
+            for k in range(3):
+                a_kp, a_kq = A[k, p], A[k, q]
+                A[k, p], A[k, q] = c * a_kp - s * a_kq, s * a_kp + c * a_kq
+            for k in range(3):
+                a_pk, a_qk = A[p, k], A[q, k]
+                A[p, k], A[q, k] = c * a_pk - s * a_qk, s * a_pk + c * a_qk
+            for k in range(3):
+                v_kp, v_kq = V[k, p], V[k, q]
+                V[k, p], V[k, q] = c * v_kp - s * v_kq, s * v_kp + c * v_kq
+    return np.array([A[0, 0], A[1, 1], A[2, 2]]), V
+
+
+@njit
+def _dot(a, b):  # pragma: no cover  (compiled)
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit
+def _unit(a):  # pragma: no cover  (compiled)
+    return a / np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit
+def _apply(M, a):  # pragma: no cover  (compiled)
+    return np.array([_dot(M[0], a), _dot(M[1], a), _dot(M[2], a)])
+
+
+@njit
+def _cross(a, b):  # pragma: no cover  (compiled)
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit
 def wahba_svd(ref_I, obs_S):  # pragma: no cover  (compiled)
     """R_IS (3, 3) minimising sum |obs_i - R_IS^T ref_i|^2, equal weights (SVD, Markley 1988).
 
-    B = sum obs_i ref_i^T = U S V^T, A = U diag(1, 1, det U det V) V^T (I -> S), R_IS = A^T; the same
-    solution as :class:`startrack.attitude.SvdWahba` without its validation and covariance (used for
-    every fit inside the identification).
+    B = sum obs_i ref_i^T = U S V^T and A = U diag(1, 1, det U det V) V^T (I -> S), R_IS = A^T: the
+    solution of :class:`startrack.attitude.SvdWahba` (used for every fit inside the identification).
+    The SVD of the 3x3 B comes from the symmetric eigenproblem B^T B = V S^2 V^T (Jacobi sweeps):
+    u_i = B v_i / s_i for the two largest s_i, and v_3 = v_1 x v_2, u_3 = u_1 x u_2, which is exactly
+    the determinant correction of Markley's formula.  Needs two non-parallel stars.
     """
-    U, _, Vt = np.linalg.svd(obs_S.T @ ref_I)
-    if np.linalg.det(U) * np.linalg.det(Vt) < 0.0:
-        U[:, 2] = -U[:, 2]
-    return (U @ Vt).T
+    B = np.zeros((3, 3))
+    for n in range(obs_S.shape[0]):
+        for r in range(3):
+            for c in range(3):
+                B[r, c] += obs_S[n, r] * ref_I[n, c]
+    BtB = np.zeros((3, 3))
+    for r in range(3):
+        for c in range(3):
+            BtB[r, c] = B[0, r] * B[0, c] + B[1, r] * B[1, c] + B[2, r] * B[2, c]
+    eigenvalues, V = _symmetric_eigen(BtB)
+    order = np.argsort(-eigenvalues)
+    v1 = V[:, order[0]].copy()
+    v2 = _unit(V[:, order[1]] - _dot(V[:, order[1]], v1) * v1)
+    v3 = _cross(v1, v2)
+    u1 = _unit(_apply(B, v1))
+    u2 = _apply(B, v2)
+    u2 = _unit(u2 - _dot(u2, u1) * u1)
+    u3 = _cross(u1, u2)
+    R_IS = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            R_IS[r, c] = v1[r] * u1[c] + v2[r] * u2[c] + v3[r] * u3[c]  # (U V^T)^T = V U^T
+    return R_IS
 
 
 def binomial_tail(n: int, k: int, p: float) -> float:
@@ -128,7 +197,10 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     :class:`startrack.camera.Camera`.
     """
     focal, cx, cy, width, height, k1, k2, circular = camera_params
-    v_S = stars_I @ R_IS
+    v_S = np.empty_like(stars_I)
+    for s in range(stars_I.shape[0]):
+        for c in range(3):
+            v_S[s, c] = stars_I[s, 0] * R_IS[0, c] + stars_I[s, 1] * R_IS[1, c] + stars_I[s, 2] * R_IS[2, c]
     keep = np.empty(v_S.shape[0], np.int64)
     count = 0
     radius = width / 2.0 + margin_px
@@ -172,9 +244,12 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
     cos_gate = np.cos(pass_gates[-1])
     keep = np.empty(obs_index.size, np.bool_)
     for m in range(obs_index.size):
-        p = stars_I[star_index[m]] @ R_IS
-        o = obs_S[obs_index[m]]
-        keep[m] = p[0] * o[0] + p[1] * o[1] + p[2] * o[2] >= cos_gate
+        star, obs = star_index[m], obs_index[m]
+        cosine = 0.0
+        for c in range(3):
+            cosine += (stars_I[star, 0] * R_IS[0, c] + stars_I[star, 1] * R_IS[1, c]
+                       + stars_I[star, 2] * R_IS[2, c]) * obs_S[obs, c]
+        keep[m] = cosine >= cos_gate
     if not keep.all():
         obs_index, star_index = obs_index[keep], star_index[keep]
         if obs_index.size < 3:
@@ -206,7 +281,7 @@ def _field_solid_angle(camera, blocks: int = 128) -> float:
 class FieldStars:
     """The stars a frame can show (every star to the sensor's magnitude limit), indexed by sky cell.
 
-    Cells are the sub-catalogs' base points of the navigation catalog: cell ``b`` lists the stars
+    ``vectors`` (N, 3) ICRS unit vectors, ``hip``, ``v_mag``.  Cells are the sub-catalogs' base points of the navigation catalog: cell ``b`` lists the stars
     within the field radius (boresight to image corner) plus ``s_max`` (the largest base-point
     spacing, which bounds the distance from a boresight to the base point eq. 7-8 assigns to it) of
     base point ``b``; a boresight's cell is its eq. 7-8 address.
@@ -231,9 +306,16 @@ class FieldStars:
                                        camera.k1, camera.k2, float(camera.circular_fov)])
 
     @classmethod
-    def from_star_catalog(cls, catalog, camera, stars, mag_limit: float):
-        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) with V <= mag_limit."""
-        keep = stars.v_mag <= mag_limit
+    def from_star_catalog(cls, catalog, camera, stars, mag_limit: float, resolution_px: float = 3.0):
+        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) with V <= mag_limit.
+
+        Stars closer than ``resolution_px`` [px] to another such star are left out: their images merge
+        into one centroid that matches neither, and a match to either would be a guess.
+        """
+        keep = np.flatnonzero(stars.v_mag <= mag_limit)
+        vectors = stars.vectors[keep]
+        close = cKDTree(vectors).query_pairs(float(chord(resolution_px / camera.focal_px)), output_type="ndarray")
+        keep = np.delete(keep, np.unique(close))
         return cls(catalog, camera, stars.vectors[keep], stars.hip[keep], stars.v_mag[keep])
 
     def __len__(self):

@@ -62,6 +62,7 @@ def campaign_dir(tmp_path_factory, catalog):
 
 def test_run_report_has_sections_and_key_numbers(run_dir, tmp_path):
     pdf = write_report(run_dir, tmp_path / "run.pdf")
+    assert write_report(run_dir, tmp_path / "again.pdf").read_bytes() == pdf.read_bytes()  # reproducible
     text, pages = pdf_text(pdf)
     summary = json.loads((run_dir / "summary.json").read_text())
     for heading in ("Simulation run report: demo", "Key results", "Scenario parameters", "Attitude estimation error",
@@ -121,7 +122,7 @@ def test_run_report_with_image_chain_quantities(run_dir, tmp_path):
         assert heading in text
     assert "Not logged in this run" not in text
     distinct = np.unique(series["subcatalog_index"]).size
-    assert f"n_d = 53 declination divisions" in text
+    assert "n_d = 53 declination divisions" in text
     assert f"used {distinct} distinct sub-catalogs" in text
     assert "The sensor changed mode 4 times" in text
     assert f"tracking {np.count_nonzero(series['mode'] == 2)}" in text  # mode table row: name, frames
@@ -146,7 +147,7 @@ def test_campaign_report_has_sections_and_statistics(campaign_dir, tmp_path):
         assert heading in text
     summaries = [json.loads(p.read_text()) for p in sorted(campaign_dir.glob("runs/run_*/summary.json"))]
     cross = [s["cross_boresight_rms_arcsec"] for s in summaries]
-    assert f"3 finished runs, 1 failed, 4 requested" in text
+    assert "3 finished runs, 1 failed, 4 requested" in text
     assert f"cross-boresight RMS error is {np.mean(cross):.2f} arcsec on average" in text
     assert f"worst {max(cross):.2f} arcsec" in text
     lo, hi = chi2.ppf([0.025, 0.975], 18) / 3  # average of 3 runs of 6 dof
@@ -184,6 +185,17 @@ def test_filter_sigma_envelope_averages_the_covariance_not_the_sigma():
     env = statistics.envelopes(fake_campaign(np.ones((2, 5)), P))
     assert env.final_sigma_filter == pytest.approx(np.full(3, np.sqrt(5.0)))
     assert env.sigma3_filter[0] == pytest.approx(np.full(3, 3 * np.sqrt(5.0)))
+
+
+def test_identification_success_pools_frames_per_mode():
+    mode = np.array([0, 0, 2, 2, 2, 3])
+    runs = [RunData(Path(f"run_{k}"), {"modes": ["full-sky", "sub-catalog", "tracking", "outage"]},
+                    {"t": np.arange(6.0), "mode": mode, "n_identified": np.array([0, 3, 5, 1, 2, 0]) + k})
+            for k in range(2)]
+    rows, criterion = statistics.identification_success(SimpleNamespace(runs=runs, summary=None))
+    assert criterion == "frames with at least 2 identified stars"
+    pooled = [(r.name, r.identified, r.frames) for r in rows]
+    assert pooled == [("full-sky", 2, 4), ("tracking", 5, 6), ("outage", 0, 2)]
 
 
 def test_cli_report_and_run_with_report(run_dir, tmp_path, capsys):

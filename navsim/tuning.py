@@ -1,0 +1,108 @@
+"""Filter tuning: scale Q and R until the filter is consistent over a batch of seeded runs.
+
+Consistency means the time-averaged NEES of attitude and bias is at its expected value (its
+dof, 6) and the NIS per degree of freedom is 1 (Bar-Shalom, Li & Kirubarajan, *Estimation with
+Applications to Tracking and Navigation*, §5.4). With common random numbers (the same seeds at
+every evaluation) the two scale factors are fitted together by minimising
+
+    J(q, r) = ln²(NEES/dof) + ln²(NIS/dof)
+
+over (ln q, ln r) with Nelder-Mead (the statistics are smooth in the scales but their coupling is
+strong: a smaller R lowers the NIS and raises the NEES), stopping as soon as both statistics are
+within the tolerance of 1.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize
+
+from navsim.simulation import NEES_DOF, run_batch, resolve_scenario
+
+
+@dataclass
+class TuneStep:
+    """Statistics of one iteration's batch with the scales it used."""
+
+    process_noise_scale: float
+    measurement_noise_scale: float
+    nees_per_dof: float
+    nis_per_dof: float
+    cross_boresight_rms_arcsec: float
+    roll_rms_arcsec: float
+
+
+@dataclass
+class TuneResult:
+    """The iterations (first = the scenario as given) and the fitted scale factors."""
+
+    steps: list = field(default_factory=list)
+
+    @property
+    def process_noise_scale(self):
+        return self.steps[-1].process_noise_scale
+
+    @property
+    def measurement_noise_scale(self):
+        return self.steps[-1].measurement_noise_scale
+
+    def as_dict(self):
+        return {"process_noise_scale": self.process_noise_scale,
+                "measurement_noise_scale": self.measurement_noise_scale,
+                "steps": [vars(step) for step in self.steps]}
+
+
+def batch_statistics(results, settle_s):
+    """(NEES per dof, NIS per dof, mean cross-boresight RMS, mean roll RMS) over a batch."""
+    nees, nis, dof = [], 0.0, 0
+    for result in results:
+        steady = result.series["t"] >= settle_s
+        nees.append(result.series["nees"][steady])
+        accepted = np.isfinite(result.series["nis"]) & steady
+        nis += float(np.sum(result.series["nis"][accepted]))
+        dof += int(np.sum(result.series["nis_dof"][accepted]))
+    return (
+        float(np.mean(np.concatenate(nees))) / NEES_DOF,
+        nis / max(dof, 1),
+        float(np.mean([r.summary["cross_boresight_rms_arcsec"] for r in results])),
+        float(np.mean([r.summary["roll_rms_arcsec"] for r in results])),
+    )
+
+
+def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0.05, threads=1):
+    """Fit ``filter.process_noise_scale`` and ``filter.measurement_noise_scale`` (module docstring).
+
+    Stops when both NEES/dof and NIS/dof are within ``tolerance`` of 1 or after ``evaluations``
+    batches. Returns a :class:`TuneResult`: its first step is the scenario as given, its last the
+    best scales found.
+    """
+    scenario = resolve_scenario(scenario, overrides)
+    base_seed = scenario["seed"] if seed is None else int(seed)
+    seeds = [base_seed + k for k in range(runs)]
+    q_scale = scenario["filter"]["process_noise_scale"]
+    r_scale = scenario["filter"]["measurement_noise_scale"]
+    outcome = TuneResult()
+
+    def evaluate(log_scales):
+        q_scale, r_scale = (float(v) for v in np.exp(log_scales))
+        results = run_batch(scenario, seeds, overrides={"filter.process_noise_scale": q_scale,
+                                                        "filter.measurement_noise_scale": r_scale}, threads=threads)
+        nees, nis, cross, roll = batch_statistics(results, scenario["settle_s"])
+        outcome.steps.append(TuneStep(q_scale, r_scale, nees, nis, cross, roll))
+        if abs(nees - 1.0) < tolerance and abs(nis - 1.0) < tolerance:
+            raise _Converged
+        return np.log(nees) ** 2 + np.log(nis) ** 2
+
+    start = np.log([scenario["filter"]["process_noise_scale"], scenario["filter"]["measurement_noise_scale"]])
+    try:
+        minimize(evaluate, start, method="Nelder-Mead",
+                 options={"maxfev": max(evaluations, 1), "initial_simplex": start + np.array([[0, 0], [0.7, 0], [0, 0.3]])})
+    except _Converged:
+        pass
+    best = min(outcome.steps, key=lambda step: np.log(step.nees_per_dof) ** 2 + np.log(step.nis_per_dof) ** 2)
+    outcome.steps.append(best) if best is not outcome.steps[-1] else None
+    return outcome
+
+
+class _Converged(Exception):
+    """Both statistics are within the tolerance: stop the search."""
