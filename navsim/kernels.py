@@ -491,12 +491,13 @@ def rigid_body_rk4(q0, omega0, J, torques, dt):
 
 @njit
 def run_filter(q, b, s, q_BS, P, omega, ratio, dt, arw, rrw, sf_rw, q_scale, sf_start, mis_start,
-               fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, gate):
+               fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, gate, available):
     """The vector-fidelity filter loop of one run, compiled: for each frame f, ``ratio`` gyro
     samples of ``omega`` (M, 3) propagate the filter (:func:`predict`), then the frame's
     measurements update it — an attitude fix ``q_meas[f]`` with covariance ``R_S`` when
     ``fix_mode``, else the stars ``offsets[f]:offsets[f+1]`` of ``ref_I``/``obs_S``/``variance``
-    (:func:`attitude_update`, :func:`stars_update`) — all gated at ``gate``.
+    (:func:`attitude_update`, :func:`stars_update`) — all gated at ``gate``; frames whose
+    ``available`` is False (outage, dropped) only propagate.
 
     Returns per frame: q (F, 4), b (F, 3), P (F, n, n), measurements, accepted, NIS of the
     accepted, its degrees of freedom, and the RMS of the accepted innovations [rad].
@@ -513,7 +514,9 @@ def run_filter(q, b, s, q_BS, P, omega, ratio, dt, arw, rrw, sf_rw, q_scale, sf_
     innov_log = np.full(n_frames, np.nan)
     for f in range(n_frames):
         q, P = predict(q, P, b, s, omega[f * ratio : (f + 1) * ratio], dt, arw, rrw, sf_rw, q_scale, sf_start)
-        if fix_mode:
+        if not available[f]:
+            pass
+        elif fix_mode:
             q, b, s, q_BS, P, z, nis, ok = attitude_update(q, b, s, q_BS, P, q_meas[f], R_S, gate, sf_start, mis_start)
             n_meas[f] = 1
             if ok:

@@ -54,4 +54,7 @@ def write_run(directory, result, max_frames=None):
         stride = -(-frames // max_frames)
         series = {k: (v[stride - 1 :: stride] if v.shape[:1] == (frames,) else v) for k, v in series.items()}
     write_npz(directory / "timeseries.npz", series)
+    if result.sample_frame is not None:
+        np.save(directory / "frame.npy", result.sample_frame["image"], allow_pickle=False)
+        write_json(directory / "frame_detections.json", result.sample_frame["detections"])
     return directory

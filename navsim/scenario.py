@@ -85,7 +85,9 @@ SCHEMA = Table(
         ),
         "star_sensor": Table(
             {
-                "fidelity": Value("str", default="vector", choices=("vector",)),
+                "fidelity": Value("str", default="vector", choices=("vector", "image"),
+                                  doc="vector: noisy star vectors or fixes; image: rendered frames through "
+                                      "detection, identification and (dim stars) stacking"),
                 "measurement": Value("str", default="stars", choices=("stars", "attitude")),
                 "rate_hz": Value("float", exclusive_minimum=0.0),
                 "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
@@ -100,6 +102,51 @@ SCHEMA = Table(
                                              doc="nominal R_BS (sensor to body) as a rotation vector"),
                 "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0],
                                              doc="true, unknown mounting error (rotation vector in S)"),
+                "image": Table(
+                    {
+                        "width_px": Value("int", default=1024, minimum=16, maximum=8192),
+                        "height_px": Value("int", default=1024, minimum=16, maximum=8192),
+                        "field": Value("str", default="circular", choices=("circular", "rectangular"),
+                                       doc="circular: the circle of diameter fov_deg inscribed in the width"),
+                        "psf_sigma_px": Value("float", default=0.671, exclusive_minimum=0.0, maximum=10.0),
+                        "exposure_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=10.0),
+                        "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0),
+                        "read_noise_e": Value("float", default=20.0, minimum=0.0),
+                        "render_mag_limit": Value("float", default=7.0, minimum=-2.0, maximum=12.0,
+                                                  doc="faintest star drawn into the frames"),
+                        "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0,
+                                                  doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
+                        "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0,
+                                                   doc="centroid error assumed by identification and filter"),
+                        "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
+                                            doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
+                        "catalog_max_pointing_error_deg": Value("float", default=2.0, exclusive_minimum=0.0,
+                                                                doc="max(δ) of eq. 6 of 000"),
+                        "tracking_window_px": Value("int", default=5, minimum=2, maximum=50,
+                                                    doc="half-width of the readout windows while tracking"),
+                        "max_identified_stars": Value("int", default=12, minimum=3),
+                        "dim_star_stacking": Value("bool", default=True,
+                                                   doc="stack the predicted dim star over 4 frames when < 3 stars"),
+                    },
+                    optional=True,
+                ),
+            }
+        ),
+        "faults": Table(
+            {
+                "outages": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
+                                               "end_s": Value("float", minimum=0.0),
+                                               "reason": Value("str", default="Sun in the field")})),
+                "attitude_jumps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
+                                                      "angle_deg": Value("float", exclusive_minimum=0.0, maximum=180.0)}),
+                                               doc="the filter's attitude is knocked off by this angle "
+                                                   "(tracking loss); the sensor must re-acquire"),
+                "false_star_storms": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
+                                                        "end_s": Value("float", minimum=0.0),
+                                                        "count": Value("int", minimum=1, maximum=1000)})),
+                "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
+                                                       "step_deg_per_h": Value("vector")})),
+                "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
             }
         ),
         "filter": Table(
@@ -205,6 +252,20 @@ def validate(data, source="<scenario>"):
                 f"{source}: truth.rate_segments.segments: cover {covered:g} s, "
                 f"less than duration_s = {checked['duration_s']:g} s"
             )
+    sensor = checked["star_sensor"]
+    if sensor["fidelity"] == "image":
+        if sensor["measurement"] != "stars":
+            raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
+        if "image" not in sensor:
+            sensor["image"] = SCHEMA.entries["star_sensor"].entries["image"].check("star_sensor.image", {})
+    if sensor["fidelity"] == "vector":
+        for kind in ("attitude_jumps", "false_star_storms"):
+            if checked["faults"][kind]:
+                raise InputError(f"{source}: faults.{kind}: needs star_sensor.fidelity = 'image' (it acts on frames)")
+    for kind in ("outages", "false_star_storms"):
+        for k, interval in enumerate(checked["faults"][kind]):
+            if interval["end_s"] <= interval["start_s"]:
+                raise InputError(f"{source}: faults.{kind}[{k}]: end_s must be after start_s")
     if checked["settle_s"] is None:
         checked["settle_s"] = 0.1 * checked["duration_s"]
     if checked["settle_s"] >= checked["duration_s"]:

@@ -17,7 +17,7 @@ REQUIRED = object()
 class Value:
     """A scalar or fixed-length list value.
 
-    ``kind``: 'float', 'int', 'bool', 'str', 'vector' (list of floats of length ``size``),
+    ``kind``: 'float', 'int', 'bool', 'str', 'list' (floats, any length), 'vector' (list of floats of length ``size``),
     'matrix' (size x size floats) or 'quaternion' (4 floats, non-zero norm).
     """
 
@@ -52,6 +52,12 @@ class Value:
                 raise InputError(f"{where}: must be a string, got {value!r}")
             if self.choices and value not in self.choices:
                 raise InputError(f"{where}: must be one of {', '.join(self.choices)}; got {value!r}")
+        elif self.kind == "list":
+            if not isinstance(value, list):
+                raise InputError(f"{where}: must be a list of numbers, got {value!r}")
+            value = _numbers(where, value, len(value))
+            for v in value:
+                self._check_range(where, v)
         elif self.kind in ("vector", "quaternion"):
             size = 4 if self.kind == "quaternion" else self.size
             value = _numbers(where, value, size)

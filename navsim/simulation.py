@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
-from navsim import build, kernels
+from navsim import build, faults, kernels
+from navsim.closed_loop import MODES, ImageSensor, mode_statistics, run_image_loop
 from navsim import quaternion as quat
 from navsim import units
 from navsim.scenario import Scenario, load_scenario, scenario_from_dict
@@ -27,11 +28,13 @@ NEES_DOF = 6
 @dataclass(frozen=True)
 class RunResult:
     """``summary``: JSON-ready metrics; ``series``: arrays logged at every star-sensor frame;
-    ``scenario``: the validated scenario (units in key names) the run used."""
+    ``scenario``: the validated scenario (units in key names) the run used; ``sample_frame``: one
+    rendered frame with its detections and identifications (image fidelity)."""
 
     summary: dict
     series: dict
     scenario: dict
+    sample_frame: dict | None = None
 
 
 def resolve_scenario(scenario, overrides=()):
@@ -60,6 +63,8 @@ class Prepared:
     gyro: object
     sensor: object
     R_BS: np.ndarray
+    q_BS_true: np.ndarray
+    image_sensor: object = None
 
 
 def prepare(scenario, overrides=(), star_catalog=None):
@@ -75,7 +80,8 @@ def prepare(scenario, overrides=(), star_catalog=None):
     q_truth, _ = build.truth_profile(scenario).simulate(t_truth, q0)
     if scenario["star_sensor"]["measurement"] == "stars" and star_catalog is None:
         star_catalog = load_star_catalog(epoch=scenario["epoch_jyear"])
-    q_BS, _ = build.mounting(scenario)
+    q_BS, q_BS_true = build.mounting(scenario)
+    image = scenario["star_sensor"]["fidelity"] == "image"
     return Prepared(
         scenario=scenario,
         t_gyro=np.arange(n_gyro + 1) * dt,
@@ -85,8 +91,10 @@ def prepare(scenario, overrides=(), star_catalog=None):
         dt=dt,
         n_frames=n_gyro // ratio,
         gyro=build.gyro_model(scenario),
-        sensor=build.star_sensor(scenario, star_catalog),
+        sensor=None if image else build.star_sensor(scenario, star_catalog),
         R_BS=quat.to_matrix(q_BS),
+        q_BS_true=q_BS_true,
+        image_sensor=ImageSensor.build(scenario, star_catalog) if image else None,
     )
 
 
@@ -97,21 +105,34 @@ def simulate(prepared, seed):
     scenario = p.scenario
     gyro_ss, sensor_ss, init_ss = np.random.SeedSequence(seed).spawn(3)
     record = p.gyro.measure(p.omega_mean, gyro_ss)
+    omega_measured, bias_true = faults.apply_bias_steps(record.omega, record.bias, p.t_gyro[1:],
+                                                        scenario["faults"]["gyro_bias_steps"])
     P0 = build.initial_covariance(scenario, p.gyro)
     dtheta0 = np.sqrt(np.diag(P0)[0:3]) * np.random.default_rng(init_ss).standard_normal(3)
     filt = build.attitude_filter(scenario, p.gyro, quat.multiply(p.q_true[0], quat.from_rotation_vector(dtheta0)), P0)
     frame_k = np.arange(1, p.n_frames + 1) * p.ratio  # gyro sample index of each frame
-    measurements = p.sensor.observe_frames(p.q_true[frame_k], np.random.default_rng(sensor_ss))
-    log = {"t": p.t_gyro[frame_k], "q_true": p.q_true[frame_k], "bias_true": record.bias[frame_k - 1]}
-    meas_scale = scenario["filter"]["measurement_noise_scale"] ** 2
-    log.update(run_vector_filter(filt, record.omega[: p.n_frames * p.ratio], p.ratio, p.dt, p.sensor, measurements, meas_scale))
+    t_frames = p.t_gyro[frame_k]
+    log = {"t": t_frames, "q_true": p.q_true[frame_k], "bias_true": bias_true[frame_k - 1]}
+    extras = {}
+    if p.image_sensor is None:
+        measurements = p.sensor.observe_frames(p.q_true[frame_k], np.random.default_rng(sensor_ss))
+        meas_scale = scenario["filter"]["measurement_noise_scale"] ** 2
+        available = faults.frames_available(t_frames, scenario["faults"], p.ratio * p.dt)
+        log.update(run_vector_filter(filt, omega_measured[: p.n_frames * p.ratio], p.ratio, p.dt, p.sensor,
+                                     measurements, meas_scale, available))
+    else:
+        image_log, extras = run_image_loop(p, filt, omega_measured, frame_k, p.omega_mean[frame_k - 1], sensor_ss)
+        log.update(image_log)
     log["attitude_error"] = quat.attitude_error(log["q_est"], log["q_true"])
     log["nees"] = nees(log)
     summary = summarize(scenario, seed, log, p.R_BS)
+    if p.image_sensor is not None:
+        summary["identification"] = mode_statistics(log, extras["transitions"])
+        summary["modes"] = list(MODES)
     summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     series = {key: value for key, value in log.items() if key != "P"}
     series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()
-    return RunResult(summary=summary, series=series, scenario=scenario.data)
+    return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=extras.get("sample_frame"))
 
 
 def run(scenario, seed=None, overrides=(), star_catalog=None):
@@ -138,13 +159,14 @@ def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
         return list(pool.map(lambda seed: simulate(prepared, int(seed)), seeds))
 
 
-def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1.0):
+def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1.0, available=None):
     """Run ``filt`` over a whole record in compiled code (:func:`navsim.kernels.run_filter`).
 
     ``omega`` (F*ratio, 3) gyro samples; ``measurements``: the sensor's ``observe_frames`` output
     (q_IS per frame for an :class:`AttitudeFixSensor`, else :class:`StarFrames`); the sensor's
-    noise is scaled by ``meas_scale`` (variance factor) in the filter's R. Returns the per-frame
-    log arrays and leaves ``filt`` in its final state.
+    noise is scaled by ``meas_scale`` (variance factor) in the filter's R; frames not ``available``
+    (outages, dropped frames) only propagate. Returns the per-frame log arrays and leaves ``filt`` in
+    its final state.
     """
     fix_mode = isinstance(sensor, AttitudeFixSensor)
     n_frames = omega.shape[0] // ratio
@@ -157,10 +179,11 @@ def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1
         ref_I = np.ascontiguousarray(measurements.ref_I)
         obs_S = np.ascontiguousarray(measurements.obs_S)
         variance = np.full(len(ref_I), meas_scale * sensor.sigma**2)
+    available = np.ones(n_frames, dtype=np.bool_) if available is None else np.asarray(available, dtype=np.bool_)
     out = kernels.run_filter(
         filt.q, filt.b, filt.s, filt.q_BS, filt.P, np.ascontiguousarray(omega), ratio, dt,
         filt.arw, filt.rrw, filt.scale_factor_rw, filt.process_noise_scale, filt.sf_start, filt.mis_start,
-        fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, filt.gate[3 if fix_mode else 2],
+        fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, filt.gate[3 if fix_mode else 2], available,
     )
     names = ("q_est", "bias_est", "P", "n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms")
     log = dict(zip(names, out))

@@ -122,31 +122,38 @@ class StarIdentifier:
             "lost_in_space": LostInSpace(catalog, matcher),
         }
         self.strategies = [available[m] for m in METHODS if m in methods]
+        self._image_max = np.array([camera.width - 0.5, camera.height - 0.5])
 
     # ------------------------------------------------------------------ public calls
     def solve(self, uv, flux=None, prior: Prior | None = None) -> IdentificationResult:
         """Identify centroids ``uv`` (n, 2) [px] (``flux`` (n,) optional: brightest first; else given order)."""
         start = time.perf_counter()
-        uv = np.asarray(uv, dtype=float) if _numeric(uv) else None
+        uv = _float_array(uv)
         if uv is None or uv.ndim != 2 or uv.shape[1] != 2:
             return _failed("error", "centroids must be an array of shape (n, 2) of numbers", start)
-        if not np.all(np.isfinite(uv)):
+        if not np.isfinite(uv).all():
             return _failed("error", "a centroid coordinate is NaN or infinite", start)
-        cam = self.camera
-        inside = (uv[:, 0] >= -0.5) & (uv[:, 0] <= cam.width - 0.5) & (uv[:, 1] >= -0.5) & (uv[:, 1] <= cam.height - 0.5)
-        if uv.shape[0] and not inside.any():
-            return _failed("error", f"all {uv.shape[0]} centroids lie outside the {cam.width} x {cam.height} px sensor", start)
-        index = np.flatnonzero(inside)
+        inside = ((uv >= -0.5) & (uv <= self._image_max)).all(axis=1)
+        index = None if inside.all() else np.flatnonzero(inside)
+        if index is not None and index.size == 0 and uv.shape[0]:
+            cam = self.camera
+            return _failed("error", f"all {uv.shape[0]} centroids lie outside the {cam.width} x {cam.height} px sensor",
+                           start)
         flux = self._checked_flux(flux, uv.shape[0])
         if isinstance(flux, str):
             return _failed("error", flux, start)
-        obs_S = cam.unproject(uv[index]) if index.size else np.zeros((0, 3))
-        return self._solve(obs_S, index, None if flux is None else flux[index], prior, start)
+        if index is None:
+            index = np.arange(uv.shape[0])
+        else:
+            uv = uv[index]
+            flux = None if flux is None else flux[index]
+        obs_S = self.camera.unproject(uv) if uv.shape[0] else np.zeros((0, 3))
+        return self._solve(obs_S, index, flux, prior, start)
 
     def solve_vectors(self, obs_S, flux=None, prior: Prior | None = None) -> IdentificationResult:
         """Identify directions ``obs_S`` (n, 3) in the sensor frame (normalised here), brightest first unless ``flux``."""
         start = time.perf_counter()
-        obs = np.asarray(obs_S, dtype=float) if _numeric(obs_S) else None
+        obs = _float_array(obs_S)
         if obs is None or obs.ndim != 2 or obs.shape[1] != 3:
             return _failed("error", "directions must be an array of shape (n, 3) of numbers", start)
         norms = np.linalg.norm(obs, axis=1)
@@ -162,7 +169,7 @@ class StarIdentifier:
     def _checked_flux(flux, n):
         if flux is None:
             return None
-        flux = np.asarray(flux, dtype=float) if _numeric(flux) else None
+        flux = _float_array(flux)
         if flux is None or flux.shape != (n,):
             return f"flux must be one number per centroid ({n})"
         if not np.all(np.isfinite(flux)):
@@ -205,12 +212,15 @@ class StarIdentifier:
 _NO_STARS = np.zeros(0, np.int64)
 
 
-def _numeric(value) -> bool:
+def _float_array(value):
+    """``value`` as a float array, or None when it is not numbers (text, ragged lists, objects)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        return value.astype(float, copy=False)
     try:
         array = np.asarray(value)
     except (ValueError, TypeError):
-        return False
-    return array.dtype.kind in "biuf"
+        return None
+    return array.astype(float) if array.dtype.kind in "biuf" else None
 
 
 def _failed(status, reason, start):

@@ -15,10 +15,12 @@ For the brightest centroids of a frame (brightest first):
    consistent.  Stars outside every group (false stars, stars missing from the guide catalog) never
    enter a hypothesis; missing stars only remove triangles, they cannot create a wrong one.
 
-The search (a compiled kernel; the per-frame hot loop) takes anchors i brightest first, then j, then
-k, so the brightest triangles come first; it stops after a few groups.  The groups found are then
-ordered by the sum of their brightness ranks and, among equals, best conditioned first (smallest sum
-of the six gates, which grow for short and badly measured pairs); groups of four before triangles.
+The search (a compiled kernel; the per-frame hot loop) runs anchor by anchor, brightest first (then j,
+then k), and stops after a few groups per anchor, which are verified before the next anchor is
+searched: a false star or a star missing from the guide catalog as anchor costs one short pass.  The
+groups of an anchor are ordered by the sum of their brightness ranks and, among equals, best
+conditioned first (smallest sum of the six gates, which grow for short and badly measured pairs);
+triangles are verified only when no group was accepted.
 """
 
 from __future__ import annotations
@@ -96,16 +98,6 @@ class Hypotheses:
     triangles_cat: np.ndarray
     n_pair_matches: int
 
-    def ordered(self):
-        """(observed indices, guide indices) of every hypothesis, groups of four first, duplicates dropped."""
-        seen = set()
-        for obs_rows, cat_rows in ((self.groups_obs, self.groups_cat), (self.triangles_obs, self.triangles_cat)):
-            for obs, cat in zip(obs_rows, cat_rows):
-                key = frozenset(zip(obs.tolist(), cat.tolist()))
-                if key not in seen:
-                    seen.add(key)
-                    yield obs, cat
-
 
 @njit
 def _inside(guide, x, y, cos_low, cos_high):
@@ -122,17 +114,35 @@ def _triple(p, q, r):
 
 
 @njit
-def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, guide, max_groups,
-                  max_triangles, head):  # pragma: no cover  (compiled)
-    """Triangles and four-star groups (module text); returns (groups (g, 8), triangles (t, 6), N_h).
+def _pair_candidates(beta, gate, theta, k, slope, intercept):  # pragma: no cover  (compiled)
+    """(lo, hi) (n, n) candidate ranges of every observed pair s < t, and N_h (oriented in-gate matches)."""
+    n = beta.shape[0]
+    lo = np.zeros((n, n), np.int64)
+    hi = np.zeros((n, n), np.int64)
+    n_matches = 0
+    for s in range(n):
+        for t in range(s + 1, n):
+            low, high = beta[s, t] - gate[s, t], beta[s, t] + gate[s, t]
+            lo[s, t], hi[s, t] = _pair_range(theta, k, slope, intercept, low, high)
+            for q in range(lo[s, t], hi[s, t]):
+                if low <= theta[q] <= high:
+                    n_matches += 1
+    return lo, hi, 2 * n_matches
 
-    For each anchor star i (brightest first) the catalog pairs matched to every observed pair (i, t)
-    are chained per (t, catalog star of i) in linked lists (with a bit mask per catalog star of the
-    partners t whose list is not empty; at most 63 stars), so that a triangle (i, j, k) is found by
-    following, for each catalog assignment (A, B) of (i, j), the list of (k, A) and testing the
-    distance (B, C) against the gate of (j, k) and the handedness; each triangle is extended to a group
-    by the lists of every other star r.  Stops after ``max_groups`` groups.  ``head`` (>= n, n_guide)
-    is a work array of -1 (the list heads), returned as found.
+
+@njit
+def _group_search(obs, beta, gate, lo, hi, theta, first, second, guide, anchor_start, anchor_stop, max_groups,
+                  max_triangles, head):  # pragma: no cover  (compiled)
+    """Triangles and four-star groups (module text) with anchors i in [anchor_start, anchor_stop).
+
+    Returns (groups (g, 8), triangles (t, 6)).  For each anchor star i (brightest first) the catalog
+    pairs matched to every observed pair (i, t) (candidate ranges ``lo``, ``hi``) are chained per
+    (t, catalog star of i) in linked lists (with a bit mask per catalog star of the partners t whose
+    list is not empty; at most 63 stars), so that a triangle (i, j, k) is found by following, for
+    each catalog assignment (A, B) of (i, j), the list of (k, A) and testing the distance (B, C)
+    against the gate of (j, k) and the handedness; each triangle is extended to a group by the lists
+    of every other star r.  Stops after ``max_groups`` groups.  ``head`` (>= n, n_guide) is a work
+    array of -1 (the list heads), returned as found.
     """
     n = obs.shape[0]
     n_guide = guide.shape[0]
@@ -140,15 +150,10 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
     high = beta + gate
     cos_high = np.cos(np.minimum(np.maximum(low, 0.0), np.pi))
     cos_low = np.cos(np.minimum(np.maximum(high, 0.0), np.pi))
-    lo = np.zeros((n, n), np.int64)
-    hi = np.zeros((n, n), np.int64)
     n_matches = 0
     for s in range(n):
         for t in range(s + 1, n):
-            lo[s, t], hi[s, t] = _pair_range(theta, k, slope, intercept, low[s, t], high[s, t])
-            for q in range(lo[s, t], hi[s, t]):
-                if low[s, t] <= theta[q] <= high[s, t]:
-                    n_matches += 1
+            n_matches += hi[s, t] - lo[s, t]
     groups = np.empty((max_groups, 8), np.int64)
     triangles = np.empty((max_triangles, 6), np.int64)
     n_groups = 0
@@ -159,7 +164,7 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
     entry_next = np.empty(capacity, np.int64)
     entry_partner = np.empty(capacity, np.int64)
     entry_anchor = np.empty(capacity, np.int64)
-    for i in range(n):
+    for i in range(anchor_start, anchor_stop):
         m = 0
         for t in range(n):
             if t == i:
@@ -243,27 +248,39 @@ def _group_search(obs, beta, gate, theta, first, second, k, slope, intercept, gu
             partners[entry_anchor[e]] = 0
         if done:
             break
-    return groups[:n_groups], triangles[:n_triangles], 2 * n_matches
+    return groups[:n_groups], triangles[:n_triangles]
 
 
-def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int = 4,
-           max_triangles: int = 8, workspace=None) -> Hypotheses:
+def pair_candidates(beta, gate, table: PairTable):
+    """(lo (n, n), hi (n, n), N_h): catalog-pair ranges of every observed pair (s < t) and the number of
+    oriented catalog pairs inside the gates (k-vector of eq. 5 for the full sky, a binary search else)."""
+    lo, hi, n_matches = _pair_candidates(np.ascontiguousarray(beta), np.ascontiguousarray(gate), table.theta,
+                                         table.k, table.slope, table.intercept)
+    return lo, hi, int(n_matches)
+
+
+def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int = 4, max_triangles: int = 8,
+           workspace=None, anchors=None, candidates=None) -> Hypotheses:
     """Triangles and four-star groups of the centroid directions ``obs_S`` (n, 3), brightest first.
 
     ``beta`` (n, n) observed angular distances and ``gate`` (n, n) their bounds e_ij [rad];
     ``table`` the catalog pairs to search; ``guide_vectors`` (n_g, 3) the guide stars in I.  The
     search stops after ``max_groups`` four-star groups; up to ``max_triangles`` triangles found on the
-    way are kept for frames without a group.  ``workspace``: an int64 array of -1 of shape
-    (>= n, n_g) reused between calls (left as found), allocated when None.
+    way are kept for frames without a group.  ``anchors`` (start, stop): the brightest star of the
+    groups searched (default: all); ``candidates``: :func:`pair_candidates` if already computed;
+    ``workspace``: an int64 array of -1 of shape (>= n, n_g) reused between calls (left as found).
     """
-    if workspace is None or workspace.shape[0] < len(obs_S):
-        workspace = np.full((len(obs_S), len(guide_vectors)), -1, np.int64)
-    groups, triangles, n_matches = _group_search(
-        np.ascontiguousarray(obs_S), np.ascontiguousarray(beta), np.ascontiguousarray(gate), table.theta, table.first, table.second, table.k, table.slope,
-        table.intercept, guide_vectors, max_groups, max_triangles, workspace)
+    n = len(obs_S)
+    if workspace is None or workspace.shape[0] < n:
+        workspace = np.full((n, len(guide_vectors)), -1, np.int64)
+    beta, gate = np.ascontiguousarray(beta), np.ascontiguousarray(gate)
+    lo, hi, n_matches = pair_candidates(beta, gate, table) if candidates is None else candidates
+    start, stop = (0, n) if anchors is None else anchors
+    groups, triangles = _group_search(np.ascontiguousarray(obs_S), beta, gate, lo, hi, table.theta, table.first,
+                                      table.second, guide_vectors, start, stop, max_groups, max_triangles, workspace)
     groups = groups[_ranked(groups[:, :4], gate)]
     triangles = triangles[_ranked(triangles[:, :3], gate)]
-    return Hypotheses(groups[:, :4], groups[:, 4:], triangles[:, :3], triangles[:, 3:], int(n_matches))
+    return Hypotheses(groups[:, :4], groups[:, 4:], triangles[:, :3], triangles[:, 3:], n_matches)
 
 
 def _ranked(stars, gate):
@@ -282,9 +299,8 @@ _PAIRS_OF = {3: np.triu_indices(3, 1), 4: np.triu_indices(4, 1)}
 class PatternMatcher:
     """Hypotheses from :func:`search` on a pair table, each verified until one is accepted.
 
-    The brightest ``pattern_stars`` centroids are searched first; if no hypothesis is accepted and
-    the frame has more, the search is repeated with twice as many (false stars or stars missing from
-    the guide catalog among the brightest).  Holds a work array: one matcher per thread.
+    The brightest ``pattern_stars`` centroids are searched first, anchor by anchor; if no hypothesis
+    is accepted the search is widened (:meth:`match`).  Holds a work array: one matcher per thread.
     """
 
     def __init__(self, catalog, field, pattern_stars: int, max_groups: int, max_triangles: int, threshold: float):
@@ -297,23 +313,55 @@ class PatternMatcher:
         self._workspace = np.full((2 * pattern_stars, len(self.guide_vectors)), -1, np.int64)
 
     def match(self, frame, table: PairTable):
-        """A :class:`startrack.identify.verify.Verified` for ``frame`` (:class:`FrameFeatures`) or None."""
+        """A :class:`startrack.identify.verify.Verified` for ``frame`` (:class:`FrameFeatures`) or None.
+
+        The first ``max_groups`` groups of a pass over all anchors are verified; if none is accepted,
+        anchor by anchor (brightest first) the groups of up to ``max_groups`` found with that anchor;
+        then the triangles collected on the way.  If nothing is accepted among the brightest
+        ``pattern_stars``, the same with twice as many stars.
+        """
         first = min(len(frame), self.pattern_stars)
-        sizes = (first,) if len(frame) <= first else (first, min(len(frame), 2 * first))
+        wide = min(len(frame), 2 * self.pattern_stars)
         tried = set()
-        for n in sizes:
-            hypotheses = search(frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n], table,
-                                self.guide_vectors, self.max_groups, self.max_triangles, self._workspace)
-            for obs_index, cat_index in hypotheses.ordered():
-                key = frozenset(zip(obs_index.tolist(), cat_index.tolist()))
-                if key in tried:
-                    continue
-                tried.add(key)
-                R_IS = wahba_svd(self.guide_vectors[cat_index], frame.obs_S[obs_index])
-                verified = verify(frame.obs_S, R_IS, self.field, frame.verify_gate,
-                                  hypotheses.n_pair_matches, self.threshold)
+        for n in (first, wide) if wide > first else (first,):
+            obs, beta, gate = frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n]
+            candidates = pair_candidates(beta, gate, table)
+            n_hypotheses = candidates[2]
+            # Fast path: the first groups over all anchors (one pass for most frames) ...
+            found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, self.max_triangles,
+                           self._workspace, None, candidates)
+            verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
+            if verified is not None:
+                return verified
+            triangles = list(zip(found.triangles_obs, found.triangles_cat))
+            if len(found.groups_obs) < self.max_groups:
+                anchors = ()  # the pass ran to its end: every group was tried
+            else:  # ... then anchor by anchor, so that false groups of one anchor cannot hide the rest
+                anchors = range(n - 2)
+            for anchor in anchors:
+                found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, self.max_triangles,
+                               self._workspace, (anchor, anchor + 1), candidates)
+                triangles.extend(zip(found.triangles_obs, found.triangles_cat))
+                verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
                 if verified is not None:
                     return verified
+            triangles.sort(key=lambda t: int(t[0].sum()))
+            verified = self._first_verified(frame, triangles[: 4 * self.max_triangles], n_hypotheses, tried)
+            if verified is not None:
+                return verified
+        return None
+
+    def _first_verified(self, frame, hypotheses, n_hypotheses, tried):
+        """The first hypothesis (observed indices, guide indices) not tried before that verifies, or None."""
+        for obs_index, cat_index in hypotheses:
+            key = frozenset(zip(obs_index.tolist(), cat_index.tolist()))
+            if key in tried:
+                continue
+            tried.add(key)
+            R_IS = wahba_svd(self.guide_vectors[cat_index], frame.obs_S[obs_index])
+            verified = verify(frame.obs_S, R_IS, self.field, frame.verify_gate, n_hypotheses, self.threshold)
+            if verified is not None:
+                return verified
         return None
 
 

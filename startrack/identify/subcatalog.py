@@ -13,6 +13,7 @@ tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000
 
 from __future__ import annotations
 
+import functools
 import math
 
 from startrack.identify.lost_in_space import PairTable, PatternMatcher
@@ -27,6 +28,11 @@ class SubCatalog:
         self.catalog = catalog
         self.matcher = matcher
         self.neighbours = bool(neighbours)
+        self._tables = functools.lru_cache(maxsize=64)(self._table)
+
+    def _table(self, b: int) -> PairTable:
+        """The pair table of sub-catalog ``b`` (cached: consecutive frames reuse the same few)."""
+        return PairTable.subset(self.catalog, self.catalog.sub_catalog_pairs(b))
 
     def cells(self, ra: float, dec: float) -> list[int]:
         """Sub-catalog indices to search for a predicted boresight (ra, dec) [rad], predicted one first."""
@@ -46,7 +52,7 @@ class SubCatalog:
         if not (math.isfinite(ra) and math.isfinite(dec)):
             return None
         for b in self.cells(ra, dec):
-            verified = self.matcher.match(frame, PairTable.subset(self.catalog, self.catalog.sub_catalog_pairs(b)))
+            verified = self.matcher.match(frame, self._tables(b))
             if verified is not None:
                 return verified
         return None

@@ -20,8 +20,8 @@ from startrack import address
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
-DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "demo.toml"
-SHORT = {"duration_s": 6.0}
+DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity
+SHORT = {"duration_s": 20.0}  # 40 frames at 2 Hz
 
 
 def pdf_text(path):
@@ -65,7 +65,7 @@ def test_run_report_has_sections_and_key_numbers(run_dir, tmp_path):
     assert write_report(run_dir, tmp_path / "again.pdf").read_bytes() == pdf.read_bytes()  # reproducible
     text, pages = pdf_text(pdf)
     summary = json.loads((run_dir / "summary.json").read_text())
-    for heading in ("Simulation run report: demo", "Key results", "Scenario parameters", "Attitude estimation error",
+    for heading in ("Simulation run report: paper000_high_dynamic", "Key results", "Scenario parameters", "Attitude estimation error",
                     "Gyro bias estimate", "Filter consistency", "Not logged in this run"):
         assert heading in text
     assert pages >= 3

@@ -30,7 +30,7 @@ def test_tune_recovers_the_arw_ratio_and_restores_consistency(base_scenario):
 
 
 def test_tune_command_prints_the_settings_to_use():
-    done = subprocess.run([sys.executable, "-m", "navsim.cli", "tune", "scenarios/demo.toml", "--runs", "2",
+    done = subprocess.run([sys.executable, "-m", "navsim.cli", "tune", "scenarios/paper000_high_dynamic.toml", "--runs", "2",
                            "--evaluations", "3", "--set", "duration_s=5"], cwd=ROOT, capture_output=True, text=True,
                           timeout=300)
     assert done.returncode == 0, done.stderr

@@ -1,0 +1,319 @@
+"""The image-fidelity closed loop of DESIGN.md: the star sensor runs inside the simulation.
+
+Per star-sensor frame:
+
+1. the filter propagates over the frame's gyro samples and predicts the attitude q̂_IS;
+2. the predicted boresight gives the sub-catalog address (eq. 7-8 of 000), tracked every frame;
+3. the frame is rendered from the true attitude (mounting R_BS with its true misalignment, smear from
+   the true body rate): windows around the predicted stars while tracking, the full frame otherwise;
+4. detection and centroids; identification with the prediction as prior — tracking first, then the
+   predicted sub-catalog with its 4 redundant neighbours, then full-sky lost-in-space
+   (:class:`startrack.identify.StarIdentifier`);
+5. with fewer than 3 stars identified while a prior exists, the detected stars are matched to their
+   predicted positions and the brightest undetected predicted star is stacked over the last 4 frames
+   (shifted-window superposition, eq. 13-18 of 004);
+6. one unit-vector measurement per identified star (the stacked dim star with its own, larger σ)
+   goes through the gated filter update; if a lost-in-space or sub-catalog fix disagrees with the
+   prediction beyond the gate (the filter lost track), the attitude is re-initialised from it.
+
+Faults (scenario ``[faults]``): outages, dropped frames, attitude jumps (the estimate is knocked off,
+as by an external disturbance), false-star storms and gyro bias steps. Every frame is logged: mode,
+stars detected / identified / stacked, identification time, address, innovations, estimate,
+covariance and truth; mode transitions are listed with their reasons.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim import quaternion as quat
+from startrack.camera import Camera
+from startrack.detection import detect, detect_windows
+from startrack.identify.identifier import Prior, StarIdentifier
+from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+from startrack.render import SensorModel, Windows, cosmic_ray, render_star_field
+from startrack.stacking import DimStarCache
+
+#: Frame modes, in the order of their integer codes in the time series.
+MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped")
+MODE_CODE = {name: code for code, name in enumerate(MODES)}
+
+#: σ of a stacked dim-star centroid relative to a single-frame centroid (integer shifts average the
+#: sub-pixel phases of the 4 frames: ~0.25 px per axis, 004's stacking experiment).
+STACKED_SIGMA_PX = 0.3
+
+
+@dataclass(frozen=True)
+class ImageSensor:
+    """Everything the image loop needs, built once per scenario (seed-free)."""
+
+    camera: Camera
+    model: SensorModel
+    identifier: StarIdentifier
+    stars_I: np.ndarray
+    stars_mag: np.ndarray
+    stars_hip: np.ndarray
+    detection_sigmas: float
+    window_half_px: int
+    max_identified: int
+    stacking: bool
+    mag_limit: float
+    centroid_sigma: float  # [rad]
+
+    @classmethod
+    def build(cls, scenario, star_catalog):
+        sensor = scenario["star_sensor"]
+        image = sensor["image"]
+        fov = np.radians(sensor["fov_deg"])
+        camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
+        model = SensorModel(psf_sigma_px=image["psf_sigma_px"], exposure_s=image["exposure_s"],
+                            zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"])
+        params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],
+                                         max_delta=np.radians(image["catalog_max_pointing_error_deg"]),
+                                         epoch=scenario["epoch_jyear"])
+        catalog = load_navigation_catalog(params, progress=False)
+        identifier = StarIdentifier(catalog, camera, centroid_sigma_px=image["centroid_sigma_px"],
+                                    max_stars=image["max_identified_stars"])
+        stars = star_catalog.brighter_than(image["render_mag_limit"])
+        return cls(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
+                   stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
+                   detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
+                   max_identified=image["max_identified_stars"], stacking=image["dim_star_stacking"],
+                   mag_limit=sensor["mag_limit"], centroid_sigma=image["centroid_sigma_px"] / camera.focal_px)
+
+    @property
+    def catalog(self):
+        return self.identifier.catalog
+
+
+def _in_intervals(t, intervals):
+    return any(iv["start_s"] <= t < iv["end_s"] for iv in intervals)
+
+
+def _match_predicted(uv, uv_predicted, gate_px):
+    """One-to-one nearest matches (detection index, predicted index) within ``gate_px``."""
+    if len(uv) == 0 or len(uv_predicted) == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    d = np.linalg.norm(uv[:, None, :] - uv_predicted[None, :, :], axis=2)
+    pairs = []
+    used_d, used_p = set(), set()
+    for flat in np.argsort(d, axis=None):
+        i, k = divmod(int(flat), d.shape[1])
+        if d[i, k] > gate_px:
+            break
+        if i not in used_d and k not in used_p:
+            pairs.append((i, k))
+            used_d.add(i)
+            used_p.add(k)
+    if not pairs:
+        return np.zeros(0, int), np.zeros(0, int)
+    det, pred = np.array(pairs).T
+    return det, pred
+
+
+def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
+    """Run the closed loop over all frames; ``seed`` a SeedSequence for rendering, jumps and
+    false stars. Returns the per-frame log and run-level extras (transitions, a sample frame)."""
+    scenario = p.scenario
+    faults = scenario["faults"]
+    sensor = p.image_sensor
+    camera, model = sensor.camera, sensor.model
+    n_frames, ratio, dt = p.n_frames, p.ratio, p.dt
+    q_BS = filt.q_BS.copy()
+    q_BS_true = p.q_BS_true
+    R_SB_true = quat.to_matrix(q_BS_true).T
+    dropped = np.asarray(faults["dropped_frames_s"])
+    jumps = sorted(faults["attitude_jumps"], key=lambda j: j["time_s"])
+    jump_rng, storm_rng, render_rng = (np.random.default_rng(s) for s in seed.spawn(3))
+    P0_attitude = filt.P[0:3, 0:3].copy()
+    n = filt.n
+    log = {
+        "q_est": np.empty((n_frames, 4)), "bias_est": np.empty((n_frames, 3)), "P": np.empty((n_frames, n, n)),
+        "n_measurements": np.zeros(n_frames, np.int32), "n_accepted": np.zeros(n_frames, np.int32),
+        "nis": np.full(n_frames, np.nan), "nis_dof": np.zeros(n_frames, np.int32),
+        "innovation_rms": np.full(n_frames, np.nan),
+        "mode": np.zeros(n_frames, np.int8), "n_detected": np.zeros(n_frames, np.int32),
+        "n_identified": np.zeros(n_frames, np.int32), "n_stacked": np.zeros(n_frames, np.int32),
+        "id_ms": np.full(n_frames, np.nan), "boresight_radec": np.empty((n_frames, 2)),
+        "subcatalog_index": np.zeros(n_frames, np.int32), "subcatalog_address": np.zeros((n_frames, 2), np.int32),
+        "frame_ms": np.zeros(n_frames),
+    }
+    transitions = []
+    tracking = False  # the previous frame was identified: read windows around predicted stars
+    cache = DimStarCache(half_width=2, depth=4)
+    sample = None
+    sample_at = n_frames // 2
+    jump_index = 0
+    previous_mode = None
+    for j in range(n_frames):
+        started = time.perf_counter()
+        k = frame_k[j]
+        t = k * dt
+        filt.predict(omega_measured[k - ratio : k], dt)
+        while jump_index < len(jumps) and jumps[jump_index]["time_s"] <= t:
+            axis = jump_rng.standard_normal(3)
+            axis /= np.linalg.norm(axis)
+            filt.q = quat.normalize(quat.multiply(filt.q, quat.from_rotation_vector(np.radians(jumps[jump_index]["angle_deg"]) * axis)))
+            tracking = False
+            cache.reset()
+            jump_index += 1
+        q_IS_pred = quat.multiply(filt.q, q_BS)
+        ra, dec = quat.boresight_radec(q_IS_pred)
+        log["boresight_radec"][j] = (ra, dec)
+        log["subcatalog_address"][j] = sensor.catalog.address(ra, dec)
+        log["subcatalog_index"][j] = sensor.catalog.sub_catalog_index(ra, dec)
+        mode, reason = None, ""
+        if _in_intervals(t, faults["outages"]):
+            mode = "outage"
+            reason = next(iv["reason"] for iv in faults["outages"] if iv["start_s"] <= t < iv["end_s"])
+        elif dropped.size and np.any(np.abs(dropped - t) < 0.5 * ratio * dt):
+            mode, reason = "dropped", "frame dropped"
+        if mode is not None:
+            tracking = False
+            cache.reset()
+        else:
+            q_IS_true = quat.multiply(p.q_true[k], q_BS_true)
+            omega_S = R_SB_true @ omega_true_frames[j]
+            uv_pred, visible = camera.project(q_IS_pred, sensor.stars_I)
+            predicted = np.flatnonzero(visible)
+            extra = ()
+            if _in_intervals(t, faults["false_star_storms"]):
+                count = next(iv["count"] for iv in faults["false_star_storms"] if iv["start_s"] <= t < iv["end_s"])
+                u0 = storm_rng.uniform(0, camera.width - 1, count)
+                v0 = storm_rng.uniform(0, camera.height - 1, count)
+                du, dv = storm_rng.normal(0, 3.0, (2, count))
+                extra = tuple(cosmic_ray(a, b, a + c, b + d, 4.0e4) for a, b, c, d in zip(u0, v0, du, dv))
+            full = not tracking or len(predicted) == 0 or j == sample_at  # one full frame for the report
+            windows = None if full else Windows.around(uv_pred[predicted], sensor.window_half_px, camera.height, camera.width)
+            frame = render_star_field(camera, model, q_IS_true, sensor.stars_I, sensor.stars_mag, render_rng,
+                                      omega_S=omega_S, windows=windows, extra_sources=extra)
+            b, sigma_n = model.background_dn, model.noise_dn
+            threshold = b + sensor.detection_sigmas * sigma_n
+            if full:
+                found = detect(frame.image, background=b, sigma_n=sigma_n, a=sensor.detection_sigmas,
+                               saturation_dn=model.saturation_dn)
+            else:
+                found = detect_windows(frame.image, windows.row0, windows.col0, b, sigma_n, a=sensor.detection_sigmas,
+                                       saturation_dn=model.saturation_dn)
+                found = _unique(found)
+            log["n_detected"][j] = len(found)
+            result = sensor.identifier.solve(found.uv, found.flux, prior=Prior(q_IS=q_IS_pred))
+            log["id_ms"][j] = result.solve_ms
+            ref_I, obs_S = np.zeros((0, 3)), np.zeros((0, 3))
+            sigma = np.zeros(0)
+            if result.ok:
+                mode = result.method
+                ref_I, obs_S = result.ref_I, result.obs_S
+                sigma = np.full(len(ref_I), sensor.centroid_sigma)
+                reason = f"{len(ref_I)} stars identified"
+            else:
+                reason = result.reason
+                if tracking:  # few stars: window-match them to their predictions
+                    det, pred = _match_predicted(found.uv, uv_pred[predicted], 3.0 * sensor.window_half_px / 2)
+                    if det.size:
+                        ref_I = sensor.stars_I[predicted[pred]]
+                        obs_S = camera.unproject(found.uv[det])
+                        sigma = np.full(len(ref_I), sensor.centroid_sigma)
+                        mode = "tracking"
+                        reason = f"{det.size} stars matched to their predictions"
+            log["n_identified"][j] = len(ref_I)
+            # dim-star pipeline cache (004): the brightest predicted star not detected
+            stacked = None
+            if sensor.stacking and tracking and len(predicted):
+                det_match, pred_match = _match_predicted(found.uv, uv_pred[predicted], 3.0)
+                undetected = np.setdiff1d(np.arange(len(predicted)), pred_match)
+                if undetected.size:
+                    candidate = predicted[undetected[np.argmin(sensor.stars_mag[predicted[undetected]])]]
+                    if full:
+                        cache.push(frame.image, uv_pred[candidate], star_id=int(candidate))
+                    else:
+                        cache.reset()
+                    if len(ref_I) < 3 and cache.full:
+                        stacked = cache.stack(b, sigma_n, a=sensor.detection_sigmas)
+                        if stacked.detected:
+                            ref_I = np.vstack([ref_I, sensor.stars_I[candidate]])
+                            obs_S = np.vstack([obs_S, camera.unproject(np.array([[stacked.u, stacked.v]]))])
+                            sigma = np.append(sigma, STACKED_SIGMA_PX / camera.focal_px)
+                            log["n_stacked"][j] = 1
+                            mode = "stacked"
+                            reason = f"{len(ref_I) - 1} stars and the stacked dim star HIP {sensor.stars_hip[candidate]}"
+            if len(ref_I):
+                update = filt.update_stars(ref_I, obs_S, sigma)
+                if update.n_accepted == 0 and mode in ("subcatalog", "lost_in_space") and result.ok:
+                    # the identification disagrees with the prediction: the filter lost track
+                    filt.q = quat.normalize(quat.multiply(result.q_IS, quat.conjugate(q_BS)))
+                    filt.P[0:3, :] = 0.0
+                    filt.P[:, 0:3] = 0.0
+                    filt.P[0:3, 0:3] = P0_attitude
+                    update = filt.update_stars(ref_I, obs_S, sigma)
+                    reason += "; attitude re-initialised from the fix"
+                _log_update(log, j, update)
+                tracking = update.n_accepted >= 2 or (tracking and update.n_accepted >= 1)
+            else:
+                mode = "no_fix"
+                tracking = False
+            if sample is None and full and (j >= sample_at or j == n_frames - 1):
+                sample = _sample_frame(frame.image, found, result)
+        log["mode"][j] = MODE_CODE[mode]
+        if mode != previous_mode:
+            transitions.append({"time_s": float(t), "mode": mode, "reason": reason})
+            previous_mode = mode
+        log["q_est"][j] = filt.q
+        log["bias_est"][j] = filt.b
+        log["P"][j] = filt.P
+        log["frame_ms"][j] = 1e3 * (time.perf_counter() - started)
+    return log, {"transitions": transitions, "sample_frame": sample}
+
+
+def _unique(found):
+    """Windows around close stars overlap: keep one detection per star image (1 px)."""
+    if len(found) < 2:
+        return found
+    uv = found.uv
+    keep = np.ones(len(found), bool)
+    for i in range(len(found)):
+        if keep[i]:
+            close = np.linalg.norm(uv[i + 1 :] - uv[i], axis=1) < 1.0
+            keep[i + 1 :][close] = False
+    return found.select(keep)
+
+
+def _log_update(log, j, update):
+    accepted = update.accepted
+    n_accepted = int(np.count_nonzero(accepted))
+    log["n_measurements"][j] = accepted.size
+    log["n_accepted"][j] = n_accepted
+    if n_accepted:
+        z = update.z[accepted].ravel()
+        log["nis"][j] = float(np.dot(update.nis, accepted))
+        log["nis_dof"][j] = 2 * n_accepted
+        log["innovation_rms"][j] = float(np.sqrt(np.dot(z, z) / z.size))
+
+
+def _sample_frame(image, found, result):
+    hip = {int(c): int(h) for c, h in result.matches} if result.ok else {}
+    return {
+        "image": np.asarray(image),
+        "detections": [{"u": float(u), "v": float(v), "hip": hip.get(i)} for i, (u, v) in enumerate(found.uv)],
+    }
+
+
+def mode_statistics(log, transitions):
+    """Per-mode counts and identification times for summary.json."""
+    out = {}
+    for code, name in enumerate(MODES):
+        frames = log["mode"] == code
+        if not frames.any():
+            continue
+        ms = log["id_ms"][frames]
+        ms = ms[np.isfinite(ms)]
+        out[name] = {
+            "frames": int(frames.sum()),
+            "identified_stars_mean": float(log["n_identified"][frames].mean()),
+            "id_ms_median": float(np.median(ms)) if ms.size else None,
+            "id_ms_p95": float(np.percentile(ms, 95)) if ms.size else None,
+        }
+    return {"modes": list(MODES), "per_mode": out, "transitions": transitions,
+            "stacked_frames": int(log["n_stacked"].sum())}
+

@@ -1,0 +1,109 @@
+"""The image-fidelity closed loop: acquisition, tracking, re-acquisition after a tracking loss,
+outages, false stars, and the faults at vector fidelity."""
+
+import copy
+
+import numpy as np
+import pytest
+
+import navsim
+from navsim import units
+from navsim.closed_loop import MODE_CODE
+from startrack.errors import InputError
+
+
+def image_scenario(base, duration_s=30.0, **faults):
+    scenario = copy.deepcopy(base)
+    scenario["duration_s"] = duration_s
+    scenario["star_sensor"] = {"fidelity": "image", "measurement": "stars", "rate_hz": 2.0, "fov_deg": 16.0,
+                               "mag_limit": 6.0, "image": {"centroid_sigma_px": 0.15}}
+    scenario["filter"] = {"initial_attitude_sigma_deg": 0.3}
+    scenario["faults"] = faults
+    return scenario
+
+
+def modes(result):
+    return result.series["mode"]
+
+
+def test_acquires_then_tracks_with_many_stars(base_scenario):
+    result = navsim.run(image_scenario(base_scenario), seed=3)
+    mode = modes(result)
+    tracking = mode == MODE_CODE["tracking"]
+    assert tracking[4:].mean() > 0.9
+    assert np.median(result.series["n_identified"][tracking]) >= 6
+    assert result.summary["cross_boresight_rms_arcsec"] < 10.0
+    assert result.summary["updates"]["rejected"] <= 0.05 * result.summary["updates"]["measurements"]
+    assert result.summary["identification"]["transitions"][0]["time_s"] == pytest.approx(0.5)
+    sub = result.series["subcatalog_index"]
+    assert np.all(sub >= 0) and np.all(sub < 3100)
+    assert result.sample_frame is not None and result.sample_frame["image"].dtype == np.uint16
+
+
+def test_reacquires_after_a_tracking_loss(base_scenario):
+    """A 5 deg knock at 10 s: tracking fails, the predicted sub-catalog with its redundant
+    neighbours (or lost-in-space) re-acquires, the attitude is re-initialised, tracking resumes."""
+    scenario = image_scenario(base_scenario, attitude_jumps=[{"time_s": 10.0, "angle_deg": 5.0}])
+    result = navsim.run(scenario, seed=4)
+    t, mode = result.series["t"], modes(result)
+    after = (t >= 10.0) & (t < 12.0)
+    assert np.any(np.isin(mode[after], [MODE_CODE["subcatalog"], MODE_CODE["lost_in_space"]]))
+    assert np.all(mode[t >= 13.0] == MODE_CODE["tracking"])
+    error = units.rad_to_arcsec(np.linalg.norm(result.series["attitude_error"], axis=1))
+    assert error[t >= 13.0].max() < 60.0
+    reasons = [tr["reason"] for tr in result.summary["identification"]["transitions"]]
+    assert any("re-initialised" in r for r in reasons)
+
+
+def test_outage_and_dropped_frames_are_logged_and_survived(base_scenario):
+    scenario = image_scenario(base_scenario, outages=[{"start_s": 10.0, "end_s": 14.0}], dropped_frames_s=[20.0])
+    result = navsim.run(scenario, seed=5)
+    t, mode = result.series["t"], modes(result)
+    assert np.all(mode[(t >= 10.0) & (t < 14.0)] == MODE_CODE["outage"])
+    assert mode[np.argmin(np.abs(t - 20.0))] == MODE_CODE["dropped"]
+    assert mode[np.argmin(np.abs(t - 14.5))] == MODE_CODE["tracking"]
+    sigma = np.sqrt(result.series["P_diag"][:, 0])
+    assert sigma[np.argmin(np.abs(t - 13.5))] > sigma[np.argmin(np.abs(t - 9.5))]  # grows while blind
+
+
+def test_false_star_storm_does_not_corrupt_the_attitude(base_scenario):
+    """30 cosmic-ray tracks per frame for 8 s."""
+    scenario = image_scenario(base_scenario, false_star_storms=[{"start_s": 8.0, "end_s": 16.0, "count": 30}])
+    result = navsim.run(scenario, seed=6)
+    t = result.series["t"]
+    storm = (t >= 8.0) & (t < 16.0)
+    # windows around the predicted stars are read while tracking: stray hits fall mostly outside them
+    assert np.all(modes(result)[storm] == MODE_CODE["tracking"])
+    assert result.series["n_accepted"][storm].min() >= 3
+    error = units.rad_to_arcsec(np.linalg.norm(result.series["attitude_error"], axis=1))
+    assert error[t >= 4.0].max() < 60.0
+
+
+def test_gyro_bias_step_is_absorbed_at_vector_fidelity(base_scenario):
+    scenario = copy.deepcopy(base_scenario)
+    scenario["duration_s"] = 120.0
+    scenario["faults"] = {"gyro_bias_steps": [{"time_s": 40.0, "step_deg_per_h": [20.0, 0.0, 0.0]}]}
+    result = navsim.run(scenario, seed=7)
+    t = result.series["t"]
+    jump = result.series["bias_true"][t > 41.0, 0] - result.series["bias_true"][t < 39.0, 0].mean()
+    assert units.rad_per_s_to_deg_per_h(jump.mean()) == pytest.approx(20.0, abs=1.0)
+    # the filter's bias random walk (0.5 deg/h/√h) absorbs a step slowly, but it does absorb it
+    bias_error = units.rad_per_s_to_deg_per_h(result.series["bias_true"][:, 0] - result.series["bias_est"][:, 0])
+    assert abs(bias_error[np.argmin(np.abs(t - 41.0))]) > 15.0
+    assert abs(bias_error[-1]) < 10.0
+
+
+def test_outages_at_vector_fidelity_skip_updates(base_scenario):
+    scenario = copy.deepcopy(base_scenario)
+    scenario["faults"] = {"outages": [{"start_s": 10.0, "end_s": 20.0}], "dropped_frames_s": [30.0]}
+    result = navsim.run(scenario, seed=8)
+    t = result.series["t"]
+    assert np.all(result.series["n_measurements"][(t >= 10.0) & (t < 20.0)] == 0)
+    assert result.series["n_measurements"][np.argmin(np.abs(t - 30.0))] == 0
+    assert result.series["n_measurements"][np.argmin(np.abs(t - 25.0))] == 1
+
+
+def test_frame_faults_need_image_fidelity(base_scenario):
+    base_scenario["faults"] = {"attitude_jumps": [{"time_s": 1.0, "angle_deg": 2.0}]}
+    with pytest.raises(InputError, match="faults.attitude_jumps: needs star_sensor.fidelity = 'image'"):
+        navsim.run(base_scenario)

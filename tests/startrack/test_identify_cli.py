@@ -1,0 +1,127 @@
+"""``startrack solve``: centroid CSV (with and without header/flux), image, JSON Lines batch, bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from startrack.camera import Camera
+from startrack.cli import main
+from startrack.identify.simulate import centroid_frame, random_attitude
+from startrack.star_catalog import load_star_catalog
+
+GEOMETRY = ["--fov-deg", "16", "--width", "1024", "--height", "1024"]
+
+
+@pytest.fixture(scope="module")
+def frame():
+    camera = Camera.from_fov(np.radians(16.0), 1024, 1024)
+    stars = load_star_catalog(2000.0).brighter_than(6.0)
+    rng = np.random.default_rng(77)
+    return camera, centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, 0.1,
+                                  n_false=2, n_missing=1)
+
+
+def _run(capsys, argv):
+    status = main(argv)
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def _check_identified(record, frame):
+    assert record["status"] == "ok" and record["method"] == "lost_in_space"
+    for pair in record["matches"]:
+        assert frame.hip[pair[0]] == pair[1]
+    q = np.array(record["q_IS"])
+    assert min(np.abs(q - frame.q_IS).max(), np.abs(q + frame.q_IS).max()) < 1e-4
+    for key in ("ra_deg", "dec_deg", "roll_deg", "solve_ms", "false_match_probability", "id"):
+        assert key in record
+
+
+def test_csv_with_header_and_flux(tmp_path, capsys, frame):
+    _, f = frame
+    path = tmp_path / "frame.csv"
+    np.savetxt(path, np.column_stack([f.uv, f.flux]), delimiter=",", header="u,v,flux", comments="")
+    status, out, _ = _run(capsys, ["solve", str(path), *GEOMETRY, "--centroid-sigma-px", "0.1", "--json"])
+    assert status == 0
+    record = json.loads(out)
+    assert record["id"] == str(path)
+    _check_identified(record, f)
+
+
+def test_csv_without_header_or_flux_in_brightness_order(tmp_path, capsys, frame):
+    _, f = frame
+    path = tmp_path / "frame.csv"
+    np.savetxt(path, f.uv, delimiter=",")
+    status, out, _ = _run(capsys, ["solve", str(path), *GEOMETRY, "--boresight-deg", "10,20"])
+    assert status == 0 and ": ok  RA" in out
+
+
+def test_image_is_detected_then_identified(tmp_path, capsys, frame):
+    camera, f = frame
+    rows, cols = np.mgrid[0:1024, 0:1024]
+    image = np.full((1024, 1024), 100.0)
+    for (u, v), flux in zip(f.uv, f.flux):  # Gaussian star images, sigma 1 px, on a flat background
+        if 3 < u < 1020 and 3 < v < 1020:
+            r0, c0 = int(v), int(u)
+            window = (slice(r0 - 4, r0 + 5), slice(c0 - 4, c0 + 5))
+            peak = 3000.0 * np.sqrt(flux / f.flux.max())  # compressed range: every star well above noise
+            image[window] += peak * np.exp(-((cols[window] - u) ** 2 + (rows[window] - v) ** 2) / 2.0)
+    image += np.random.default_rng(1).normal(0.0, 2.0, image.shape)
+    path = tmp_path / "frame.npy"
+    np.save(path, image)
+    status, out, _ = _run(capsys, ["solve", str(path), *GEOMETRY, "--json"])
+    record = json.loads(out)
+    assert status == 0 and record["status"] == "ok", record
+    q = np.array(record["q_IS"])
+    assert min(np.abs(q - f.q_IS).max(), np.abs(q + f.q_IS).max()) < 1e-4
+
+
+def test_batch_reports_every_frame_and_bad_lines(tmp_path, capsys, frame):
+    _, f = frame
+    lines = [json.dumps({"id": "good", "centroids": np.column_stack([f.uv, f.flux]).tolist()}),
+             json.dumps({"id": "nan", "centroids": [[1, 2, 1], [3, float("nan"), 1], [5, 6, 1]]}),
+             json.dumps({"id": "two", "centroids": [[1, 2], [3, 4]]}),
+             json.dumps({"id": "off", "centroids": [[-100, 2], [3000, 4], [5, -90]]}),
+             json.dumps({"id": "text", "centroids": [[1, "x"]]}),
+             json.dumps({"id": "extra", "centroids": [], "fov": 3}),
+             "{broken", ""]
+    path = tmp_path / "frames.jsonl"
+    path.write_text("\n".join(lines) + "\n")
+    status, out, err = _run(capsys, ["solve", "--batch", str(path), *GEOMETRY, "--centroid-sigma-px", "0.1",
+                                     "--json"])
+    records = [json.loads(line) for line in out.splitlines()]
+    assert status == 1 and err == ""
+    assert [r["status"] for r in records] == ["ok", "error", "too_few", "error", "error", "error", "error"]
+    assert [r["id"] for r in records] == ["good", "nan", "two", "off", "text", "extra", 7]
+    _check_identified(records[0], f)
+    for record in records[1:]:
+        assert record["reason"]
+    assert "unknown key(s) fov" in records[5]["reason"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["solve", "missing.csv", *GEOMETRY], "does not exist"),
+    (["solve", *GEOMETRY], "no input"),
+    (["solve", "x.csv", "--batch", "y.jsonl", *GEOMETRY], "not both"),
+    (["solve", "FILE", "--fov-deg", "nan", "--width", "1024", "--height", "1024"], "--fov-deg"),
+    (["solve", "FILE", *GEOMETRY, "--boresight-deg", "12"], "--boresight-deg"),
+    (["solve", "FILE", *GEOMETRY, "--boresight-deg", "12,95"], "DEC"),
+    (["solve", "FILE", "--fov-deg", "16", "--width", "0", "--height", "1024"], "--width"),
+])
+def test_bad_options_end_with_one_line(tmp_path, capsys, argv, message):
+    path = tmp_path / "frame.csv"
+    path.write_text("1,2\n3,4\n5,6\n")
+    argv = [str(path) if a == "FILE" else a for a in argv]
+    status, out, err = _run(capsys, argv)
+    assert status == 2 and out == ""
+    assert err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("text, message", [("u,v,w\n1,2,3\n", "header"), ("1,2\n3,x\n", "line 2"),
+                                           ("1,2\n3,4,5\n", "columns")])
+def test_malformed_csv(tmp_path, capsys, text, message):
+    path = tmp_path / "frame.csv"
+    path.write_text(text)
+    status, _, err = _run(capsys, ["solve", str(path), *GEOMETRY])
+    assert status == 2 and message in err
