@@ -21,7 +21,7 @@ from pathlib import Path
 from navsim.montecarlo import run_campaign
 from navsim.simulation import run_batch
 
-SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "demo.toml"
+SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity
 # Basilisk's set-up: a 6-state attitude/bias filter, gyro and star-tracker attitude fixes at 10 Hz.
 OVERRIDES = {"duration_s": 600.0, "gyro.rate_hz": 10.0, "star_sensor.rate_hz": 10.0, "truth.rate_hz": 40.0,
              "star_sensor.measurement": "attitude", "filter.estimate_scale_factor": False}

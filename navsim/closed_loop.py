@@ -60,6 +60,7 @@ class ImageSensor:
     stacking: bool
     mag_limit: float
     centroid_sigma: float  # [rad]
+    probes: dict  # method name -> StarIdentifier restricted to it (000 §5 comparison), or empty
 
     @classmethod
     def build(cls, scenario, star_catalog):
@@ -75,12 +76,19 @@ class ImageSensor:
         catalog = load_navigation_catalog(params, progress=False)
         identifier = StarIdentifier(catalog, camera, centroid_sigma_px=image["centroid_sigma_px"],
                                     max_stars=image["max_identified_stars"])
+        probes = {}
+        if scenario["faults"].get("tracking_failure_probes"):
+            probes = {method: StarIdentifier(catalog, camera, centroid_sigma_px=image["centroid_sigma_px"],
+                                             max_stars=image["max_identified_stars"], methods=(method,),
+                                             field_stars=identifier.field)
+                      for method in ("subcatalog", "lost_in_space")}
         stars = star_catalog.brighter_than(image["render_mag_limit"])
         return cls(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
                    stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
                    detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
                    max_identified=image["max_identified_stars"], stacking=image["dim_star_stacking"],
-                   mag_limit=sensor["mag_limit"], centroid_sigma=image["centroid_sigma_px"] / camera.focal_px)
+                   mag_limit=sensor["mag_limit"], centroid_sigma=image["centroid_sigma_px"] / camera.focal_px,
+                   probes=probes)
 
     @property
     def catalog(self):
@@ -146,6 +154,12 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
     sample_at = n_frames // 2
     jump_index = 0
     previous_mode = None
+    probe_spec = faults.get("tracking_failure_probes")
+    probe_frames, probe_log = set(), []
+    if probe_spec:
+        probe_rng = np.random.default_rng(seed.spawn(1)[0])
+        eligible = np.arange(min(4, n_frames - 1), n_frames)
+        probe_frames = set(probe_rng.choice(eligible, size=min(probe_spec["count"], eligible.size), replace=False).tolist())
     for j in range(n_frames):
         started = time.perf_counter()
         k = frame_k[j]
@@ -184,8 +198,15 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
                 v0 = storm_rng.uniform(0, camera.height - 1, count)
                 du, dv = storm_rng.normal(0, 3.0, (2, count))
                 extra = tuple(cosmic_ray(a, b, a + c, b + d, 4.0e4) for a, b, c, d in zip(u0, v0, du, dv))
-            full = not tracking or len(predicted) == 0 or j == sample_at  # one full frame for the report
-            windows = None if full else Windows.around(uv_pred[predicted], sensor.window_half_px, camera.height, camera.width)
+            # full frames while acquiring, after a (probed) tracking failure and once for the report
+            full = not tracking or len(predicted) == 0 or j == sample_at or j in probe_frames
+            windows = None
+            if not full:
+                # the window must hold the whole smear trail: rate from the gyro, across the boresight
+                omega_est_S = quat.to_matrix(q_BS).T @ ((1.0 - filt.s) * (omega_measured[k - 1] - filt.b))
+                smear_px = np.hypot(omega_est_S[0], omega_est_S[1]) * model.exposure_s * camera.focal_px
+                half = max(sensor.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
+                windows = Windows.around(uv_pred[predicted], half, camera.height, camera.width)
             frame = render_star_field(camera, model, q_IS_true, sensor.stars_I, sensor.stars_mag, render_rng,
                                       omega_S=omega_S, windows=windows, extra_sources=extra)
             b, sigma_n = model.background_dn, model.noise_dn
@@ -198,6 +219,8 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
                                        saturation_dn=model.saturation_dn)
                 found = _unique(found)
             log["n_detected"][j] = len(found)
+            if j in probe_frames:
+                probe_log.append(_probe(sensor, found, q_IS_pred, q_IS_true, probe_rng, probe_spec["angle_3sigma_deg"]))
             result = sensor.identifier.solve(found.uv, found.flux, prior=Prior(q_IS=q_IS_pred))
             log["id_ms"][j] = result.solve_ms
             ref_I, obs_S = np.zeros((0, 3)), np.zeros((0, 3))
@@ -263,7 +286,24 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
         log["bias_est"][j] = filt.b
         log["P"][j] = filt.P
         log["frame_ms"][j] = 1e3 * (time.perf_counter() - started)
-    return log, {"transitions": transitions, "sample_frame": sample}
+    return log, {"transitions": transitions, "sample_frame": sample, "probes": probe_log}
+
+
+def _probe(sensor, found, q_IS_pred, q_IS_true, rng, angle_3sigma_deg):
+    """One 000 §5 trial on a full frame: disturb the prior by a random rotation (σ = angle_3sigma_deg / 3
+    per axis) and run each restricted identifier on the frame's centroids.
+
+    Success (a recognition): status ok and the attitude within 0.1 deg of the truth — a wrong
+    identification is off by degrees, while smeared centroids of a correct one can be off by an arcmin."""
+    sigma = np.radians(angle_3sigma_deg) / 3.0
+    phi = rng.normal(0.0, sigma, 3)
+    disturbed = quat.multiply(q_IS_pred, quat.from_rotation_vector(phi))
+    trial = {"disturbance_deg": float(np.degrees(np.linalg.norm(phi)))}
+    for method, identifier in sensor.probes.items():
+        result = identifier.solve(found.uv, found.flux, prior=Prior(q_IS=disturbed))
+        error = np.linalg.norm(quat.attitude_error(q_IS_true, result.q_IS)) if result.ok else np.inf
+        trial[method] = {"ok": bool(result.ok and error < np.radians(0.1)), "ms": float(result.solve_ms)}
+    return trial
 
 
 def _unique(found):
@@ -297,6 +337,36 @@ def _sample_frame(image, found, result):
         "image": np.asarray(image),
         "detections": [{"u": float(u), "v": float(v), "hip": hip.get(i)} for i, (u, v) in enumerate(found.uv)],
     }
+
+
+def probe_statistics(probes):
+    """Recognition rate and time of each method over the 000 §5 trials, beside 000's figures."""
+    if not probes:
+        return None
+    out = {"trials": len(probes),
+           "disturbance_deg_max": max(p["disturbance_deg"] for p in probes)}
+    for method in ("subcatalog", "lost_in_space"):
+        ok = [p[method]["ok"] for p in probes]
+        ms = np.array([p[method]["ms"] for p in probes])
+        out[method] = {"recognition_rate": float(np.mean(ok)), "ms_mean": float(ms.mean()),
+                       "ms_median": float(np.median(ms)), "ms_p95": float(np.percentile(ms, 95))}
+    out["time_ratio"] = out["subcatalog"]["ms_mean"] / out["lost_in_space"]["ms_mean"]
+    return out
+
+
+def paper000_comparison(stats):
+    """Rows of the report's comparison table for 000 §5 (Fig. 5 and its text)."""
+    return [
+        {"quantity": "recognition rate, predicted sub-catalog [%]", "ours": 100 * stats["subcatalog"]["recognition_rate"],
+         "paper": 100.0, "source": "000 §5"},
+        {"quantity": "recognition rate, full-sky [%]", "ours": 100 * stats["lost_in_space"]["recognition_rate"],
+         "paper": 100.0, "source": "000 §5"},
+        {"quantity": "mean time, predicted sub-catalog [ms]", "ours": stats["subcatalog"]["ms_mean"], "paper": 14.2,
+         "source": "000 Fig. 5"},
+        {"quantity": "mean time, full-sky [ms]", "ours": stats["lost_in_space"]["ms_mean"], "paper": 74.1,
+         "source": "000 Fig. 5"},
+        {"quantity": "time ratio sub-catalog / full-sky", "ours": stats["time_ratio"], "paper": 0.192, "source": "000 §5"},
+    ]
 
 
 def mode_statistics(log, transitions):

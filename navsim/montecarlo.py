@@ -253,4 +253,14 @@ def aggregate(directory):
             "divergent_runs": divergent,
         }
     )
+    per_mode = {}
+    for _, summary, _ in finished:
+        for mode, stats in summary.get("identification", {}).get("per_mode", {}).items():
+            per_mode[mode] = per_mode.get(mode, 0) + stats["frames"]
+    if per_mode:
+        frames = sum(per_mode.values())
+        out["identification"] = {
+            "frames_per_mode": per_mode,
+            "fix_fraction": 1.0 - (per_mode.get("no_fix", 0) + per_mode.get("outage", 0) + per_mode.get("dropped", 0)) / frames,
+        }
     return out

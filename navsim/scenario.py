@@ -147,6 +147,14 @@ SCHEMA = Table(
                 "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
                                                        "step_deg_per_h": Value("vector")})),
                 "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
+                "tracking_failure_probes": Table(
+                    {"count": Value("int", minimum=1, maximum=100000),
+                     "angle_3sigma_deg": Value("float", exclusive_minimum=0.0, maximum=90.0)},
+                    optional=True,
+                    doc="000 §5: at `count` random frames the prior is disturbed (Rayleigh angle of "
+                        "3σ = angle_3sigma_deg) and the predicted sub-catalog and full-sky methods are both "
+                        "run on that frame's centroids; the filter is not disturbed",
+                ),
             }
         ),
         "filter": Table(
@@ -204,7 +212,7 @@ def parse_override(text):
 
 def apply_overrides(data, overrides, source):
     """Return a copy of ``data`` with overrides applied; ``overrides`` is a dict {dotted: value}
-    or a list of 'key=value' strings."""
+    (a value of None removes the key) or a list of 'key=value' strings."""
     data = copy.deepcopy(data)
     items = overrides.items() if isinstance(overrides, dict) else (parse_override(o) for o in overrides)
     for key, value in items:
@@ -214,7 +222,10 @@ def apply_overrides(data, overrides, source):
             node = node.setdefault(part, {})
             if not isinstance(node, dict):
                 raise InputError(f"{source}: {'.'.join(path)}: {part} is not a table")
-        node[path[-1]] = value
+        if value is None:  # the Python API's way to remove an optional key or table
+            node.pop(path[-1], None)
+        else:
+            node[path[-1]] = value
     return data
 
 
@@ -259,8 +270,8 @@ def validate(data, source="<scenario>"):
         if "image" not in sensor:
             sensor["image"] = SCHEMA.entries["star_sensor"].entries["image"].check("star_sensor.image", {})
     if sensor["fidelity"] == "vector":
-        for kind in ("attitude_jumps", "false_star_storms"):
-            if checked["faults"][kind]:
+        for kind in ("attitude_jumps", "false_star_storms", "tracking_failure_probes"):
+            if checked["faults"].get(kind):
                 raise InputError(f"{source}: faults.{kind}: needs star_sensor.fidelity = 'image' (it acts on frames)")
     for kind in ("outages", "false_star_storms"):
         for k, interval in enumerate(checked["faults"][kind]):

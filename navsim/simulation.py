@@ -14,7 +14,14 @@ import numpy as np
 from scipy.stats import chi2
 
 from navsim import build, faults, kernels
-from navsim.closed_loop import MODES, ImageSensor, mode_statistics, run_image_loop
+from navsim.closed_loop import (
+    MODES,
+    ImageSensor,
+    mode_statistics,
+    paper000_comparison,
+    probe_statistics,
+    run_image_loop,
+)
 from navsim import quaternion as quat
 from navsim import units
 from navsim.scenario import Scenario, load_scenario, scenario_from_dict
@@ -129,6 +136,10 @@ def simulate(prepared, seed):
     if p.image_sensor is not None:
         summary["identification"] = mode_statistics(log, extras["transitions"])
         summary["modes"] = list(MODES)
+        probes = probe_statistics(extras["probes"])
+        if probes is not None:
+            summary["tracking_failure_probes"] = probes
+            summary["paper_comparison"] = paper000_comparison(probes)
     summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     series = {key: value for key, value in log.items() if key != "P"}
     series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()

@@ -52,6 +52,23 @@ class Prior:
     boresight: tuple[float, float] | None = None
     tracked_hip: np.ndarray | None = None
 
+    def __post_init__(self):
+        if self.q_IS is not None:
+            q = np.asarray(self.q_IS, dtype=float)
+            if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 0.0:
+                raise InputError(f"prior q_IS must be 4 finite numbers, not all zero; got {self.q_IS!r}.")
+            object.__setattr__(self, "q_IS", q / np.linalg.norm(q))
+        if self.rate_S is not None:
+            rate = np.asarray(self.rate_S, dtype=float)
+            if rate.shape != (3,) or not np.all(np.isfinite(rate)):
+                raise InputError(f"prior rate_S must be 3 finite numbers [rad/s]; got {self.rate_S!r}.")
+            object.__setattr__(self, "rate_S", rate)
+        if not math.isfinite(self.dt):
+            raise InputError(f"prior dt must be a finite number of seconds; got {self.dt!r}.")
+        if self.boresight is not None and (len(self.boresight) != 2 or not all(math.isfinite(x) for x in self.boresight)
+                                           or abs(self.boresight[1]) > math.pi / 2):
+            raise InputError(f"prior boresight must be (ra, dec) in rad with |dec| <= pi/2; got {self.boresight!r}.")
+
     def boresight_radec(self):
         """(ra, dec) [rad] of the predicted boresight, or None."""
         if self.q_IS is not None:
@@ -75,7 +92,7 @@ class StarIdentifier:
     catalog: :class:`startrack.navigation_catalog.NavigationCatalog`; camera: :class:`startrack.camera.Camera`;
     centroid_sigma_px: centroid noise per axis [px] (covariance and gates); delta_sigmas: the error
     bound delta of 001 §4.3.1 in units of it (3); gate_sigmas: verification match radius in units of it
-    (5); pattern_stars: brightest centroids searched first (16); max_stars: centroids used at all
+    (5); pattern_stars: brightest centroids searched first (16, at most 31; then twice as many); max_stars: centroids used at all
     (None: all); max_groups: four-star groups searched for (4); max_triangles: triangles kept for frames
     without a group (8); false_match_threshold: acceptance threshold
     (1e-6); tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
@@ -93,10 +110,10 @@ class StarIdentifier:
         self.centroid_sigma_px = _positive("centroid_sigma_px", centroid_sigma_px, 100.0)
         self.delta_px = _positive("delta_sigmas", delta_sigmas, 100.0) * self.centroid_sigma_px
         self.verify_gate = _positive("gate_sigmas", gate_sigmas, 100.0) * self.centroid_sigma_px / camera.focal_px
-        for name, value, least in (("pattern_stars", pattern_stars, 4), ("max_groups", max_groups, 1),
-                                   ("max_triangles", max_triangles, 1)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
-                raise InputError(f"star identifier option {name} = {value!r} must be an integer >= {least}.")
+        for name, value, least, most in (("pattern_stars", pattern_stars, 4, 31), ("max_groups", max_groups, 1, 10**4),
+                                         ("max_triangles", max_triangles, 1, 10**4)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not least <= value <= most:
+                raise InputError(f"star identifier option {name} = {value!r} must be an integer in [{least}, {most}].")
         if max_stars is not None and (isinstance(max_stars, bool) or not isinstance(max_stars, (int, np.integer))
                                       or max_stars < 3):
             raise InputError(f"star identifier option max_stars = {max_stars!r} must be an integer >= 3 or None.")

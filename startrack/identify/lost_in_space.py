@@ -115,71 +115,74 @@ def _triple(p, q, r):
 
 @njit
 def _pair_candidates(beta, gate, theta, k, slope, intercept):  # pragma: no cover  (compiled)
-    """(lo, hi) (n, n) candidate ranges of every observed pair s < t, and N_h (oriented in-gate matches)."""
+    """Candidate ranges (lo, hi) (n, n) of every observed pair s < t, the cosines of their gate ends
+    (cos_low = cos(beta + e), cos_high = cos(max(beta - e, 0))) and N_h (oriented in-gate matches)."""
     n = beta.shape[0]
     lo = np.zeros((n, n), np.int64)
     hi = np.zeros((n, n), np.int64)
+    cos_low = np.zeros((n, n))
+    cos_high = np.zeros((n, n))
     n_matches = 0
     for s in range(n):
         for t in range(s + 1, n):
             low, high = beta[s, t] - gate[s, t], beta[s, t] + gate[s, t]
             lo[s, t], hi[s, t] = _pair_range(theta, k, slope, intercept, low, high)
+            cos_high[s, t] = np.cos(max(low, 0.0))
+            cos_low[s, t] = np.cos(min(high, np.pi))
+            cos_high[t, s], cos_low[t, s] = cos_high[s, t], cos_low[s, t]
             for q in range(lo[s, t], hi[s, t]):
                 if low <= theta[q] <= high:
                     n_matches += 1
-    return lo, hi, 2 * n_matches
+    return lo, hi, cos_low, cos_high, 2 * n_matches
 
 
 @njit
-def _group_search(obs, beta, gate, lo, hi, theta, first, second, guide, anchor_start, anchor_stop, max_groups,
-                  max_triangles, head):  # pragma: no cover  (compiled)
+def _group_search(obs, beta, gate, lo, hi, cos_low, cos_high, theta, first, second, guide, anchor_start,
+                  anchor_stop, max_groups, max_triangles, head, partners):  # pragma: no cover  (compiled)
     """Triangles and four-star groups (module text) with anchors i in [anchor_start, anchor_stop).
 
-    Returns (groups (g, 8), triangles (t, 6)).  For each anchor star i (brightest first) the catalog
-    pairs matched to every observed pair (i, t) (candidate ranges ``lo``, ``hi``) are chained per
+    Returns (groups (g, 8), triangles (t, 6)).  For each anchor star i (brightest first; the smallest
+    index of its groups) the catalog pairs matched to every observed pair (i, t > i) (candidate
+    ranges ``lo``, ``hi``) are chained per
     (t, catalog star of i) in linked lists (with a bit mask per catalog star of the partners t whose
     list is not empty; at most 63 stars), so that a triangle (i, j, k) is found by following, for
     each catalog assignment (A, B) of (i, j), the list of (k, A) and testing the distance (B, C)
     against the gate of (j, k) and the handedness; each triangle is extended to a group by the lists
-    of every other star r.  Stops after ``max_groups`` groups.  ``head`` (>= n, n_guide) is a work
-    array of -1 (the list heads), returned as found.
+    of every other star r.  Stops after ``max_groups`` groups.  ``head`` (n_guide, >= n) int32 is a
+    work array of -1 (the list heads, catalog-star major so that the lists of one catalog star share a
+    cache line) and ``partners`` (n_guide,) int64 one of zeros, both returned as found.
     """
     n = obs.shape[0]
-    n_guide = guide.shape[0]
     low = beta - gate
     high = beta + gate
-    cos_high = np.cos(np.minimum(np.maximum(low, 0.0), np.pi))
-    cos_low = np.cos(np.minimum(np.maximum(high, 0.0), np.pi))
-    n_matches = 0
-    for s in range(n):
-        for t in range(s + 1, n):
-            n_matches += hi[s, t] - lo[s, t]
+    capacity = 1  # list entries of one anchor: both orientations of its candidate pairs
+    for i in range(anchor_start, anchor_stop):
+        count = 0
+        for t in range(i + 1, n):
+            count += 2 * (hi[i, t] - lo[i, t])
+        capacity = max(capacity, count + 1)
     groups = np.empty((max_groups, 8), np.int64)
     triangles = np.empty((max_triangles, 6), np.int64)
     n_groups = 0
     n_triangles = 0
-    partners = np.zeros(n_guide, np.int64)  # bit t set: the list (t, A) is not empty
-    capacity = 4 * n_matches + 1
-    entry_other = np.empty(capacity, np.int64)
-    entry_next = np.empty(capacity, np.int64)
-    entry_partner = np.empty(capacity, np.int64)
-    entry_anchor = np.empty(capacity, np.int64)
+    # partners[A]: bit t set when the list (A, t) is not empty
+    entry_other = np.empty(capacity, np.int32)
+    entry_next = np.empty(capacity, np.int32)
+    entry_partner = np.empty(capacity, np.int32)
+    entry_anchor = np.empty(capacity, np.int32)
     for i in range(anchor_start, anchor_stop):
         m = 0
-        for t in range(n):
-            if t == i:
-                continue
-            s0, t0 = min(i, t), max(i, t)
-            for q in range(lo[s0, t0], hi[s0, t0]):
-                if not low[s0, t0] <= theta[q] <= high[s0, t0]:
+        for t in range(i + 1, n):  # the anchor is the brightest (smallest index) star of its groups
+            for q in range(lo[i, t], hi[i, t]):
+                if not low[i, t] <= theta[q] <= high[i, t]:
                     continue
                 for orientation in range(2):
                     a_cat = first[q] if orientation == 0 else second[q]
                     entry_other[m] = second[q] if orientation == 0 else first[q]
-                    entry_next[m] = head[t, a_cat]
+                    entry_next[m] = head[a_cat, t]
                     entry_partner[m] = t
                     entry_anchor[m] = a_cat
-                    head[t, a_cat] = m
+                    head[a_cat, t] = m
                     partners[a_cat] |= np.int64(1) << t
                     m += 1
         done = False
@@ -200,7 +203,7 @@ def _group_search(obs, beta, gate, lo, hi, theta, first, second, guide, anchor_s
                         later >>= 1
                         if present == 0:
                             continue
-                        e = head[k, a_cat]
+                        e = head[a_cat, k]
                         while e >= 0 and not done:
                             c_cat = entry_other[e]
                             e = entry_next[e]
@@ -216,12 +219,12 @@ def _group_search(obs, beta, gate, lo, hi, theta, first, second, guide, anchor_s
                                 triangles[n_triangles, 4] = b_cat
                                 triangles[n_triangles, 5] = c_cat
                                 n_triangles += 1
-                            for r in range(n):
-                                if r == i or r == j or r == k or done or (partners[a_cat] >> r) & 1 == 0:
+                            for r in range(i + 1, n):
+                                if r == j or r == k or done or (partners[a_cat] >> r) & 1 == 0:
                                     continue
                                 jr0, jr1 = min(j, r), max(j, r)
                                 kr0, kr1 = min(k, r), max(k, r)
-                                f = head[r, a_cat]
+                                f = head[a_cat, r]
                                 while f >= 0:
                                     d_cat = entry_other[f]
                                     f = entry_next[f]
@@ -244,19 +247,27 @@ def _group_search(obs, beta, gate, lo, hi, theta, first, second, guide, anchor_s
                                         done = True
                                     break
         for e in range(m):
-            head[entry_partner[e], entry_anchor[e]] = -1
+            head[entry_anchor[e], entry_partner[e]] = -1
             partners[entry_anchor[e]] = 0
         if done:
             break
     return groups[:n_groups], triangles[:n_triangles]
 
 
+def new_workspace(n_guide: int, n_stars: int):
+    """Work arrays of :func:`search` for up to ``n_stars`` stars: list heads (-1) and partner bit masks (0)."""
+    if n_stars > 63:
+        raise ValueError(f"the pattern search takes at most 63 stars, not {n_stars}")
+    return np.full((n_guide, n_stars), -1, np.int32), np.zeros(n_guide, np.int64)
+
+
 def pair_candidates(beta, gate, table: PairTable):
-    """(lo (n, n), hi (n, n), N_h): catalog-pair ranges of every observed pair (s < t) and the number of
-    oriented catalog pairs inside the gates (k-vector of eq. 5 for the full sky, a binary search else)."""
-    lo, hi, n_matches = _pair_candidates(np.ascontiguousarray(beta), np.ascontiguousarray(gate), table.theta,
-                                         table.k, table.slope, table.intercept)
-    return lo, hi, int(n_matches)
+    """(lo, hi, cos_low, cos_high, N_h): catalog-pair ranges of every observed pair (s < t), the cosines
+    of the gate ends, and the number of oriented catalog pairs inside the gates (k-vector of eq. 5 for
+    the full sky, a binary search else)."""
+    lo, hi, cos_low, cos_high, n_matches = _pair_candidates(
+        np.ascontiguousarray(beta), np.ascontiguousarray(gate), table.theta, table.k, table.slope, table.intercept)
+    return lo, hi, cos_low, cos_high, int(n_matches)
 
 
 def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int = 4, max_triangles: int = 8,
@@ -268,16 +279,17 @@ def search(obs_S, beta, gate, table: PairTable, guide_vectors, max_groups: int =
     search stops after ``max_groups`` four-star groups; up to ``max_triangles`` triangles found on the
     way are kept for frames without a group.  ``anchors`` (start, stop): the brightest star of the
     groups searched (default: all); ``candidates``: :func:`pair_candidates` if already computed;
-    ``workspace``: an int64 array of -1 of shape (>= n, n_g) reused between calls (left as found).
+    ``workspace``: (:func:`new_workspace`) reused between calls (left as found).
     """
     n = len(obs_S)
-    if workspace is None or workspace.shape[0] < n:
-        workspace = np.full((n, len(guide_vectors)), -1, np.int64)
+    if workspace is None or workspace[0].shape[1] < n:
+        workspace = new_workspace(len(guide_vectors), n)
     beta, gate = np.ascontiguousarray(beta), np.ascontiguousarray(gate)
-    lo, hi, n_matches = pair_candidates(beta, gate, table) if candidates is None else candidates
+    lo, hi, cos_low, cos_high, n_matches = pair_candidates(beta, gate, table) if candidates is None else candidates
     start, stop = (0, n) if anchors is None else anchors
-    groups, triangles = _group_search(np.ascontiguousarray(obs_S), beta, gate, lo, hi, table.theta, table.first,
-                                      table.second, guide_vectors, start, stop, max_groups, max_triangles, workspace)
+    groups, triangles = _group_search(np.ascontiguousarray(obs_S), beta, gate, lo, hi, cos_low, cos_high,
+                                      table.theta, table.first, table.second, guide_vectors, start, stop, max_groups,
+                                      max_triangles, *workspace)
     groups = groups[_ranked(groups[:, :4], gate)]
     triangles = triangles[_ranked(triangles[:, :3], gate)]
     return Hypotheses(groups[:, :4], groups[:, 4:], triangles[:, :3], triangles[:, 3:], n_matches)
@@ -310,13 +322,13 @@ class PatternMatcher:
         self.max_groups = max_groups
         self.max_triangles = max_triangles
         self.threshold = threshold
-        self._workspace = np.full((2 * pattern_stars, len(self.guide_vectors)), -1, np.int64)
+        self._workspace = new_workspace(len(self.guide_vectors), 2 * pattern_stars)
 
     def match(self, frame, table: PairTable):
         """A :class:`startrack.identify.verify.Verified` for ``frame`` (:class:`FrameFeatures`) or None.
 
         The first ``max_groups`` groups of a pass over all anchors are verified; if none is accepted,
-        anchor by anchor (brightest first) the groups of up to ``max_groups`` found with that anchor;
+        anchor by anchor (brightest first) the groups of up to 4 ``max_groups`` found with that anchor;
         then the triangles collected on the way.  If nothing is accepted among the brightest
         ``pattern_stars``, the same with twice as many stars.
         """
@@ -326,7 +338,7 @@ class PatternMatcher:
         for n in (first, wide) if wide > first else (first,):
             obs, beta, gate = frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n]
             candidates = pair_candidates(beta, gate, table)
-            n_hypotheses = candidates[2]
+            n_hypotheses = candidates[-1]
             # Fast path: the first groups over all anchors (one pass for most frames) ...
             found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, self.max_triangles,
                            self._workspace, None, candidates)
@@ -339,7 +351,7 @@ class PatternMatcher:
             else:  # ... then anchor by anchor, so that false groups of one anchor cannot hide the rest
                 anchors = range(n - 2)
             for anchor in anchors:
-                found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, self.max_triangles,
+                found = search(obs, beta, gate, table, self.guide_vectors, 4 * self.max_groups, self.max_triangles,
                                self._workspace, (anchor, anchor + 1), candidates)
                 triangles.extend(zip(found.triangles_obs, found.triangles_cat))
                 verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)

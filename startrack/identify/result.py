@@ -6,7 +6,6 @@ gives the JSON form of the ``startrack solve`` contract (DESIGN.md) with degrees
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -106,10 +105,6 @@ class IdentificationResult:
     def matched_hip(self) -> np.ndarray:
         """HIP numbers of the matched stars, in the order of :attr:`matches`."""
         return self.matches[:, 1]
-
-    def with_time(self, solve_ms: float) -> "IdentificationResult":
-        """The same result with ``solve_ms`` set."""
-        return dataclasses.replace(self, solve_ms=float(solve_ms))
 
     def to_dict(self, frame_id=None) -> dict:
         """JSON-ready dict of the ``startrack solve --json`` contract (degrees, arcseconds)."""

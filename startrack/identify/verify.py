@@ -6,9 +6,10 @@ Steps (the verification of the issue; the same for lost-in-space, sub-catalog an
    those that project inside the image (:class:`FieldStars`);
 2. match: each centroid to its nearest predicted star and back (mutual nearest neighbours, so the
    matching is one-to-one), kept only within the gate; outliers are the centroids outside it;
-3. refit: the attitude by SVD (Wahba's problem, Markley 1988) with every matched star, then match
-   again with a gate three times narrower (3 r, then r) and refit each time; matches the last refit
-   puts outside r are dropped and the attitude refitted once more;
+3. refit: match within 3 r of the hypothesis and refit the attitude by SVD (Wahba's problem,
+   Markley 1988) with every matched star, then match within r and refit again; matches the last
+   refit puts outside r are dropped and the attitude refitted once more (tracking first matches
+   within its window);
 4. accept: only if the false-match probability (:func:`false_match_probability`) is below a threshold.
 
 Probability model.  Under a *wrong* attitude hypothesis the centroids are unrelated to the predicted

@@ -78,3 +78,12 @@ def test_a_prior_beyond_the_window_hands_over_to_the_sub_catalog(setup):
     assert result.ok and result.method == "subcatalog"
     near = (q * Rotation.from_rotvec([0.05 * DEG, 0.0, 0.1 * DEG])).as_quat()  # 3 px: tracked
     assert identifier.solve(frame.uv, frame.flux, Prior(q_IS=near)).method == "tracking"
+
+
+@pytest.mark.parametrize("kwargs", [{"q_IS": [0.0, 0.0, 0.0, 0.0]}, {"q_IS": [np.nan, 0, 0, 1]}, {"q_IS": [0, 0, 1]},
+                                    {"rate_S": [0.0, 1.0]}, {"dt": float("inf")}, {"boresight": (0.0, 2.0)}])
+def test_bad_priors_are_refused(kwargs):
+    from startrack.errors import InputError
+
+    with pytest.raises(InputError):
+        Prior(**kwargs)
