@@ -75,35 +75,6 @@ def inverse_small(S):
 
 
 @njit
-def inverse_small(S):
-    """Inverse of a small symmetric positive-definite matrix: closed form for 2x2 and 3x3, else LAPACK."""
-    n = S.shape[0]
-    if n == 3:
-        a, b, c = S[0, 0], S[0, 1], S[0, 2]
-        d, e, f = S[1, 1], S[1, 2], S[2, 2]
-        A = d * f - e * e
-        B = c * e - b * f
-        C = b * e - c * d
-        det = a * A + b * B + c * C
-        out = np.empty((3, 3))
-        out[0, 0] = A / det
-        out[0, 1] = out[1, 0] = B / det
-        out[0, 2] = out[2, 0] = C / det
-        out[1, 1] = (a * f - c * c) / det
-        out[1, 2] = out[2, 1] = (b * c - a * e) / det
-        out[2, 2] = (a * d - b * b) / det
-        return out
-    if n == 2:
-        det = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
-        out = np.empty((2, 2))
-        out[0, 0] = S[1, 1] / det
-        out[1, 1] = S[0, 0] / det
-        out[0, 1] = out[1, 0] = -S[0, 1] / det
-        return out
-    return np.linalg.inv(S)
-
-
-@njit
 def quat_multiply(p, q):
     """Hamilton product p ⊗ q, scalar-last (4,)."""
     out = np.empty(4)

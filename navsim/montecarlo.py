@@ -27,6 +27,7 @@ from scipy.stats import chi2
 from tqdm import tqdm
 
 from navsim import units
+from navsim.closed_loop import paper000_comparison, paper004_comparison
 from navsim.output import read_npz, write_json, write_run
 from navsim.scenario import Scenario
 from navsim.simulation import NEES_DOF, prepare, resolve_scenario, simulate
@@ -174,6 +175,40 @@ def _run_dask(scenario, chunks, scheduler, bar):
             client.close()
 
 
+def _pooled_paper_comparison(summaries):
+    """Pool the source-document experiments over runs: 004's dim-star RMS (frame-weighted) and 000's
+    tracking-failure probes (trial-weighted), with their comparison rows."""
+    out, rows = {}, []
+    dim = [s["dim_star"] for s in summaries if "dim_star" in s]
+    if dim:
+        pooled = {}
+        for name in ("two_star_triad", "three_star_optimal"):
+            parts = [(d[name]["frames"], np.square(d[name]["rms_ra_dec_roll_arcsec"])) for d in dim if name in d]
+            frames = sum(f for f, _ in parts)
+            if frames:
+                pooled[name] = {"frames": frames, "rms_ra_dec_roll_arcsec":
+                                [float(v) for v in np.sqrt(sum(f * ms for f, ms in parts) / frames)]}
+        for name in ("filter_with_stacking", "filter_without_stacking"):
+            values = [d[name]["rms_xyz_arcsec"] for d in dim if name in d]
+            if values:
+                pooled[name] = {"rms_xyz_arcsec": [float(v) for v in np.sqrt(np.mean(np.square(values), axis=0))]}
+        out["dim_star"] = pooled
+        rows += paper004_comparison(pooled)
+    probes = [s["tracking_failure_probes"] for s in summaries if "tracking_failure_probes" in s]
+    if probes:
+        trials = sum(p["trials"] for p in probes)
+        pooled = {"trials": trials}
+        for method in ("subcatalog", "lost_in_space"):
+            pooled[method] = {key: float(sum(p["trials"] * p[method][key] for p in probes) / trials)
+                              for key in ("recognition_rate", "ms_mean")}
+        pooled["time_ratio"] = pooled["subcatalog"]["ms_mean"] / pooled["lost_in_space"]["ms_mean"]
+        out["tracking_failure_probes"] = pooled
+        rows += paper000_comparison(pooled)
+    if rows:
+        out["paper_comparison"] = rows
+    return out
+
+
 def load_runs(directory):
     """(index, summary, series) of every finished run and (index, error) of every failed one."""
     directory = Path(directory)
@@ -253,6 +288,8 @@ def aggregate(directory):
             "divergent_runs": divergent,
         }
     )
+    comparison = _pooled_paper_comparison([summary for _, summary, _ in finished])
+    out.update(comparison)
     per_mode = {}
     for _, summary, _ in finished:
         for mode, stats in summary.get("identification", {}).get("per_mode", {}).items():

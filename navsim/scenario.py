@@ -33,6 +33,9 @@ SCHEMA = Table(
                 "rate_hz": Value("float", default=None, exclusive_minimum=0.0,
                                  doc="truth integration rate, an integer multiple of the gyro rate"),
                 "initial_q_IB": Value("quaternion", default=[0.0, 0.0, 0.0, 1.0]),
+                "initial_radec_roll_deg": Value("vector", default=None,
+                                                doc="initial boresight RA, Dec and roll (003 §1.1) instead of "
+                                                    "initial_q_IB; with the nominal mounting"),
                 "constant_rate": Table({"rate_deg_per_s": Value("vector")}, optional=True),
                 "sinusoidal_axis": Table(
                     {
@@ -127,6 +130,15 @@ SCHEMA = Table(
                         "max_identified_stars": Value("int", default=12, minimum=3),
                         "dim_star_stacking": Value("bool", default=True,
                                                    doc="stack the predicted dim star over 4 frames when < 3 stars"),
+                        "sky_hip": Value("list", default=[], minimum=1.0,
+                                         doc="render only these Hipparcos stars (004 §3 renders four); "
+                                             "empty: the whole catalog"),
+                        "start_tracking": Value("bool", default=False,
+                                                doc="the sensor starts in tracking, with the filter's initial "
+                                                    "attitude as prior (004's set-up)"),
+                        "compare_without_stacking": Value("bool", default=False,
+                                                          doc="also run a shadow filter that never gets the "
+                                                              "stacked star, for the paired comparison of 004"),
                     },
                     optional=True,
                 ),

@@ -18,7 +18,9 @@ from navsim.closed_loop import (
     MODES,
     ImageSensor,
     mode_statistics,
+    dim_star_statistics,
     paper000_comparison,
+    paper004_comparison,
     probe_statistics,
     run_image_loop,
 )
@@ -27,6 +29,7 @@ from navsim import units
 from navsim.scenario import Scenario, load_scenario, scenario_from_dict
 from navsim.star_sensor import AttitudeFixSensor
 from navsim.truth import interval_mean_rates
+from startrack.attitude_angles import quaternion_from_radec_roll
 from startrack.star_catalog import load_star_catalog
 
 NEES_DOF = 6
@@ -74,6 +77,17 @@ class Prepared:
     image_sensor: object = None
 
 
+def initial_attitude(scenario):
+    """q_IB at t = 0: ``truth.initial_radec_roll_deg`` (boresight RA, Dec, roll through the nominal
+    mounting) when given, else ``truth.initial_q_IB``."""
+    radec_roll = scenario["truth"]["initial_radec_roll_deg"]
+    if radec_roll is None:
+        return quat.normalize(scenario["truth"]["initial_q_IB"])
+    q_IS = quaternion_from_radec_roll(*np.radians(radec_roll))
+    q_BS, _ = build.mounting(scenario)
+    return quat.normalize(quat.multiply(q_IS, quat.conjugate(q_BS)))
+
+
 def prepare(scenario, overrides=(), star_catalog=None):
     """Validate ``scenario`` and compute everything that does not depend on the seed."""
     scenario = resolve_scenario(scenario, overrides)
@@ -82,7 +96,7 @@ def prepare(scenario, overrides=(), star_catalog=None):
     factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
     n_gyro = int(round(scenario["duration_s"] * gyro_hz))
     dt = 1.0 / gyro_hz
-    q0 = quat.normalize(scenario["truth"]["initial_q_IB"])
+    q0 = initial_attitude(scenario)
     t_truth = np.arange(n_gyro * factor + 1) / (gyro_hz * factor)
     q_truth, _ = build.truth_profile(scenario).simulate(t_truth, q0)
     if scenario["star_sensor"]["measurement"] == "stars" and star_catalog is None:
@@ -140,6 +154,14 @@ def simulate(prepared, seed):
         if probes is not None:
             summary["tracking_failure_probes"] = probes
             summary["paper_comparison"] = paper000_comparison(probes)
+        if extras["shadow"] is not None or any(extras["solver_errors"].values()):
+            shadow_error = None
+            if extras["shadow"] is not None:
+                shadow_error = quat.attitude_error(extras["shadow"]["q_est"], log["q_true"])
+                log["attitude_error_without_stacking"] = shadow_error
+            dim = dim_star_statistics(extras, log["attitude_error"], shadow_error, log["t"] >= scenario["settle_s"])
+            summary["dim_star"] = dim
+            summary["paper_comparison"] = summary.get("paper_comparison", []) + paper004_comparison(dim)
     summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     series = {key: value for key, value in log.items() if key != "P"}
     series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()

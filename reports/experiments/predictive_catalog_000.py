@@ -183,7 +183,7 @@ def main(argv=None):
     axis.axvline(tolerance / DEG, color="C1", ls="--", label=f"claimed: delta + (sqrt2 - 1) rho_sub = {tolerance / DEG:.2f} deg")
     axis.set_xlabel("prior boresight error [deg]")
     axis.set_ylabel("recognition rate [%]")
-    axis.set_title("000 §4: predicted sub-catalog recognition vs prior error (guide-star frames, 7 stars)")
+    axis.set_title("000 §4: predicted sub-catalog recognition vs prior error\n(guide-star frames, 7 stars, 1 px)", fontsize=10)
     axis.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(args.out / "predictive_catalog_000.png", dpi=120)

@@ -329,7 +329,8 @@ class PatternMatcher:
 
         The first ``max_groups`` groups of a pass over all anchors are verified; if none is accepted,
         anchor by anchor (brightest first) the groups of up to 4 ``max_groups`` found with that anchor;
-        then the triangles collected on the way.  If nothing is accepted among the brightest
+        then the triangles collected on the way (up to 4 ``max_triangles`` per anchor, the 32
+        ``max_triangles`` brightest verified).  If nothing is accepted among the brightest
         ``pattern_stars``, the same with twice as many stars.
         """
         first = min(len(frame), self.pattern_stars)
@@ -346,19 +347,19 @@ class PatternMatcher:
             if verified is not None:
                 return verified
             triangles = list(zip(found.triangles_obs, found.triangles_cat))
-            if len(found.groups_obs) < self.max_groups:
-                anchors = ()  # the pass ran to its end: every group was tried
+            if len(found.groups_obs) < self.max_groups and len(found.triangles_obs) < self.max_triangles:
+                anchors = ()  # the pass ran to its end within both budgets: every group and triangle is known
             else:  # ... then anchor by anchor, so that false groups of one anchor cannot hide the rest
                 anchors = range(n - 2)
             for anchor in anchors:
-                found = search(obs, beta, gate, table, self.guide_vectors, 4 * self.max_groups, self.max_triangles,
-                               self._workspace, (anchor, anchor + 1), candidates)
+                found = search(obs, beta, gate, table, self.guide_vectors, 4 * self.max_groups,
+                               4 * self.max_triangles, self._workspace, (anchor, anchor + 1), candidates)
                 triangles.extend(zip(found.triangles_obs, found.triangles_cat))
                 verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
                 if verified is not None:
                     return verified
             triangles.sort(key=lambda t: int(t[0].sum()))
-            verified = self._first_verified(frame, triangles[: 4 * self.max_triangles], n_hypotheses, tried)
+            verified = self._first_verified(frame, triangles[: 32 * self.max_triangles], n_hypotheses, tried)
             if verified is not None:
                 return verified
         return None

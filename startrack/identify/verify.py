@@ -7,9 +7,9 @@ Steps (the verification of the issue; the same for lost-in-space, sub-catalog an
 2. match: each centroid to its nearest predicted star and back (mutual nearest neighbours, so the
    matching is one-to-one), kept only within the gate; outliers are the centroids outside it;
 3. refit: match within 3 r of the hypothesis and refit the attitude by SVD (Wahba's problem,
-   Markley 1988) with every matched star, then match within r and refit again; matches the last
-   refit puts outside r are dropped and the attitude refitted once more (tracking first matches
-   within its window);
+   Markley 1988) with every matched star, then match within r and refit again, repeated while it
+   adds stars; matches the last refit puts outside r are dropped and the attitude refitted once
+   more (tracking first matches within its window);
 4. accept: only if the false-match probability (:func:`false_match_probability`) is below a threshold.
 
 Probability model.  Under a *wrong* attitude hypothesis the centroids are unrelated to the predicted
@@ -222,26 +222,37 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     return keep[:count], v_S[keep[:count]]
 
 
+#: Repetitions of the final-gate pass of :func:`match_and_refit` allowed while they add stars.
+_EXTRA_PASSES = 3
+
+
 @njit
 def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px):  # pragma: no cover  (compiled)
     """Predict, match (mutual nearest within each gate of ``pass_gates`` [rad] in turn) and refit by SVD.
 
-    Each pass predicts with the field grown by its gate, matches, and refits with every match; a last
-    check drops matches outside the final gate and refits.  Returns (ok, R_IS, obs indices, star
+    Each pass predicts with the field grown by its gate, matches, and refits with every match; the
+    final gate is repeated (up to ``_EXTRA_PASSES`` times) while it adds stars, since a first fit from
+    a few stars may leave distant ones outside the gate; a last check drops matches outside the final
+    gate and refits.  Returns (ok, R_IS, obs indices, star
     indices, number of stars predicted in the field); ok is False below 3 matches.
     """
     empty = np.zeros(0, np.int64)
     n_predicted = 0
     obs_index = empty
     star_index = empty
-    for gate in pass_gates:
+    n_passes = pass_gates.size + _EXTRA_PASSES
+    for p in range(n_passes):
+        gate = pass_gates[min(p, pass_gates.size - 1)]
         index, pred_S = predict(stars_I, R_IS, camera_params, gate * focal_px)
         n_predicted = index.size
+        previous = obs_index.size
         obs_index, pred_index = match_nearest(obs_S, pred_S, gate)
         if obs_index.size < 3:
             return False, R_IS, empty, empty, n_predicted
         star_index = index[pred_index]
         R_IS = wahba_svd(stars_I[star_index], obs_S[obs_index])
+        if p >= pass_gates.size - 1 and obs_index.size <= previous:
+            break  # the final gate no longer adds stars
     cos_gate = np.cos(pass_gates[-1])
     keep = np.empty(obs_index.size, np.bool_)
     for m in range(obs_index.size):

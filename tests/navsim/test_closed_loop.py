@@ -107,3 +107,23 @@ def test_frame_faults_need_image_fidelity(base_scenario):
     base_scenario["faults"] = {"attitude_jumps": [{"time_s": 1.0, "angle_deg": 2.0}]}
     with pytest.raises(InputError, match="faults.attitude_jumps: needs star_sensor.fidelity = 'image'"):
         navsim.run(base_scenario)
+
+
+def test_paper004_dim_star_is_stacked_and_fused():
+    """004's four stars only: once C leaves, A and B plus the dim X stacked over 4 frames (eq. 13-18)
+    keep three stars in the update; the shadow filter without X runs beside it."""
+    from pathlib import Path
+
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper004_dim_star.toml"
+    result = navsim.run(scenario, seed=1)
+    mode, t = modes(result), result.series["t"]
+    assert np.all(result.series["n_detected"][t < 1.4] == 3)  # A, B, C; X is under V_th alone
+    assert result.series["n_stacked"].sum() >= 2
+    assert np.any(mode == MODE_CODE["stacked"])
+    stacked = result.series["n_stacked"] == 1
+    assert np.all(result.series["n_identified"][stacked] == 3)  # two bright stars + the stacked one
+    dim = result.summary["dim_star"]
+    assert {"two_star_triad", "three_star_optimal", "filter_with_stacking", "filter_without_stacking"} <= set(dim)
+    assert "attitude_error_without_stacking" in result.series
+    rows = {row["quantity"] for row in result.summary["paper_comparison"]}
+    assert "three star optimal roll RMS [arcsec]" in rows
