@@ -7,7 +7,8 @@ catalog's magnitude limit) and three strategies, each an object with ``identify(
 * :class:`~startrack.identify.tracking.Tracking` -- needs ``prior.q_IS`` (and optionally a rate);
 * :class:`~startrack.identify.subcatalog.SubCatalog` -- needs a prior boresight (from ``prior.q_IS``
   or ``prior.boresight``);
-* :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing.
+* :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing; searches the guide catalog,
+  then (``dense_fallback``) the pairs of every field star.
 
 ``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
 vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
@@ -26,7 +27,7 @@ import numpy as np
 from startrack.attitude_angles import quaternion_from_matrix, radec_roll_from_matrix
 from startrack.errors import InputError
 from startrack.identify.features import FrameFeatures
-from startrack.identify.lost_in_space import LostInSpace, PatternMatcher
+from startrack.identify.lost_in_space import LostInSpace, PairTable, PatternMatcher
 from startrack.identify.result import IdentificationResult
 from startrack.identify.subcatalog import SubCatalog
 from startrack.identify.tracking import Tracking, propagate
@@ -98,13 +99,14 @@ class StarIdentifier:
     (1e-6); tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
     :data:`METHODS`; neighbours: search the 4 redundant sub-catalogs; field_stars: a
     :class:`~startrack.identify.verify.FieldStars` (default: every Hipparcos star with V <= field_mag_limit,
-    by default the catalog's magnitude limit).
+    by default the catalog's magnitude limit); dense_fallback: when the guide catalog finds nothing,
+    search the pairs of every field star (lost-in-space only; built at construction, ~0.2 s).
     """
 
     def __init__(self, catalog, camera, centroid_sigma_px=0.2, delta_sigmas=3.0, gate_sigmas=5.0,
                  pattern_stars=16, max_stars=None, max_groups=4, max_triangles=8,
                  false_match_threshold=DEFAULT_FALSE_MATCH_THRESHOLD, tracking_window_px=20.0,
-                 methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None):
+                 methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None, dense_fallback=True):
         self.catalog = catalog
         self.camera = camera
         self.centroid_sigma_px = _positive("centroid_sigma_px", centroid_sigma_px, 100.0)
@@ -130,13 +132,18 @@ class StarIdentifier:
                 catalog, camera, load_star_catalog(catalog.params.epoch),
                 catalog.params.mag_limit if field_mag_limit is None else _positive("field_mag_limit", field_mag_limit, 20.0))
         self.field = field_stars
-        matcher = PatternMatcher(catalog, self.field, self.pattern_stars, int(max_groups), int(max_triangles),
-                                 self.false_match_threshold)
+        matcher = PatternMatcher(catalog.guide_vectors, self.field, self.pattern_stars, int(max_groups),
+                                 int(max_triangles), self.false_match_threshold)
+        dense = None
+        if dense_fallback and "lost_in_space" in methods:
+            dense = (PatternMatcher(self.field.vectors, self.field, self.pattern_stars, int(max_groups),
+                                    int(max_triangles), self.false_match_threshold),
+                     PairTable.of_stars(self.field.vectors, catalog.params.theta_min, catalog.params.theta_max))
         available = {
             "tracking": Tracking(self.field, _positive("tracking_window_px", tracking_window_px, 1e4),
                                  self.false_match_threshold),
             "subcatalog": SubCatalog(catalog, matcher, neighbours),
-            "lost_in_space": LostInSpace(catalog, matcher),
+            "lost_in_space": LostInSpace(catalog, matcher, dense),
         }
         self.strategies = [available[m] for m in METHODS if m in methods]
         self._image_max = np.array([camera.width - 0.5, camera.height - 0.5])

@@ -31,6 +31,8 @@ import numpy as np
 
 from startrack.identify.verify import verify, wahba_svd
 from startrack.jit import njit
+from startrack.kvector import KVector
+from startrack.navigation_catalog import pattern_pairs
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +63,14 @@ class PairTable:
         kv = catalog.kvector
         return cls(catalog.pair_theta, catalog.pair_i, catalog.pair_j, kv.k.astype(np.int64), float(kv.slope),
                    float(kv.intercept))
+
+    @classmethod
+    def of_stars(cls, vectors, theta_min: float, theta_max: float) -> "PairTable":
+        """Every pair of the unit vectors (N, 3) with distance in [theta_min, theta_max] [rad] (000 §2.2),
+        with its own k-vector (eq. 3-4)."""
+        theta, first, second = pattern_pairs(vectors, theta_min, theta_max)
+        kv = KVector.build(theta, theta_min, theta_max)
+        return cls(theta, first, second, kv.k.astype(np.int64), float(kv.slope), float(kv.intercept))
 
     @classmethod
     def subset(cls, catalog, pair_index) -> "PairTable":
@@ -311,12 +321,15 @@ _PAIRS_OF = {3: np.triu_indices(3, 1), 4: np.triu_indices(4, 1)}
 class PatternMatcher:
     """Hypotheses from :func:`search` on a pair table, each verified until one is accepted.
 
-    The brightest ``pattern_stars`` centroids are searched first, anchor by anchor; if no hypothesis
-    is accepted the search is widened (:meth:`match`).  Holds a work array: one matcher per thread.
+    ``star_vectors`` (N, 3): the stars the pair tables index (the guide stars of the navigation
+    catalog, or the field stars for the dense fall-back).  The brightest ``pattern_stars`` centroids
+    are searched first, anchor by anchor; if no hypothesis is accepted the search is widened
+    (:meth:`match`).  Holds a work array: one matcher per thread.
     """
 
-    def __init__(self, catalog, field, pattern_stars: int, max_groups: int, max_triangles: int, threshold: float):
-        self.guide_vectors = np.ascontiguousarray(catalog.guide_vectors)
+    def __init__(self, star_vectors, field, pattern_stars: int, max_groups: int, max_triangles: int,
+                 threshold: float):
+        self.guide_vectors = np.ascontiguousarray(star_vectors)
         self.field = field
         self.pattern_stars = pattern_stars
         self.max_groups = max_groups
@@ -379,14 +392,25 @@ class PatternMatcher:
 
 
 class LostInSpace:
-    """Full-sky lost-in-space identification: the pattern search over every pair of the guide catalog."""
+    """Full-sky lost-in-space identification: the pattern search over every pair of the guide catalog.
+
+    With ``dense`` (a :class:`PatternMatcher` over the field stars and their :class:`PairTable`),
+    frames the guide catalog cannot identify -- fewer than 3 guide stars among the centroids, since the
+    uniform guide selection of 000 §2.1 keeps about half of the stars to the magnitude limit -- are
+    searched again over every field star.
+    """
 
     name = "lost_in_space"
 
-    def __init__(self, catalog, matcher: PatternMatcher):
+    def __init__(self, catalog, matcher: PatternMatcher, dense=None):
         self.table = PairTable.full_sky(catalog)
         self.matcher = matcher
+        self.dense = dense
 
     def identify(self, frame, prior):
         """Verified hypothesis or None; ``prior`` is not used."""
-        return self.matcher.match(frame, self.table)
+        verified = self.matcher.match(frame, self.table)
+        if verified is None and self.dense is not None:
+            dense_matcher, dense_table = self.dense
+            verified = dense_matcher.match(frame, dense_table)
+        return verified

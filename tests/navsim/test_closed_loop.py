@@ -121,7 +121,8 @@ def test_paper004_dim_star_is_stacked_and_fused():
     assert result.series["n_stacked"].sum() >= 2
     assert np.any(mode == MODE_CODE["stacked"])
     stacked = result.series["n_stacked"] == 1
-    assert np.all(result.series["n_identified"][stacked] == 3)  # two bright stars + the stacked one
+    assert np.all(result.series["n_identified"][stacked] == 2)  # A and B ...
+    assert np.all(result.series["n_measurements"][stacked] == 3)  # ... and the stacked X in the update
     dim = result.summary["dim_star"]
     assert {"two_star_triad", "three_star_optimal", "filter_with_stacking", "filter_without_stacking"} <= set(dim)
     assert "attitude_error_without_stacking" in result.series

@@ -113,3 +113,21 @@ def test_contest_star_maps_of_001():
         result = identifier.solve(frame.uv, frame.flux)
         assert result.ok, result.reason
         np.testing.assert_array_equal(frame.hip[result.matches[:, 0]], result.matches[:, 1])
+
+
+def test_frames_with_two_guide_stars_need_the_dense_fall_back(setup):
+    """Keep only 2 guide stars of each frame: the guide catalog cannot identify it, the field stars can."""
+    catalog, camera, stars, identifier = setup
+    no_fallback = StarIdentifier(catalog, camera, centroid_sigma_px=SIGMA_PX, dense_fallback=False)
+    guide = set(catalog.guide_hip.tolist())
+    rng = np.random.default_rng(22)
+    for _ in range(5):
+        frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, SIGMA_PX,
+                               n_false=2)
+        is_guide = np.array([h in guide for h in frame.hip])
+        keep = ~is_guide | (np.cumsum(is_guide) <= 2)
+        uv, flux, hip = frame.uv[keep], frame.flux[keep], frame.hip[keep]
+        assert no_fallback.solve(uv, flux).status == "no_match"
+        result = identifier.solve(uv, flux)
+        assert result.ok and result.method == "lost_in_space"
+        np.testing.assert_array_equal(hip[result.matches[:, 0]], result.matches[:, 1])
