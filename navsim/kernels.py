@@ -295,6 +295,48 @@ def joseph_update(P, H, R, z):
 
 
 @njit
+def joseph_update_attitude(P, R, z):
+    """:func:`joseph_update` for H = [I₃ 0] (an attitude fix, no mounting state), in O(n²):
+    S = P₁₁ + R, K = P[:, :3] S⁻¹, M = P − K P[:3, :], P⁺ = M − M[:, :3] Kᵀ + K R Kᵀ."""
+    n = P.shape[0]
+    S = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            S[i, j] = P[i, j] + R[i, j]
+    S_inv = inverse_small(S)
+    K = np.zeros((n, 3))
+    for i in range(n):
+        for j in range(3):
+            for m in range(3):
+                K[i, j] += P[i, m] * S_inv[m, j]
+    dx = np.zeros(n)
+    for i in range(n):
+        dx[i] = K[i, 0] * z[0] + K[i, 1] * z[1] + K[i, 2] * z[2]
+    M = P.copy()
+    for i in range(n):
+        for j in range(n):
+            M[i, j] -= K[i, 0] * P[0, j] + K[i, 1] * P[1, j] + K[i, 2] * P[2, j]
+    KR = np.zeros((n, 3))
+    for i in range(n):
+        for j in range(3):
+            for m in range(3):
+                KR[i, j] += K[i, m] * R[m, j]
+    P_next = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            acc = M[i, j]
+            for m in range(3):
+                acc += (KR[i, m] - M[i, m]) * K[j, m]
+            P_next[i, j] = acc
+    for i in range(n):
+        for j in range(i + 1, n):
+            value = 0.5 * (P_next[i, j] + P_next[j, i])
+            P_next[i, j] = value
+            P_next[j, i] = value
+    return dx, P_next
+
+
+@njit
 def star_residuals(q_IB, R_BS, ref_I, obs_S, n, mis_start):
     """Tangent-plane residuals of identified stars and their Jacobians.
 
@@ -377,7 +419,10 @@ def attitude_update(q, b, s, q_BS, P, q_IS, R_S, gate, sf_start, mis_start):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
         return q, b, s, q_BS, P, z, nis, False
-    dx, P_next = joseph_update(P, H, R, z)
+    if mis_start >= 0:
+        dx, P_next = joseph_update(P, H, R, z)
+    else:
+        dx, P_next = joseph_update_attitude(P, R, z)
     q, b, s, q_BS = reset(q, b, s, q_BS, dx, sf_start, mis_start)
     return q, b, s, q_BS, P_next, z, nis, True
 
@@ -518,3 +563,32 @@ def run_filter(q, b, s, q_BS, P, omega, ratio, dt, arw, rrw, sf_rw, q_scale, sf_
         b_log[f] = b
         P_log[f] = P
     return q_log, b_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
+
+
+@njit
+def quadratic_forms(P, e):
+    """eᵢᵀ Pᵢ⁻¹ eᵢ for each i of P (N, m, m) symmetric positive definite and e (N, m), by
+    Cholesky factorisation (NEES of the logged covariances)."""
+    count, m = e.shape
+    out = np.empty(count)
+    L = np.empty((m, m))
+    y = np.empty(m)
+    for i in range(count):
+        for r in range(m):
+            for c in range(r + 1):
+                acc = P[i, r, c]
+                for k in range(c):
+                    acc -= L[r, k] * L[c, k]
+                if r == c:
+                    L[r, r] = np.sqrt(acc)
+                else:
+                    L[r, c] = acc / L[c, c]
+        total = 0.0
+        for r in range(m):
+            acc = e[i, r]
+            for k in range(r):
+                acc -= L[r, k] * y[k]
+            y[r] = acc / L[r, r]
+            total += y[r] * y[r]
+        out[i] = total
+    return out

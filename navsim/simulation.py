@@ -227,8 +227,7 @@ def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1
 def nees(log):
     """Normalised estimation error squared of attitude and bias (6 dof) at every frame."""
     e = np.concatenate([log["attitude_error"], log["bias_true"] - log["bias_est"]], axis=1)
-    P = log["P"][:, :NEES_DOF, :NEES_DOF]
-    return np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
+    return kernels.quadratic_forms(np.ascontiguousarray(log["P"][:, :NEES_DOF, :NEES_DOF]), e)
 
 
 def summarize(scenario, seed, log, R_BS):

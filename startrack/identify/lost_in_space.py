@@ -334,48 +334,58 @@ class PatternMatcher:
         self.pattern_stars = pattern_stars
         self.max_groups = max_groups
         self.max_triangles = max_triangles
+        self.triangle_budget = 32 * max_triangles  # triangles kept by a full pass and verified at most
         self.threshold = threshold
         self._workspace = new_workspace(len(self.guide_vectors), 2 * pattern_stars)
 
-    def match(self, frame, table: PairTable):
+    def match(self, frame, table: PairTable, widths=(1, 2), triangles=True):
         """A :class:`startrack.identify.verify.Verified` for ``frame`` (:class:`FrameFeatures`) or None.
 
-        The first ``max_groups`` groups of a pass over all anchors are verified; if none is accepted,
-        anchor by anchor (brightest first) the groups of up to 4 ``max_groups`` found with that anchor;
-        then the triangles collected on the way (up to 4 ``max_triangles`` per anchor, the 32
-        ``max_triangles`` brightest verified).  If nothing is accepted among the brightest
-        ``pattern_stars``, the same with twice as many stars.
+        For each width w of ``widths`` in turn, the brightest w ``pattern_stars`` centroids: the first
+        ``max_groups`` groups of a pass over all anchors are verified; if none is accepted and the pass
+        stopped at that budget, anchor by anchor (brightest first) the groups of up to 4
+        ``max_groups`` found with that anchor; then, with ``triangles``, the triangles collected on the
+        way (the 32 ``max_triangles`` brightest verified).
         """
-        first = min(len(frame), self.pattern_stars)
-        wide = min(len(frame), 2 * self.pattern_stars)
         tried = set()
-        for n in (first, wide) if wide > first else (first,):
-            obs, beta, gate = frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n]
-            candidates = pair_candidates(beta, gate, table)
-            n_hypotheses = candidates[-1]
-            # Fast path: the first groups over all anchors (one pass for most frames) ...
-            found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, self.max_triangles,
-                           self._workspace, None, candidates)
-            verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
-            if verified is not None:
-                return verified
-            triangles = list(zip(found.triangles_obs, found.triangles_cat))
-            if len(found.groups_obs) < self.max_groups and len(found.triangles_obs) < self.max_triangles:
-                anchors = ()  # the pass ran to its end within both budgets: every group and triangle is known
-            else:  # ... then anchor by anchor, so that false groups of one anchor cannot hide the rest
-                anchors = range(n - 2)
-            for anchor in anchors:
-                found = search(obs, beta, gate, table, self.guide_vectors, 4 * self.max_groups,
-                               4 * self.max_triangles, self._workspace, (anchor, anchor + 1), candidates)
-                triangles.extend(zip(found.triangles_obs, found.triangles_cat))
-                verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
-                if verified is not None:
-                    return verified
-            triangles.sort(key=lambda t: int(t[0].sum()))
-            verified = self._first_verified(frame, triangles[: 32 * self.max_triangles], n_hypotheses, tried)
+        done = 0
+        for width in widths:
+            n = min(len(frame), width * self.pattern_stars)
+            if n <= done:
+                continue
+            done = n
+            verified = self._match_stars(frame, table, n, tried, triangles)
             if verified is not None:
                 return verified
         return None
+
+    def _match_stars(self, frame, table, n, tried, with_triangles):
+        """:meth:`match` for the brightest ``n`` centroids."""
+        obs, beta, gate = frame.obs_S[:n], frame.beta[:n, :n], frame.gate[:n, :n]
+        candidates = pair_candidates(beta, gate, table)
+        n_hypotheses = candidates[-1]
+        # Fast path: the first groups over all anchors (one pass for most frames) ...
+        budget = self.triangle_budget if with_triangles else 0
+        found = search(obs, beta, gate, table, self.guide_vectors, self.max_groups, budget, self._workspace, None,
+                       candidates)
+        verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
+        if verified is not None:
+            return verified
+        triangles = list(zip(found.triangles_obs, found.triangles_cat))
+        if len(found.groups_obs) < self.max_groups:
+            anchors = ()  # the pass ran to its end: every group and (up to the budget) triangle is known
+        else:  # ... then anchor by anchor, so that false groups of one anchor cannot hide the rest
+            anchors = range(n - 2)
+        for anchor in anchors:
+            found = search(obs, beta, gate, table, self.guide_vectors, 4 * self.max_groups,
+                           4 * self.max_triangles if with_triangles else 0, self._workspace, (anchor, anchor + 1),
+                           candidates)
+            triangles.extend(zip(found.triangles_obs, found.triangles_cat))
+            verified = self._first_verified(frame, zip(found.groups_obs, found.groups_cat), n_hypotheses, tried)
+            if verified is not None:
+                return verified
+        triangles.sort(key=lambda t: int(t[0].sum()))
+        return self._first_verified(frame, triangles[: self.triangle_budget], n_hypotheses, tried)
 
     def _first_verified(self, frame, hypotheses, n_hypotheses, tried):
         """The first hypothesis (observed indices, guide indices) not tried before that verifies, or None."""
@@ -408,9 +418,20 @@ class LostInSpace:
         self.dense = dense
 
     def identify(self, frame, prior):
-        """Verified hypothesis or None; ``prior`` is not used."""
-        verified = self.matcher.match(frame, self.table)
-        if verified is None and self.dense is not None:
-            dense_matcher, dense_table = self.dense
-            verified = dense_matcher.match(frame, dense_table)
-        return verified
+        """Verified hypothesis or None; ``prior`` is not used.
+
+        Order: the guide catalog with the brightest ``pattern_stars`` centroids, the field stars with
+        as many, then both with twice as many (a frame whose brightest stars hold too few guide stars
+        is solved sooner by the dense table than by a wider guide search).  With the dense table the
+        guide catalog is searched for four-star groups only; the dense search also verifies triangles.
+        """
+        if self.dense is None:
+            return self.matcher.match(frame, self.table)
+        dense_matcher, dense_table = self.dense
+        for width in (1, 2):
+            verified = self.matcher.match(frame, self.table, (width,), triangles=False)
+            if verified is None:
+                verified = dense_matcher.match(frame, dense_table, (width,))
+            if verified is not None:
+                return verified
+        return None

@@ -245,3 +245,21 @@ def test_misalignment_state_is_estimated_under_rotation(base_scenario):
     assert np.all(sigma_m < 20.0)  # from 120 arcsec
     lo, hi = result.summary["nees"]["band_95"]
     assert lo < result.summary["nees"]["mean"] < hi
+
+
+def test_attitude_fix_joseph_shortcut_equals_the_general_form():
+    P = random_spd(9)
+    R = np.diag([1e-9, 2e-9, 4e-9])
+    z = RNG.standard_normal(3) * 1e-4
+    H = np.hstack([np.eye(3), np.zeros((3, 6))])
+    dx, P_general = kernels.joseph_update(P, H, R, z)
+    dx_short, P_short = kernels.joseph_update_attitude(P, R, z)
+    np.testing.assert_allclose(dx_short, dx, rtol=1e-10, atol=1e-20)
+    np.testing.assert_allclose(P_short, P_general, rtol=1e-9, atol=1e-24)
+
+
+def test_quadratic_forms_equal_a_linear_solve():
+    P = np.array([random_spd(6) for _ in range(20)])
+    e = RNG.standard_normal((20, 6)) * 1e-4
+    expected = np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
+    np.testing.assert_allclose(kernels.quadratic_forms(P, e), expected, rtol=1e-9)
