@@ -1,18 +1,23 @@
 """navsim: the INS / star-sensor navigation system simulator.
 
-Truth attitude motion, gyro models, quaternion kinematics (RK4), the multiplicative
-error-state Kalman filter, scenarios and the ``navsim`` command line.
+Truth attitude motion, gyro models, quaternion kinematics (RK4), the multiplicative error-state
+Kalman filter, the closed loop that runs the star sensor inside the simulation, faults, scenarios,
+Monte Carlo campaigns, filter tuning and the ``navsim`` command line.
 
     >>> import navsim
-    >>> result = navsim.run("scenarios/demo.toml", seed=1, overrides={"duration_s": 20})
+    >>> result = navsim.run("scenarios/paper000_high_dynamic.toml", seed=1, overrides={"duration_s": 20})
     >>> result.summary["cross_boresight_rms_arcsec"]   # doctest: +SKIP
+
+PDF reports live in :mod:`navsim.report` (not imported here: it loads matplotlib and typst).
 """
 
 from navsim.filter import AttitudeFilter
 from navsim.gyro import GyroModel
+from navsim.montecarlo import run_campaign
 from navsim.output import read_npz, write_run
 from navsim.scenario import Scenario, load_scenario
-from navsim.simulation import RunResult, run
+from navsim.simulation import RunResult, prepare, run, run_batch, simulate
+from navsim.tuning import tune
 
 __all__ = [
     "AttitudeFilter",
@@ -20,7 +25,12 @@ __all__ = [
     "RunResult",
     "Scenario",
     "load_scenario",
+    "prepare",
     "read_npz",
     "run",
+    "run_batch",
+    "run_campaign",
+    "simulate",
+    "tune",
     "write_run",
 ]

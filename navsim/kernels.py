@@ -8,7 +8,7 @@ tested against its numpy / filterpy counterpart. Conventions are those of DESIGN
 
 import numpy as np
 
-from navsim.jit import njit
+from startrack.jit import njit
 
 
 @njit

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from startrack.errors import InputError
+from startrack.sphere import local_frame
 
 #: Order of the redundant neighbours returned by :func:`redundant_neighbours`.
 NEIGHBOUR_DIRECTIONS = ("east", "west", "north", "south")
@@ -181,13 +182,7 @@ def offset_directions(ra, dec, distance):
     north/south along the meridian (crossing the pole if needed). Returns two
     arrays of shape (..., 4) in :data:`NEIGHBOUR_DIRECTIONS` order.
     """
-    ra = np.asarray(ra, dtype=float)
-    dec = np.asarray(dec, dtype=float)
-    sin_a, cos_a = np.sin(ra), np.cos(ra)
-    sin_d, cos_d = np.sin(dec), np.cos(dec)
-    u = np.stack([cos_d * cos_a, cos_d * sin_a, sin_d], axis=-1)
-    east = np.stack([-sin_a, cos_a, np.zeros_like(ra)], axis=-1)
-    north = np.stack([-sin_d * cos_a, -sin_d * sin_a, cos_d], axis=-1)
+    u, east, north = local_frame(ra, dec)
     directions = np.stack([east, -east, north, -north], axis=-2)  # (..., 4, 3)
     moved = np.cos(distance) * u[..., None, :] + np.sin(distance) * directions
     new_ra = np.mod(np.arctan2(moved[..., 1], moved[..., 0]), 2.0 * np.pi)

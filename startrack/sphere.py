@@ -31,3 +31,16 @@ def angular_distance(a, b):
     cross = np.linalg.norm(np.cross(a, b), axis=-1)
     dot = np.sum(a * b, axis=-1)
     return np.arctan2(cross, dot)
+
+
+def local_frame(ra, dec):
+    """Unit vectors (..., 3) of the local frame at (ra, dec) [rad]: the direction u, east (increasing
+    RA along the parallel) and north (increasing Dec along the meridian)."""
+    ra = np.asarray(ra, dtype=float)
+    dec = np.asarray(dec, dtype=float)
+    sin_a, cos_a = np.sin(ra), np.cos(ra)
+    sin_d, cos_d = np.sin(dec), np.cos(dec)
+    u = np.stack([cos_d * cos_a, cos_d * sin_a, sin_d], axis=-1)
+    east = np.stack([-sin_a, cos_a, np.zeros_like(ra)], axis=-1)
+    north = np.stack([-sin_d * cos_a, -sin_d * sin_a, cos_d], axis=-1)
+    return u, east, north

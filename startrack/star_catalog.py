@@ -55,7 +55,7 @@ import numpy as np
 
 from startrack.cache import cache_dir
 from startrack.errors import InputError
-from startrack.sphere import vector_to_radec
+from startrack.sphere import local_frame, vector_to_radec
 
 #: Epoch of the Hipparcos-2 astrometry [Julian year].
 HIPPARCOS_EPOCH = 1991.25
@@ -129,13 +129,7 @@ def propagate_proper_motion(ra, dec, pm_ra_cosdec, pm_dec, years):
     Linear motion on the tangent plane, renormalised (space motion without
     radial velocity); see the module docstring.
     """
-    ra = np.asarray(ra, dtype=float)
-    dec = np.asarray(dec, dtype=float)
-    sin_a, cos_a = np.sin(ra), np.cos(ra)
-    sin_d, cos_d = np.sin(dec), np.cos(dec)
-    u = np.stack([cos_d * cos_a, cos_d * sin_a, sin_d], axis=-1)
-    east = np.stack([-sin_a, cos_a, np.zeros_like(ra)], axis=-1)
-    north = np.stack([-sin_d * cos_a, -sin_d * sin_a, cos_d], axis=-1)
+    u, east, north = local_frame(ra, dec)
     v = u + years * (np.asarray(pm_ra_cosdec)[..., None] * east + np.asarray(pm_dec)[..., None] * north)
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
