@@ -7,8 +7,9 @@ For the brightest centroids of a frame (brightest first):
    (the k-vector of 000 eq. 3-5 for the full sky, a binary search in a sub-catalog);
 2. triangles (001 §4.4.2): catalog pairs matched to the observed pairs (i, j) and (i, k) that share
    the catalog star A of i form a candidate triangle (A, B, C); it is kept when the distance (B, C)
-   lies within the gate of (j, k) and it has the handedness of the observed triangle (a mirror image
-   is not a rotation);
+   (from the catalog vectors, so it may exceed the table's theta_max, e.g. across the diagonal of a
+   square field) lies within the gate of (j, k) and the triangle has the handedness of the observed
+   one (a mirror image is not a rotation);
 3. higher-order star groups (001 §4.4.3; the fourth star of the pyramid algorithm): a triangle is
    extended by any other centroid r with a catalog star D matched to (i, r) whose distances to B and
    C also lie within the gates of (j, r) and (k, r): the four-star group ijkr, all six distances
@@ -20,7 +21,12 @@ then k), and stops after a few groups per anchor, which are verified before the 
 searched: a false star or a star missing from the guide catalog as anchor costs one short pass.  The
 groups of an anchor are ordered by the sum of their brightness ranks and, among equals, best
 conditioned first (smallest sum of the six gates, which grow for short and badly measured pairs);
-triangles are verified only when no group was accepted.
+triangles are verified only when no group was accepted.  The common case -- the first groups of the
+brightest stars, verified -- runs as one compiled call (:meth:`PatternMatcher.match_fast`).
+
+The guide catalog holds about half of the stars to the magnitude limit (000 §2.1 keeps one star per
+base point), so a frame may show fewer than 3 guide stars among its brightest centroids; the full-sky
+search then continues over the pairs of every field star (:class:`LostInSpace`, ``dense``).
 """
 
 from __future__ import annotations
@@ -29,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.identify.verify import verify, wahba_svd
+from startrack.identify.verify import Verified, verify, verify_near, wahba_svd
 from startrack.jit import njit
 from startrack.kvector import KVector
 from startrack.navigation_catalog import pattern_pairs
@@ -264,6 +270,39 @@ def _group_search(obs, beta, gate, lo, hi, cos_low, cos_high, theta, first, seco
     return groups[:n_groups], triangles[:n_triangles]
 
 
+@njit
+def _fast_lost_in_space(obs_S, n, beta, gate, theta, first, second, k, slope, intercept, guide, max_groups, head,
+                        partners, field_vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
+                        threshold):  # pragma: no cover  (compiled)
+    """The fast path of :meth:`PatternMatcher.match` in one compiled call: candidates, the first
+    ``max_groups`` groups of the brightest ``n`` centroids over all anchors, each verified
+    (:func:`startrack.identify.verify.verify_near`) in rank order until one is accepted.
+    Returns (ok, R_IS, obs indices, field-star indices, P_false, stars predicted in the field, groups
+    found)."""
+    obs = obs_S[:n].copy()
+    beta_n = beta[:n, :n].copy()
+    gate_n = gate[:n, :n].copy()
+    lo, hi, cos_low, cos_high, n_hypotheses = _pair_candidates(beta_n, gate_n, theta, k, slope, intercept)
+    groups, _ = _group_search(obs, beta_n, gate_n, lo, hi, cos_low, cos_high, theta, first, second, guide, 0, n,
+                              max_groups, 0, head, partners)
+    rank = np.empty(groups.shape[0])
+    for g in range(groups.shape[0]):  # rank sum, then (tie-break) the sum of the six gates, scaled below 1
+        gates = 0.0
+        for a in range(4):
+            for b in range(a + 1, 4):
+                gates += gate_n[groups[g, a], groups[g, b]]
+        rank[g] = groups[g, 0] + groups[g, 1] + groups[g, 2] + groups[g, 3] + gates / (1.0 + gates)
+    for g in np.argsort(rank):
+        R_IS = wahba_svd(guide[groups[g, 4:]], obs[groups[g, :4]])
+        ok, R_IS, obs_index, star_index, probability, n_predicted = verify_near(
+            obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
+            n_hypotheses, threshold, 2)
+        if ok:
+            return True, R_IS, obs_index, star_index, probability, n_predicted, groups.shape[0]
+    empty = np.zeros(0, np.int64)
+    return False, np.eye(3), empty, empty, 1.0, 0, groups.shape[0]
+
+
 def new_workspace(n_guide: int, n_stars: int):
     """Work arrays of :func:`search` for up to ``n_stars`` stars: list heads (-1) and partner bit masks (0)."""
     if n_stars > 63:
@@ -387,6 +426,22 @@ class PatternMatcher:
         triangles.sort(key=lambda t: int(t[0].sum()))
         return self._first_verified(frame, triangles[: self.triangle_budget], n_hypotheses, tried)
 
+    def match_fast(self, frame, table: PairTable):
+        """The fast path of :meth:`match` (first groups of the brightest ``pattern_stars``, all anchors)
+        in one compiled call: (a :class:`~startrack.identify.verify.Verified` or None, whether every
+        group of those stars was tried)."""
+        n = min(len(frame), self.pattern_stars)
+        field = self.field
+        ok, R_IS, obs_index, star_index, probability, n_predicted, n_groups = _fast_lost_in_space(
+            frame.obs_S, n, frame.beta, frame.gate, table.theta, table.first, table.second, table.k, table.slope,
+            table.intercept, self.guide_vectors, self.max_groups, *self._workspace, field.vectors,
+            field.cos_field_radius, field.camera_params, np.array([3.0 * frame.verify_gate, frame.verify_gate]),
+            field.camera.focal_px, field.solid_angle, self.threshold)
+        if not ok:
+            return None, n_groups < self.max_groups
+        return Verified(R_IS=R_IS, obs_index=obs_index, star_index=star_index, false_match_probability=probability,
+                        n_predicted=int(n_predicted)), True
+
     def _first_verified(self, frame, hypotheses, n_hypotheses, tried):
         """The first hypothesis (observed indices, guide indices) not tried before that verifies, or None."""
         for obs_index, cat_index in hypotheses:
@@ -420,18 +475,24 @@ class LostInSpace:
     def identify(self, frame, prior):
         """Verified hypothesis or None; ``prior`` is not used.
 
-        Order: the guide catalog with the brightest ``pattern_stars`` centroids, the field stars with
+        Order: the compiled fast path (:meth:`PatternMatcher.match_fast`), then the guide catalog
+        with the brightest ``pattern_stars`` centroids, the field stars with
         as many, then both with twice as many (a frame whose brightest stars hold too few guide stars
         is solved sooner by the dense table than by a wider guide search).  With the dense table the
         guide catalog is searched for four-star groups only; the dense search also verifies triangles.
         """
+        verified, exhausted = self.matcher.match_fast(frame, self.table)
+        if verified is not None:
+            return verified
         if self.dense is None:
             return self.matcher.match(frame, self.table)
         dense_matcher, dense_table = self.dense
         for width in (1, 2):
-            verified = self.matcher.match(frame, self.table, (width,), triangles=False)
-            if verified is None:
-                verified = dense_matcher.match(frame, dense_table, (width,))
+            if not (width == 1 and exhausted):  # the fast path already tried every group of these stars
+                verified = self.matcher.match(frame, self.table, (width,), triangles=False)
+                if verified is not None:
+                    return verified
+            verified = dense_matcher.match(frame, dense_table, (width,))
             if verified is not None:
                 return verified
         return None

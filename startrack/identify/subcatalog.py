@@ -52,7 +52,10 @@ class SubCatalog:
         if not (math.isfinite(ra) and math.isfinite(dec)):
             return None
         for b in self.cells(ra, dec):
-            verified = self.matcher.match(frame, self._tables(b))
+            table = self._tables(b)
+            verified, exhausted = self.matcher.match_fast(frame, table)
+            if verified is None:
+                verified = self.matcher.match(frame, table, widths=(2,) if exhausted else (1, 2))
             if verified is not None:
                 return verified
         return None

@@ -127,7 +127,8 @@ def wahba_svd(ref_I, obs_S):  # pragma: no cover  (compiled)
     return R_IS
 
 
-def binomial_tail(n: int, k: int, p: float) -> float:
+@njit
+def binomial_tail(n, k, p):
     """P[Binomial(n, p) >= k], summed term by term from k upwards (accurate for tiny p)."""
     if k <= 0:
         return 1.0
@@ -148,8 +149,8 @@ def binomial_tail(n: int, k: int, p: float) -> float:
     return min(total, 1.0)
 
 
-def false_match_probability(n_other: int, n_matched_other: int, gate: float, density: float,
-                            n_hypotheses: int) -> float:
+@njit
+def false_match_probability(n_other, n_matched_other, gate, density, n_hypotheses):
     """P_false of the module model: min(1, N_h P[Binomial(n_other, p) >= K]).
 
     n_other: centroids besides the two seed stars; n_matched_other: K, those matched; gate: r [rad];
@@ -157,6 +158,30 @@ def false_match_probability(n_other: int, n_matched_other: int, gate: float, den
     """
     p = -math.expm1(-density * 2.0 * math.pi * (1.0 - math.cos(gate)))
     return min(1.0, max(n_hypotheses, 1) * binomial_tail(n_other, n_matched_other, p))
+
+
+@njit
+def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
+                n_hypotheses, threshold, n_seed):  # pragma: no cover  (compiled)
+    """:func:`verify` in one compiled call, the field stars taken by brute force (all within the field
+    radius of the boresight, ``cos_field_radius`` its cosine); returns (ok, R_IS, obs indices, star
+    indices into ``field_vectors``, P_false, stars predicted in the field)."""
+    boresight = R_IS[:, 2].copy()
+    near = np.empty(field_vectors.shape[0], np.int64)
+    count = 0
+    for s in range(field_vectors.shape[0]):
+        if (field_vectors[s, 0] * boresight[0] + field_vectors[s, 1] * boresight[1]
+                + field_vectors[s, 2] * boresight[2]) >= cos_field_radius:
+            near[count] = s
+            count += 1
+    near = near[:count]
+    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
+        obs_S, field_vectors[near], R_IS, camera_params, pass_gates, focal_px)
+    if not ok:
+        return False, R_IS, obs_index, star_index, 1.0, n_predicted
+    probability = false_match_probability(max(obs_S.shape[0] - n_seed, 0), max(obs_index.size - n_seed, 0),
+                                          pass_gates[-1], max(n_predicted, 1) / solid_angle, n_hypotheses)
+    return probability <= threshold, R_IS, obs_index, near[star_index], probability, n_predicted
 
 
 @njit
@@ -270,6 +295,10 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
     return True, R_IS, obs_index, star_index, n_predicted
 
 
+#: Margin [rad] around the field radius within which :func:`verify_near` projects the field stars.
+_FIELD_MARGIN = 0.01
+
+
 def _field_radius(camera) -> float:
     """Largest angle [rad] between the boresight and an image corner (pixel edges included)."""
     corners = np.array([[-0.5, -0.5], [camera.width - 0.5, -0.5], [-0.5, camera.height - 0.5],
@@ -306,6 +335,7 @@ class FieldStars:
         self.hip = np.asarray(hip, dtype=np.int64)
         self.v_mag = np.asarray(v_mag, dtype=float)
         self.field_radius = _field_radius(camera)
+        self.cos_field_radius = math.cos(self.field_radius + _FIELD_MARGIN)  # brute-force neighbourhood of verify_near
         self.solid_angle = _field_solid_angle(camera)
         radius = self.field_radius + catalog.s_max
         pairs = cKDTree(catalog.base_vectors).sparse_distance_matrix(
