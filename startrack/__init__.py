@@ -2,7 +2,8 @@
 
 Hipparcos star catalog, navigation catalog (guide stars, k-vector pairs, sub-catalogs and their
 address index), camera and rendering, detection and centroiding, dim-star stacking, attitude
-determination and the boresight solves. Knows nothing of vehicles or filters (never imports
+determination and the boresight solves, star identification (full-sky lost-in-space, predicted
+sub-catalog, tracking). Knows nothing of vehicles or filters (never imports
 ``navsim``). Units: radians inside; degrees only at the command line.
 """
 
@@ -13,6 +14,7 @@ from startrack.camera import Camera
 from startrack.detection import Detections, detect, detect_windows, estimate_background
 from startrack.errors import InputError
 from startrack.fov_select import field_radius, radec_prefilter
+from startrack.identify import IdentificationResult, Prior, StarIdentifier
 from startrack.image_io import read_image, write_image
 from startrack.kvector import KVector
 from startrack.navigation_catalog import (
@@ -32,14 +34,17 @@ __all__ = [
     "BoresightSolution",
     "Camera",
     "Detections",
+    "IdentificationResult",
     "DimStarCache",
     "InputError",
     "KVector",
     "NavigationCatalog",
     "NavigationCatalogParams",
+    "Prior",
     "SensorModel",
     "Sources",
     "StarCatalog",
+    "StarIdentifier",
     "Windows",
     "angular_distance",
     "build_navigation_catalog",

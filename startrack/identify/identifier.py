@@ -135,14 +135,14 @@ class StarIdentifier:
         matcher = PatternMatcher(catalog.guide_vectors, self.field, self.pattern_stars, int(max_groups),
                                  int(max_triangles), self.false_match_threshold)
         dense = None
-        if dense_fallback and "lost_in_space" in methods:
+        if dense_fallback and ("lost_in_space" in methods or "subcatalog" in methods):
             dense = (PatternMatcher(self.field.vectors, self.field, self.pattern_stars, int(max_groups),
                                     int(max_triangles), self.false_match_threshold),
                      PairTable.of_stars(self.field.vectors, catalog.params.theta_min, catalog.params.theta_max))
         available = {
             "tracking": Tracking(self.field, _positive("tracking_window_px", tracking_window_px, 1e4),
                                  self.false_match_threshold),
-            "subcatalog": SubCatalog(catalog, matcher, neighbours),
+            "subcatalog": SubCatalog(catalog, matcher, neighbours, dense),
             "lost_in_space": LostInSpace(catalog, matcher, dense),
         }
         self.strategies = [available[m] for m in METHODS if m in methods]

@@ -368,7 +368,8 @@ class PatternMatcher:
 
     def __init__(self, star_vectors, field, pattern_stars: int, max_groups: int, max_triangles: int,
                  threshold: float):
-        self.guide_vectors = np.ascontiguousarray(star_vectors)
+        self.guide_vectors = np.array(star_vectors, dtype=float, order="C")
+        self.guide_vectors.flags.writeable = False  # one array type for every matcher: one compiled kernel
         self.field = field
         self.pattern_stars = pattern_stars
         self.max_groups = max_groups

@@ -7,14 +7,19 @@ pattern pairs among them (000 §2.3), so the same pattern matcher as the full-sk
 few hundred pairs instead of tens of thousands.  If it finds nothing, the four redundant
 sub-catalogs at the boresights moved by rho_sub east, west, north and south are searched in turn
 (:meth:`startrack.navigation_catalog.NavigationCatalog.redundant_neighbours`); 000 states that this
-tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000 §5).  The caller
-(:class:`startrack.identify.StarIdentifier`) falls back to the full sky when this fails too.
+tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000 §5).  As the full-sky
+search does, a frame whose brightest stars hold too few guide stars is searched again over the pairs
+of every field star, restricted to the region those sub-catalogs cover (within 2 rho_sub of the
+predicted boresight).  The caller (:class:`startrack.identify.StarIdentifier`) falls back to the full
+sky when this fails too.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+
+import numpy as np
 
 from startrack.identify.lost_in_space import PairTable, PatternMatcher
 
@@ -24,11 +29,22 @@ class SubCatalog:
 
     name = "subcatalog"
 
-    def __init__(self, catalog, matcher: PatternMatcher, neighbours: bool = True):
+    def __init__(self, catalog, matcher: PatternMatcher, neighbours: bool = True, dense=None):
         self.catalog = catalog
         self.matcher = matcher
         self.neighbours = bool(neighbours)
+        self.dense = dense
         self._tables = functools.lru_cache(maxsize=64)(self._table)
+        self._regional = functools.lru_cache(maxsize=16)(self._regional_table)
+
+    def _regional_table(self, b: int) -> PairTable:
+        """Field-star pairs with both stars within 2 rho_sub of base point ``b`` (cached per cell)."""
+        _, table = self.dense
+        field_vectors = self.dense[0].guide_vectors  # the dense matcher's catalog: the field stars
+        centre = self.catalog.base_vectors[b]
+        near = field_vectors @ centre >= math.cos(min(2.0 * self.catalog.rho_sub, math.pi))
+        index = np.flatnonzero(near[table.first] & near[table.second])
+        return PairTable(table.theta[index], table.first[index], table.second[index], np.zeros(0, np.int64))
 
     def _table(self, b: int) -> PairTable:
         """The pair table of sub-catalog ``b`` (cached: consecutive frames reuse the same few)."""
@@ -58,4 +74,11 @@ class SubCatalog:
                 verified = self.matcher.match(frame, table, widths=(2,) if exhausted else (1, 2))
             if verified is not None:
                 return verified
+        if self.dense is not None:
+            dense_matcher = self.dense[0]
+            table = self._regional(int(self.catalog.sub_catalog_index(ra, dec)))
+            for width in (1, 2):
+                verified = dense_matcher.match(frame, table, (width,))
+                if verified is not None:
+                    return verified
         return None
