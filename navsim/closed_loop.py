@@ -142,7 +142,6 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
     sensor = p.image_sensor
     camera, model = sensor.camera, sensor.model
     n_frames, ratio, dt = p.n_frames, p.ratio, p.dt
-    q_BS = filt.q_BS.copy()
     q_BS_true = p.q_BS_true
     R_SB_true = quat.to_matrix(q_BS_true).T
     dropped = np.asarray(faults["dropped_frames_s"])
@@ -164,7 +163,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
     transitions = []
     tracking = sensor.start_tracking  # the previous frame was identified: read windows around predicted stars
     shadow = copy.deepcopy(filt) if sensor.compare_without_stacking else None
-    shadow_log = {"q_est": np.empty((n_frames, 4)), "P": np.empty((n_frames, n, n))} if shadow else None
+    shadow_q = np.empty((n_frames, 4)) if shadow else None
     solver_errors = {"two_star_triad": [], "three_star_optimal": []}
     cache = DimStarCache(half_width=2, depth=4)
     sample = None
@@ -191,7 +190,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
             tracking = False
             cache.reset()
             jump_index += 1
-        q_IS_pred = quat.multiply(filt.q, q_BS)
+        q_IS_pred = quat.multiply(filt.q, filt.q_BS)
         ra, dec = quat.boresight_radec(q_IS_pred)
         log["boresight_radec"][j] = (ra, dec)
         log["subcatalog_address"][j] = sensor.catalog.address(ra, dec)
@@ -222,7 +221,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
             windows = None
             if not full:
                 # the window must hold the whole smear trail: rate from the gyro, across the boresight
-                omega_est_S = quat.to_matrix(q_BS).T @ ((1.0 - filt.s) * (omega_measured[k - 1] - filt.b))
+                omega_est_S = filt.R_BS.T @ ((1.0 - filt.s) * (omega_measured[k - 1] - filt.b))
                 smear_px = np.hypot(omega_est_S[0], omega_est_S[1]) * model.exposure_s * camera.focal_px
                 half = max(sensor.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
                 windows = Windows.around(uv_pred[predicted], half, camera.height, camera.width)
@@ -298,7 +297,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
                 update = filt.update_stars(ref_I, obs_S, sigma)
                 if update.n_accepted == 0 and mode in ("subcatalog", "lost_in_space") and result.ok:
                     # the identification disagrees with the prediction: the filter lost track
-                    filt.q = quat.normalize(quat.multiply(result.q_IS, quat.conjugate(q_BS)))
+                    filt.q = quat.normalize(quat.multiply(result.q_IS, quat.conjugate(filt.q_BS)))
                     filt.P[0:3, :] = 0.0
                     filt.P[:, 0:3] = 0.0
                     filt.P[0:3, 0:3] = P0_attitude
@@ -319,11 +318,10 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
         log["bias_est"][j] = filt.b
         log["P"][j] = filt.P
         if shadow is not None:
-            shadow_log["q_est"][j] = shadow.q
-            shadow_log["P"][j] = shadow.P
+            shadow_q[j] = shadow.q
         log["frame_ms"][j] = 1e3 * (time.perf_counter() - started)
     return log, {"transitions": transitions, "sample_frame": sample, "probes": probe_log,
-                 "shadow": shadow_log, "solver_errors": solver_errors}
+                 "shadow_q_est": shadow_q, "solver_errors": solver_errors}
 
 
 def _compare_solvers(errors, ref_I, obs_S, dim_ref_I, dim_obs_S, q_IS_true, sigma, sigma_dim):

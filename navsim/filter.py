@@ -88,16 +88,6 @@ class AttitudeFilter:
         self.sf_start = 6 if estimate_scale_factor else -1
         self.mis_start = self.n - 3 if estimate_misalignment else -1
 
-    @property
-    def x_names(self):
-        """Names of the error-state components, in order."""
-        names = ["dtheta_x", "dtheta_y", "dtheta_z", "db_x", "db_y", "db_z"]
-        if self.sf_start >= 0:
-            names += ["ds_x", "ds_y", "ds_z"]
-        if self.mis_start >= 0:
-            names += ["dm_x", "dm_y", "dm_z"]
-        return names
-
     def predict(self, omega_measured, dt):
         """Propagate q (RK4) and P (Φ P Φᵀ + Q) over one gyro sample (3,) or several
         consecutive samples (m, 3), each held for dt [s] (:func:`navsim.kernels.predict`)."""
@@ -118,10 +108,6 @@ class AttitudeFilter:
         )
         self._set_mounting(q_BS)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
-
-    def predicted_star_vectors(self, ref_I):
-        """Predicted sensor-frame unit vectors ŝ = R_SB R_IBᵀ r of catalog vectors ref_I (N, 3)."""
-        return np.asarray(ref_I, dtype=float) @ kernels.quat_to_matrix(self.q) @ self.R_BS
 
     def update_stars(self, ref_I, obs_S, sigma):
         """Update with identified stars: catalog unit vectors ref_I (N, 3) in I, measured unit

@@ -74,7 +74,7 @@ def run_chunk(scenario_data, source, members):
     return errors
 
 
-def _prepare(directory, scenario, runs, base_seed, overrides):
+def _prepare(directory, scenario, runs, base_seed):
     directory = Path(directory)
     request = {
         "scenario": scenario.name,
@@ -129,7 +129,7 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
         raise InputError(f"--runs must be at least 1, got {runs}")
     scenario = resolve_scenario(scenario, overrides)
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
-    directory, request = _prepare(out, scenario, runs, base_seed, overrides)
+    directory, request = _prepare(out, scenario, runs, base_seed)
     todo = pending_runs(directory, request)
     members = [(request["seeds"][k], str(directory / "runs" / RUN_FORMAT.format(k))) for k in todo]
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)

@@ -154,10 +154,10 @@ def simulate(prepared, seed):
         if probes is not None:
             summary["tracking_failure_probes"] = probes
             summary["paper_comparison"] = paper000_comparison(probes)
-        if extras["shadow"] is not None or any(extras["solver_errors"].values()):
+        if extras["shadow_q_est"] is not None or any(extras["solver_errors"].values()):
             shadow_error = None
-            if extras["shadow"] is not None:
-                shadow_error = quat.attitude_error(extras["shadow"]["q_est"], log["q_true"])
+            if extras["shadow_q_est"] is not None:
+                shadow_error = quat.attitude_error(extras["shadow_q_est"], log["q_true"])
                 log["attitude_error_without_stacking"] = shadow_error
             dim = dim_star_statistics(extras, log["attitude_error"], shadow_error, log["t"] >= scenario["settle_s"])
             summary["dim_star"] = dim

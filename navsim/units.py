@@ -11,10 +11,6 @@ def deg_to_rad(x):
     return np.asarray(x, dtype=float) * DEG
 
 
-def rad_to_deg(x):
-    return np.asarray(x, dtype=float) / DEG
-
-
 def arcsec_to_rad(x):
     return np.asarray(x, dtype=float) * ARCSEC
 
