@@ -2,7 +2,8 @@
 
 Truth attitude motion, gyro models, quaternion kinematics (RK4), the multiplicative error-state
 Kalman filter, the closed loop that runs the star sensor inside the simulation, faults, scenarios,
-Monte Carlo campaigns, filter tuning and the ``navsim`` command line.
+Monte Carlo campaigns, filter tuning, the static studies of the source documents
+(:mod:`navsim.studies`) and the ``navsim`` command line.
 
     >>> import navsim
     >>> result = navsim.run("scenarios/paper000_high_dynamic.toml", seed=1, overrides={"duration_s": 20})
@@ -16,7 +17,8 @@ from navsim.gyro import GyroModel
 from navsim.montecarlo import run_campaign
 from navsim.output import read_npz, write_run
 from navsim.scenario import Scenario, load_scenario
-from navsim.simulation import RunResult, prepare, run, run_batch, simulate
+from navsim.simulation import RunResult, prepare, run, run_batch, run_study, simulate
+from navsim.studies import StudyResult
 from navsim.tuning import tune
 
 __all__ = [
@@ -24,12 +26,14 @@ __all__ = [
     "GyroModel",
     "RunResult",
     "Scenario",
+    "StudyResult",
     "load_scenario",
     "prepare",
     "read_npz",
     "run",
     "run_batch",
     "run_campaign",
+    "run_study",
     "simulate",
     "tune",
     "write_run",

@@ -15,8 +15,10 @@ from pathlib import Path
 
 from navsim.montecarlo import run_campaign
 from navsim.tuning import tune
-from navsim.output import write_run
-from navsim.simulation import run
+from navsim.output import write_run, write_study
+from navsim.scenario import resolve_scenario
+from navsim.simulation import run, run_study
+from navsim.studies import STUDIES
 from startrack.errors import InputError, run_command
 
 
@@ -42,9 +44,18 @@ def _print_summary(summary, out):
 def _run(args):
     if args.report and Path(args.report).suffix.lower() != ".pdf":
         raise InputError(f"--report {args.report}: the report file name must end in .pdf.")
-    result = run(args.scenario, seed=args.seed, overrides=args.set or ())
-    out = write_run(args.out, result)
-    _print_summary(result.summary, out)
+    scenario = resolve_scenario(args.scenario, args.set or ())
+    if scenario.is_study:
+        result = run_study(scenario, seed=args.seed, progress=True)
+        out = write_study(args.out, result)
+        print(f"study               {scenario.name} ({scenario['study']['kind']}, seed {result.summary['seed']}, "
+              f"{result.summary['wall_seconds']:.1f} s)")
+        print("\n".join(STUDIES[scenario["study"]["kind"]].text(result.summary, scenario.study_parameters)))
+        print(f"written to          {out}")
+    else:
+        result = run(scenario, seed=args.seed)
+        out = write_run(args.out, result)
+        _print_summary(result.summary, out)
     if args.report is not None:
         from navsim.report import write_report
 
@@ -103,7 +114,8 @@ def _tune(args):
 def build_parser():
     parser = argparse.ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    p = sub.add_parser("run", help="simulate one scenario and write summary.json and timeseries.npz")
+    p = sub.add_parser("run", help="simulate one scenario (or run a static study) and write summary.json and "
+                                   "timeseries.npz (study.npz)")
     p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--seed", type=int, default=None, help="random seed (default: the scenario's)")

@@ -29,8 +29,8 @@ from tqdm import tqdm
 from navsim import units
 from navsim.closed_loop import paper000_comparison, paper004_comparison
 from navsim.output import read_npz, write_json, write_run
-from navsim.scenario import Scenario
-from navsim.simulation import NEES_DOF, prepare, resolve_scenario, simulate
+from navsim.scenario import Scenario, resolve_scenario
+from navsim.simulation import NEES_DOF, prepare, simulate
 from startrack.errors import InputError
 
 RUN_FORMAT = "run_{:05d}"
@@ -128,6 +128,7 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     if runs < 1:
         raise InputError(f"--runs must be at least 1, got {runs}")
     scenario = resolve_scenario(scenario, overrides)
+    scenario.require_simulation("a Monte Carlo campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
     directory, request = _prepare(out, scenario, runs, base_seed)
     todo = pending_runs(directory, request)

@@ -1,5 +1,5 @@
-"""Run outputs: ``scenario.json`` (the validated scenario), ``summary.json`` and ``timeseries.npz``,
-byte-identical for the same inputs (but for ``wall_seconds``).
+"""Run outputs: ``scenario.json`` (the validated scenario), ``summary.json`` and ``timeseries.npz``
+(``study.npz`` for a static study), byte-identical for the same inputs (but for ``wall_seconds``).
 
 ``np.savez`` stamps the current time into the zip; :func:`write_npz` writes the same format
 (a zip of ``.npy`` members, readable by ``np.load(..., allow_pickle=False)``) with a fixed
@@ -57,4 +57,14 @@ def write_run(directory, result, max_frames=None):
     if result.sample_frame is not None:
         np.save(directory / "frame.npy", result.sample_frame["image"], allow_pickle=False)
         write_json(directory / "frame_detections.json", result.sample_frame["detections"])
+    return directory
+
+
+def write_study(directory, result):
+    """Write a :class:`~navsim.studies.StudyResult`: scenario.json, summary.json and study.npz."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    write_json(directory / "scenario.json", result.scenario)
+    write_json(directory / "summary.json", result.summary)
+    write_npz(directory / "study.npz", result.arrays)
     return directory

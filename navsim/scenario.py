@@ -1,9 +1,10 @@
 """Scenario files: strict TOML with the unit in every key name.
 
 ``load_scenario(path, overrides)`` reads a file, applies ``--set key=value`` overrides
-(dotted keys, TOML values), validates everything against :data:`SCHEMA` and returns a
-:class:`Scenario` (the validated plain dictionary plus the name of its file). Every problem
-ends in one :class:`InputError` naming the file, the key and what is wrong.
+(dotted keys, TOML values), validates everything against :data:`SCHEMA` (a simulation) or
+:data:`STUDY_SCHEMA` (a static study: a file with a ``[study]`` table, see :mod:`navsim.studies`)
+and returns a :class:`Scenario` (the validated plain dictionary plus the name of its file). Every
+problem ends in one :class:`InputError` naming the file, the key and what is wrong.
 """
 
 import copy
@@ -14,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from navsim.schema import ListOfTables, Table, Value
+from navsim.studies import STUDIES
 from startrack.errors import InputError
 
 PROFILES = ("constant_rate", "sinusoidal_axis", "rate_segments", "rigid_body")
@@ -191,6 +193,18 @@ SCHEMA = Table(
 )
 
 
+STUDY_SCHEMA = Table(
+    {
+        "name": Value("str"),
+        "description": Value("str", default=""),
+        "seed": Value("int", default=0, minimum=0),
+        "study": Table({"kind": Value("str", choices=tuple(STUDIES))}
+                       | {kind: Table(module.PARAMETERS.entries, optional=True)
+                          for kind, module in STUDIES.items()}),
+    }
+)
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A validated scenario: ``data`` is the checked dictionary (units in key names)."""
@@ -201,6 +215,23 @@ class Scenario:
     @property
     def name(self):
         return self.data["name"]
+
+    @property
+    def is_study(self):
+        """True for a static study (a ``[study]`` table), False for a simulation."""
+        return "study" in self.data
+
+    def require_simulation(self, action):
+        """Raise an InputError when this is a static study, which ``action`` cannot take."""
+        if self.is_study:
+            raise InputError(f"{self.source}: a static study (study.kind = {self.data['study']['kind']!r}) cannot be "
+                             f"used for {action}: it has no trajectory; run it with `navsim run` "
+                             "(Python: navsim.run_study)")
+
+    @property
+    def study_parameters(self):
+        """The parameters of a static study's kind."""
+        return self.data["study"][self.data["study"]["kind"]]
 
     def __getitem__(self, key):
         return self.data[key]
@@ -243,17 +274,14 @@ def apply_overrides(data, overrides, source):
 
 def validate(data, source="<scenario>"):
     """Check a raw dictionary against the schema and the cross-key rules."""
-    try:
-        checked = SCHEMA.check("", data)
-    except InputError as error:
-        raise InputError(f"{source}: {error}") from None
+    if isinstance(data, dict) and "study" in data:
+        return _validate_study(data, source)
+    checked = _checked(SCHEMA, data, source)
     truth = checked["truth"]
     profile = truth["profile"]
     if profile not in truth:
         raise InputError(f"{source}: truth.{profile}: missing table for truth.profile = {profile!r}")
-    for other in PROFILES:
-        if other != profile and other in truth:
-            raise InputError(f"{source}: truth.{other}: given, but truth.profile is {profile!r}")
+    _only_chosen(truth, "truth", "profile", PROFILES, source)
     gyro_hz = checked["gyro"]["rate_hz"]
     sensor_hz = checked["star_sensor"]["rate_hz"]
     if not _is_multiple(gyro_hz, sensor_hz):
@@ -298,6 +326,42 @@ def validate(data, source="<scenario>"):
         if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise InputError(f"{source}: truth.rigid_body.inertia_kg_m2: must be symmetric positive definite")
     return Scenario(data=checked, source=source)
+
+
+def _checked(schema, data, source):
+    try:
+        return schema.check("", data)
+    except InputError as error:
+        raise InputError(f"{source}: {error}") from None
+
+
+def _only_chosen(table, where, selector, options, source):
+    """No table of an option other than the one ``table[selector]`` chose."""
+    for other in options:
+        if other != table[selector] and other in table:
+            raise InputError(f"{source}: {where}.{other}: given, but {where}.{selector} is {table[selector]!r}")
+
+
+def _validate_study(data, source):
+    """A static study: the kind's own table (all defaults when absent), no other kind's table."""
+    checked = _checked(STUDY_SCHEMA, data, source)
+    study = checked["study"]
+    kind = study["kind"]
+    _only_chosen(study, "study", "kind", STUDIES, source)
+    if kind not in study:
+        study[kind] = STUDIES[kind].PARAMETERS.check(f"study.{kind}", {})
+    return Scenario(data=checked, source=source)
+
+
+def resolve_scenario(scenario, overrides=()):
+    """A :class:`Scenario` from a path, a dictionary or a Scenario, with overrides applied."""
+    if isinstance(scenario, Scenario):
+        if overrides:
+            return scenario_from_dict(scenario.data, overrides, source=scenario.source)
+        return scenario
+    if isinstance(scenario, dict):
+        return scenario_from_dict(scenario, overrides)
+    return load_scenario(Path(scenario), overrides)
 
 
 def _is_multiple(high, low):

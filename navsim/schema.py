@@ -17,8 +17,9 @@ REQUIRED = object()
 class Value:
     """A scalar or fixed-length list value.
 
-    ``kind``: 'float', 'int', 'bool', 'str', 'list' (floats, any length), 'vector' (list of floats of length ``size``),
-    'matrix' (size x size floats) or 'quaternion' (4 floats, non-zero norm).
+    ``kind``: 'float', 'int', 'bool', 'str', 'list' (floats, any length), 'ints' (integers, any length),
+    'strs' (strings from ``choices``, any length), 'vector' (list of floats of length ``size``),
+    'matrix' (size x size floats) or 'quaternion' (4 floats, non-zero norm). Lists of ``min_length`` or more.
     """
 
     kind: str
@@ -28,6 +29,7 @@ class Value:
     maximum: float | None = None
     choices: tuple = ()
     size: int = 3
+    min_length: int = 0
     doc: str = ""
 
     def check(self, where, value):
@@ -56,8 +58,22 @@ class Value:
             if not isinstance(value, list):
                 raise InputError(f"{where}: must be a list of numbers, got {value!r}")
             value = _numbers(where, value, len(value))
+            self._check_length(where, value)
             for v in value:
                 self._check_range(where, v)
+        elif self.kind == "ints":
+            if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+                raise InputError(f"{where}: must be a list of integers, got {value!r}")
+            self._check_length(where, value)
+            for v in value:
+                self._check_range(where, v)
+        elif self.kind == "strs":
+            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+                raise InputError(f"{where}: must be a list of strings, got {value!r}")
+            self._check_length(where, value)
+            unknown = [v for v in value if self.choices and v not in self.choices]
+            if unknown:
+                raise InputError(f"{where}: {unknown[0]!r} is not one of {', '.join(self.choices)}")
         elif self.kind in ("vector", "quaternion"):
             size = 4 if self.kind == "quaternion" else self.size
             value = _numbers(where, value, size)
@@ -72,6 +88,10 @@ class Value:
         else:  # pragma: no cover - schema authoring error
             raise AssertionError(self.kind)
         return value
+
+    def _check_length(self, where, value):
+        if len(value) < self.min_length:
+            raise InputError(f"{where}: needs at least {self.min_length} entries, got {len(value)}")
 
     def _check_range(self, where, value):
         if self.minimum is not None and value < self.minimum:

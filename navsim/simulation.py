@@ -26,10 +26,12 @@ from navsim.closed_loop import (
 )
 from navsim import quaternion as quat
 from navsim import units
-from navsim.scenario import Scenario, load_scenario, scenario_from_dict
+from navsim.scenario import Scenario, resolve_scenario
 from navsim.star_sensor import AttitudeFixSensor
+from navsim.studies import STUDIES, StudyResult
 from navsim.truth import interval_mean_rates
 from startrack.attitude_angles import quaternion_from_radec_roll
+from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
 NEES_DOF = 6
@@ -45,17 +47,6 @@ class RunResult:
     series: dict
     scenario: dict
     sample_frame: dict | None = None
-
-
-def resolve_scenario(scenario, overrides=()):
-    """A :class:`Scenario` from a path, a dictionary or a Scenario, with overrides applied."""
-    if isinstance(scenario, Scenario):
-        if overrides:
-            return scenario_from_dict(scenario.data, overrides, source=scenario.source)
-        return scenario
-    if isinstance(scenario, dict):
-        return scenario_from_dict(scenario, overrides)
-    return load_scenario(Path(scenario), overrides)
 
 
 @dataclass(frozen=True)
@@ -91,6 +82,7 @@ def initial_attitude(scenario):
 def prepare(scenario, overrides=(), star_catalog=None):
     """Validate ``scenario`` and compute everything that does not depend on the seed."""
     scenario = resolve_scenario(scenario, overrides)
+    scenario.require_simulation("a simulation run")
     gyro_hz = scenario["gyro"]["rate_hz"]
     ratio = int(round(gyro_hz / scenario["star_sensor"]["rate_hz"]))
     factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
@@ -179,6 +171,21 @@ def run(scenario, seed=None, overrides=(), star_catalog=None):
     result = simulate(prepared, prepared.scenario["seed"] if seed is None else int(seed))
     result.summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     return result
+
+
+def run_study(scenario, seed=None, overrides=(), progress=False):
+    """Run a static study (a scenario with a ``[study]`` table, :mod:`navsim.studies`); ``seed``
+    overrides the scenario's. Returns a :class:`~navsim.studies.StudyResult`."""
+    started = time.perf_counter()
+    scenario = resolve_scenario(scenario, overrides)
+    if not scenario.is_study:
+        raise InputError(f"{scenario.source}: a simulation scenario, not a static study; run it with navsim.run")
+    seed = scenario["seed"] if seed is None else int(seed)
+    kind = scenario["study"]["kind"]
+    summary, arrays = STUDIES[kind].run(scenario.study_parameters, seed, progress)
+    summary = {"scenario": scenario.name, "study": kind, "seed": seed} | summary
+    summary["wall_seconds"] = round(time.perf_counter() - started, 4)
+    return StudyResult(scenario=scenario.data, summary=summary, arrays=arrays)
 
 
 def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize
 
-from navsim.simulation import NEES_DOF, run_batch, resolve_scenario
+from navsim.scenario import resolve_scenario
+from navsim.simulation import NEES_DOF, run_batch
 
 
 @dataclass
@@ -77,6 +78,7 @@ def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0
     best scales found.
     """
     scenario = resolve_scenario(scenario, overrides)
+    scenario.require_simulation("filter tuning")
     base_seed = scenario["seed"] if seed is None else int(seed)
     seeds = [base_seed + k for k in range(runs)]
     q_scale = scenario["filter"]["process_noise_scale"]

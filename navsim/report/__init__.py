@@ -1,30 +1,33 @@
-"""PDF reports of a run directory or a Monte Carlo campaign directory.
+"""PDF reports of a run directory, a static-study directory or a Monte Carlo campaign directory.
 
     >>> from navsim.report import write_report
     >>> write_report("reports/out/demo", "reports/out/demo.pdf")   # doctest: +SKIP
 
 The kind of directory is detected from its contents (``campaign.json`` -> campaign;
-``summary.json`` + ``timeseries.npz`` -> run). Figures and sections whose quantities a run did
+``summary.json`` + ``timeseries.npz`` -> run; ``summary.json`` + ``study.npz`` -> static study). Figures and sections whose quantities a run did
 not log (vector-fidelity runs log no image-chain data) are left out and listed as absent.
 """
 
 from pathlib import Path
 
 from navsim.report import document
-from navsim.report.inputs import directory_kind, load_campaign, load_run
+from navsim.report.inputs import directory_kind, load_campaign, load_run, load_study
 from startrack.errors import InputError
 
 __all__ = ["write_report"]
 
 
 def write_report(directory, pdf_path) -> Path:
-    """Typeset the report of ``directory`` (run or campaign) into ``pdf_path``; returns the PDF's path."""
+    """Typeset the report of ``directory`` (run, study or campaign) into ``pdf_path``; returns the PDF's path."""
     directory = Path(directory)
     pdf_path = Path(pdf_path)
     if pdf_path.suffix.lower() != ".pdf":
         raise InputError(f"{pdf_path}: the report file name must end in .pdf.")
-    if directory_kind(directory) == "campaign":
+    kind = directory_kind(directory)
+    if kind == "campaign":
         pdf = document.campaign_report(load_campaign(directory))
+    elif kind == "study":
+        pdf = document.study_report(load_study(directory))
     else:
         pdf = document.run_report(load_run(directory))
     try:

@@ -18,6 +18,7 @@ import typst
 from navsim import units
 from navsim.report import figures
 from navsim.report import statistics as stats
+from navsim.studies import STUDIES
 from startrack import address
 
 PREAMBLE = """\
@@ -376,6 +377,37 @@ def _absent_section(doc, run):
         doc.heading("Not logged in this run")
         doc.paragraph(markup("This run did not log " + "; ".join(missing)
                              + " (vector-fidelity runs log no image-chain quantities), so those figures are omitted."))
+
+
+# -------------------------------------------------------------------------- static studies
+
+
+def study_report(study) -> bytes:
+    """The PDF (bytes) of a static study's directory: key results, parameters, our figures beside the
+    source document's, the explanation of every difference, and the study's figures."""
+    summary = study.summary
+    kind = summary["study"]
+    module = STUDIES[kind]
+    parameters = study.scenario["study"][kind]
+    name = _scenario_name(summary, study.scenario, study.directory)
+    with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
+        doc = Document(Path(tmp), f"navsim study report: {name}", f"navsim study · {name}")
+        doc.title(f"Static study report: {name}", study.scenario.get("description") or str(study.directory))
+        doc.paragraph(markup(f"Study directory {study.directory}; kind {kind}; seed {summary.get('seed', 'n/a')}; "
+                             f"wall time {number(summary.get('wall_seconds'), 1)} s."))
+        doc.heading("Key results")
+        doc.add(table(("Quantity", "Value", "Unit"), module.key_results(summary, parameters), ("left", "right", "left")))
+        _scenario_section(doc, study.scenario)
+        _comparison_section(doc, summary.get("paper_comparison"))
+        notes = summary.get("notes") or []
+        if notes:
+            doc.heading("What the comparison shows")
+            for note in notes:
+                doc.paragraph(markup(str(note)))
+        doc.heading("Figures")
+        for fig, caption in module.figures(summary, study.arrays, parameters):
+            doc.figure(fig, caption)
+        return doc.compile()
 
 
 # ----------------------------------------------------------------------------- campaigns

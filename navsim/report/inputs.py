@@ -1,4 +1,5 @@
-"""Read what a report is made from: a run directory or a Monte Carlo campaign directory.
+"""Read what a report is made from: a run directory, a static-study directory or a Monte Carlo
+campaign directory.
 
 A run directory holds ``summary.json`` and ``timeseries.npz`` (and usually ``scenario.json``;
 optionally ``frame.npy`` with ``frame_detections.json``). A campaign directory holds
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from navsim.studies import STUDIES
 from startrack.errors import InputError
 
 #: Arrays every run must have; the report cannot say anything without them.
@@ -59,6 +61,16 @@ class RunData:
     @property
     def frames(self) -> int:
         return int(self.series["t"].size)
+
+
+@dataclass
+class StudyData:
+    """A static study: its summary, scenario (with the kind's parameters) and per-sample arrays."""
+
+    directory: Path
+    summary: dict
+    scenario: dict
+    arrays: dict
 
 
 @dataclass
@@ -119,7 +131,7 @@ def read_series(path: Path, names=None) -> dict:
 
 
 def directory_kind(directory: Path) -> str:
-    """'run' or 'campaign'; anything else is an InputError."""
+    """'run', 'study' or 'campaign'; anything else is an InputError."""
     if not directory.exists():
         raise InputError(f"{directory}: no such directory.")
     if not directory.is_dir():
@@ -128,8 +140,10 @@ def directory_kind(directory: Path) -> str:
         return "campaign"
     if (directory / "timeseries.npz").is_file() and (directory / "summary.json").is_file():
         return "run"
-    raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz) "
-                     "nor a campaign directory (campaign.json).")
+    if (directory / "study.npz").is_file() and (directory / "summary.json").is_file():
+        return "study"
+    raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz), a static-study "
+                     "directory (summary.json and study.npz) nor a campaign directory (campaign.json).")
 
 
 def load_run(directory: Path) -> RunData:
@@ -144,6 +158,27 @@ def load_run(directory: Path) -> RunData:
         if detections_path.is_file():
             detections = _read_detections(detections_path)
     return RunData(directory, summary, series, scenario, frame, detections)
+
+
+def load_study(directory: Path) -> StudyData:
+    summary = read_json(directory / "summary.json")
+    scenario = read_json(directory / "scenario.json") if (directory / "scenario.json").is_file() else {}
+    kind = summary.get("study")
+    if kind not in STUDIES:
+        raise InputError(f"{directory / 'summary.json'}: 'study' must name a static study "
+                         f"({', '.join(STUDIES)}), got {kind!r}.")
+    parameters = scenario.get("study", {}).get(kind)
+    if not isinstance(parameters, dict):
+        raise InputError(f"{directory / 'scenario.json'}: missing, or without the study.{kind} parameters.")
+    path = directory / "study.npz"
+    if not zipfile.is_zipfile(path):
+        raise InputError(f"{path}: not an .npz array file (not a zip archive).")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {name: data[name] for name in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+        raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
+    return StudyData(directory, summary, scenario, arrays)
 
 
 def _read_frame(path: Path) -> np.ndarray:

@@ -99,7 +99,7 @@ def test_solve_vectors_agrees_with_solve(setup):
 
 
 def test_contest_star_maps_of_001():
-    """001 §5.4 (fast version of reports/experiments/contest_starmap_001.py): 12 x 12 deg, 512 x 512,
+    """001 §5.4 (fast version of the identification part of scenarios/contest_starmap.toml): 12 x 12 deg, 512 x 512,
     sigma = 0.05 px, random maps with false stars: every map identified, no false match."""
     fov = np.radians(12.0)
     catalog = load_navigation_catalog(NavigationCatalogParams(fov=fov))

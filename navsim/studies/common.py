@@ -1,0 +1,26 @@
+"""What every static study shares: its result type, the paper-difference helper and the progress bar."""
+
+import sys
+from dataclasses import dataclass, field
+
+from tqdm import tqdm
+
+
+@dataclass
+class StudyResult:
+    """A static study's outcome: ``summary`` (JSON: every point, ``paper_comparison`` rows, ``notes``)
+    and ``arrays`` (per-sample numbers the figures draw, written to ``study.npz``)."""
+
+    scenario: dict
+    summary: dict
+    arrays: dict = field(default_factory=dict)
+
+
+def percent(ours, paper):
+    """Relative differences [%] of ours from the paper's figures, one decimal."""
+    return [round(100.0 * (o - p) / p, 1) for o, p in zip(ours, paper)]
+
+
+def progress_bar(items, enabled, description):
+    """``items`` with a tqdm bar on stderr when ``enabled`` (shown after a second)."""
+    return tqdm(items, desc=description, disable=not enabled, file=sys.stderr, delay=1.0, leave=False)
