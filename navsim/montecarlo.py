@@ -27,7 +27,7 @@ from scipy.stats import chi2
 from tqdm import tqdm
 
 from navsim import units
-from navsim.closed_loop import paper000_comparison, paper004_comparison
+from navsim.closed_loop import DIM_STAR_SOLVERS, paper000_comparison, paper004_comparison, paper004_notes
 from navsim.output import read_npz, write_json, write_run
 from navsim.scenario import Scenario, resolve_scenario
 from navsim.simulation import NEES_DOF, prepare, simulate
@@ -183,18 +183,30 @@ def _pooled_paper_comparison(summaries):
     dim = [s["dim_star"] for s in summaries if "dim_star" in s]
     if dim:
         pooled = {}
-        for name in ("two_star_triad", "three_star_optimal"):
-            parts = [(d[name]["frames"], np.square(d[name]["rms_ra_dec_roll_arcsec"])) for d in dim if name in d]
-            frames = sum(f for f, _ in parts)
+        for name in (*DIM_STAR_SOLVERS, "crb_two_star", "crb_three_star"):
+            runs = [d[name] for d in dim if name in d]
+            frames = sum(r["frames"] for r in runs)
             if frames:
-                pooled[name] = {"frames": frames, "rms_ra_dec_roll_arcsec":
-                                [float(v) for v in np.sqrt(sum(f * ms for f, ms in parts) / frames)]}
+                pooled[name] = {"frames": frames} | {
+                    key: [float(v) for v in np.sqrt(sum(r["frames"] * np.square(r[key]) for r in runs) / frames)]
+                    for key in ("rms_ra_dec_roll_arcsec", "rms_cross_roll_arcsec") if all(key in r for r in runs)}
+        centroids = [d["stacked_centroid"] for d in dim if "stacked_centroid" in d]
+        if centroids:
+            frames = sum(c["frames"] for c in centroids)
+            pooled["stacked_centroid"] = {"frames": frames, "rms_error_px": np.sqrt(
+                sum(c["frames"] * np.square(c["rms_error_px"]) for c in centroids) / frames).tolist()}
+        off_axis = [d["off_axis_deg"] for d in dim if "off_axis_deg" in d]
+        if off_axis:
+            frames = sum(o["frames"] for o in off_axis)
+            pooled["off_axis_deg"] = {"frames": frames, "mean_bright_dim": (
+                sum(o["frames"] * np.array(o["mean_bright_dim"]) for o in off_axis) / frames).tolist()}
         for name in ("filter_with_stacking", "filter_without_stacking"):
             values = [d[name]["rms_xyz_arcsec"] for d in dim if name in d]
             if values:
                 pooled[name] = {"rms_xyz_arcsec": [float(v) for v in np.sqrt(np.mean(np.square(values), axis=0))]}
         out["dim_star"] = pooled
         rows += paper004_comparison(pooled)
+        out["notes"] = paper004_notes(pooled)
     probes = [s["tracking_failure_probes"] for s in summaries if "tracking_failure_probes" in s]
     if probes:
         trials = sum(p["trials"] for p in probes)

@@ -21,6 +21,7 @@ from navsim.closed_loop import (
     dim_star_statistics,
     paper000_comparison,
     paper004_comparison,
+    paper004_notes,
     probe_statistics,
     run_image_loop,
 )
@@ -154,6 +155,7 @@ def simulate(prepared, seed):
             dim = dim_star_statistics(extras, log["attitude_error"], shadow_error, log["t"] >= scenario["settle_s"])
             summary["dim_star"] = dim
             summary["paper_comparison"] = summary.get("paper_comparison", []) + paper004_comparison(dim)
+            summary["notes"] = paper004_notes(dim)
     summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     series = {key: value for key, value in log.items() if key != "P"}
     series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()

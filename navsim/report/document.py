@@ -178,6 +178,7 @@ def run_report(run) -> bytes:
         _address_section(doc, run)
         _frame_section(doc, run)
         _comparison_section(doc, summary.get("paper_comparison"))
+        _notes_section(doc, summary.get("notes"))
         _absent_section(doc, run)
         return doc.compile()
 
@@ -359,6 +360,14 @@ def _comparison_section(doc, comparison):
     doc.add(table(("Quantity", "Ours", "Source document", "Source"), rows, ("left", "right", "right", "left")))
 
 
+def _notes_section(doc, notes):
+    if not isinstance(notes, list) or not notes:
+        return
+    doc.heading("What the comparison shows")
+    for note in notes:
+        doc.paragraph(markup(str(note)))
+
+
 ABSENT = (
     (("mode",), "sensor modes"),
     (("n_detected", "n_identified", "n_stacked"), "detected, identified and stacked star counts"),
@@ -399,11 +408,7 @@ def study_report(study) -> bytes:
         doc.add(table(("Quantity", "Value", "Unit"), module.key_results(summary, parameters), ("left", "right", "left")))
         _scenario_section(doc, study.scenario)
         _comparison_section(doc, summary.get("paper_comparison"))
-        notes = summary.get("notes") or []
-        if notes:
-            doc.heading("What the comparison shows")
-            for note in notes:
-                doc.paragraph(markup(str(note)))
+        _notes_section(doc, summary.get("notes"))
         doc.heading("Figures")
         for fig, caption in module.figures(summary, study.arrays, parameters):
             doc.figure(fig, caption)
@@ -513,6 +518,7 @@ def campaign_report(campaign) -> bytes:
                 doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))
                 doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
             _comparison_section(doc, campaign.summary.get("paper_comparison"))
+            _notes_section(doc, campaign.summary.get("notes"))
 
         if campaign.failed:
             doc.heading("Failed runs")
