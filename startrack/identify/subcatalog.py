@@ -36,28 +36,40 @@ class SubCatalog:
         self.dense = dense
         self._tables = functools.lru_cache(maxsize=64)(self._table)
         self._regional = functools.lru_cache(maxsize=16)(self._regional_table)
+        if dense is not None:  # CSR index of the dense table's pairs by their first star: start (N+1,), order
+            order = np.argsort(dense[1].first, kind="stable")
+            self._dense_pairs_by_star = (np.searchsorted(dense[1].first[order], np.arange(len(dense[0].guide_vectors) + 1)),
+                                         order)
 
     def _regional_table(self, b: int) -> PairTable:
-        """Field-star pairs with both stars within 2 rho_sub of base point ``b`` (cached per cell)."""
-        _, table = self.dense
-        field_vectors = self.dense[0].guide_vectors  # the dense matcher's catalog: the field stars
+        """Field-star pairs with both stars within 2 rho_sub of base point ``b`` (cached per cell), gathered
+        through the pairs of the near stars rather than by a pass over every pair of the sky."""
+        matcher, table = self.dense
         centre = self.catalog.base_vectors[b]
-        near = field_vectors @ centre >= math.cos(min(2.0 * self.catalog.rho_sub, math.pi))
-        index = np.flatnonzero(near[table.first] & near[table.second])
+        near = matcher.guide_vectors @ centre >= math.cos(min(2.0 * self.catalog.rho_sub, math.pi))
+        stars = np.flatnonzero(near)
+        start, order = self._dense_pairs_by_star
+        lengths = start[stars + 1] - start[stars]
+        offsets = np.repeat(start[stars] - np.cumsum(lengths) + lengths, lengths) + np.arange(lengths.sum())
+        index = np.sort(order[offsets])                   # ascending pair index: sorted by distance
+        index = index[near[table.second[index]]]
         return PairTable(table.theta[index], table.first[index], table.second[index], np.zeros(0, np.int64))
 
     def _table(self, b: int) -> PairTable:
         """The pair table of sub-catalog ``b`` (cached: consecutive frames reuse the same few)."""
         return PairTable.subset(self.catalog, self.catalog.sub_catalog_pairs(b))
 
-    def cells(self, ra: float, dec: float) -> list[int]:
-        """Sub-catalog indices to search for a predicted boresight (ra, dec) [rad], predicted one first."""
-        cells = [int(self.catalog.sub_catalog_index(ra, dec))]
+    def cells(self, ra: float, dec: float):
+        """Sub-catalog indices to search for a predicted boresight (ra, dec) [rad], predicted one first; the
+        neighbours' addresses are only computed if the predicted sub-catalog fails (a generator)."""
+        first = int(self.catalog.sub_catalog_index(ra, dec))
+        yield first
         if self.neighbours:
+            seen = {first}
             for b in self.catalog.redundant_neighbours(ra, dec).tolist():
-                if b not in cells:
-                    cells.append(int(b))
-        return cells
+                if b not in seen:
+                    seen.add(b)
+                    yield int(b)
 
     def identify(self, frame, prior):
         """Verified hypothesis or None; needs ``prior.boresight_radec()``."""

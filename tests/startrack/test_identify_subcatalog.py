@@ -36,7 +36,7 @@ def test_cells_are_the_predicted_sub_catalog_and_its_neighbours(setup):
     identifier = StarIdentifier(catalog, camera, methods=("subcatalog",))
     sub = identifier.strategies[0]
     ra, dec = 1.2, 0.4
-    cells = sub.cells(ra, dec)
+    cells = list(sub.cells(ra, dec))
     assert cells[0] == catalog.sub_catalog_index(ra, dec)
     assert set(cells[1:]) == set(catalog.redundant_neighbours(ra, dec).tolist()) - {cells[0]}
 
@@ -68,3 +68,19 @@ def test_far_prior_falls_back_to_the_full_sky(setup):
     far = only_sub.solve(frame.uv, frame.flux, Prior(boresight=_disturbed_boresight(frame.q_IS, 40 * DEG, rng)))
     assert far.status == "no_match"
     assert only_sub.solve(frame.uv, frame.flux).status == "no_match"  # no prior: nothing to search
+
+
+def test_regional_table_holds_exactly_the_field_pairs_near_the_cell(setup):
+    """The regional fall-back table gathered through the near stars' pairs equals a pass over every
+    pair of the dense table (both stars within 2 rho_sub of the base point), in distance order."""
+    catalog, camera, _ = setup
+    sub = StarIdentifier(catalog, camera, methods=("subcatalog",)).strategies[0]
+    matcher, table = sub.dense
+    for b in (0, 137, len(catalog.base_vectors) // 2, len(catalog.base_vectors) - 1):
+        near = matcher.guide_vectors @ catalog.base_vectors[b] >= np.cos(2.0 * catalog.rho_sub)
+        expected = np.flatnonzero(near[table.first] & near[table.second])
+        regional = sub._regional_table(b)
+        np.testing.assert_array_equal(regional.theta, table.theta[expected])
+        np.testing.assert_array_equal(regional.first, table.first[expected])
+        np.testing.assert_array_equal(regional.second, table.second[expected])
+        assert len(expected) > 0
