@@ -27,7 +27,7 @@ from scipy.stats import chi2
 from tqdm import tqdm
 
 from navsim import units
-from navsim.closed_loop import DIM_STAR_SOLVERS, paper000_comparison, paper004_comparison, paper004_notes
+from navsim.closed_loop import DIM_STAR_SOLVERS, paper000_comparison, paper000_notes, paper004_comparison, paper004_notes
 from navsim.output import read_npz, write_json, write_run
 from navsim.scenario import Scenario, resolve_scenario
 from navsim.simulation import NEES_DOF, prepare, simulate
@@ -210,13 +210,14 @@ def _pooled_paper_comparison(summaries):
     probes = [s["tracking_failure_probes"] for s in summaries if "tracking_failure_probes" in s]
     if probes:
         trials = sum(p["trials"] for p in probes)
-        pooled = {"trials": trials}
+        pooled = {"trials": trials, "disturbance_deg_max": max(p["disturbance_deg_max"] for p in probes)}
         for method in ("subcatalog", "lost_in_space"):
             pooled[method] = {key: float(sum(p["trials"] * p[method][key] for p in probes) / trials)
                               for key in ("recognition_rate", "ms_mean")}
         pooled["time_ratio"] = pooled["subcatalog"]["ms_mean"] / pooled["lost_in_space"]["ms_mean"]
         out["tracking_failure_probes"] = pooled
         rows += paper000_comparison(pooled)
+        out["notes"] = out.get("notes", []) + paper000_notes(pooled)
     if rows:
         out["paper_comparison"] = rows
     return out

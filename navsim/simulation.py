@@ -20,6 +20,7 @@ from navsim.closed_loop import (
     mode_statistics,
     dim_star_statistics,
     paper000_comparison,
+    paper000_notes,
     paper004_comparison,
     paper004_notes,
     probe_statistics,
@@ -147,6 +148,7 @@ def simulate(prepared, seed):
         if probes is not None:
             summary["tracking_failure_probes"] = probes
             summary["paper_comparison"] = paper000_comparison(probes)
+            summary["notes"] = paper000_notes(probes)
         if extras["shadow_q_est"] is not None or any(extras["solver_errors"].values()):
             shadow_error = None
             if extras["shadow_q_est"] is not None:
@@ -155,7 +157,7 @@ def simulate(prepared, seed):
             dim = dim_star_statistics(extras, log["attitude_error"], shadow_error, log["t"] >= scenario["settle_s"])
             summary["dim_star"] = dim
             summary["paper_comparison"] = summary.get("paper_comparison", []) + paper004_comparison(dim)
-            summary["notes"] = paper004_notes(dim)
+            summary["notes"] = summary.get("notes", []) + paper004_notes(dim)
     summary["wall_seconds"] = round(time.perf_counter() - started, 4)
     series = {key: value for key, value in log.items() if key != "P"}
     series["P_diag"] = np.diagonal(log["P"], axis1=1, axis2=2).copy()
