@@ -176,6 +176,17 @@ def _run_dask(scenario, chunks, scheduler, bar):
             client.close()
 
 
+def _pool_frames(pooled, name, runs, keys):
+    """pooled[name]: the frame-weighted pool of per-run lists, an RMS for keys marked True, a mean otherwise."""
+    frames = sum(r["frames"] for r in runs)
+    if not frames:
+        return
+    pooled[name] = {"frames": frames}
+    for key, rms in keys.items():
+        mean = sum(r["frames"] * (np.square(r[key]) if rms else np.asarray(r[key], dtype=float)) for r in runs) / frames
+        pooled[name][key] = [float(v) for v in (np.sqrt(mean) if rms else mean)]
+
+
 def _pooled_paper_comparison(summaries):
     """Pool the source-document experiments over runs: 004's dim-star RMS (frame-weighted) and 000's
     tracking-failure probes (trial-weighted), with their comparison rows."""
@@ -185,21 +196,12 @@ def _pooled_paper_comparison(summaries):
         pooled = {}
         for name in (*DIM_STAR_SOLVERS, "crb_two_star", "crb_three_star"):
             runs = [d[name] for d in dim if name in d]
-            frames = sum(r["frames"] for r in runs)
-            if frames:
-                pooled[name] = {"frames": frames} | {
-                    key: [float(v) for v in np.sqrt(sum(r["frames"] * np.square(r[key]) for r in runs) / frames)]
-                    for key in ("rms_ra_dec_roll_arcsec", "rms_cross_roll_arcsec") if all(key in r for r in runs)}
-        centroids = [d["stacked_centroid"] for d in dim if "stacked_centroid" in d]
-        if centroids:
-            frames = sum(c["frames"] for c in centroids)
-            pooled["stacked_centroid"] = {"frames": frames, "rms_error_px": np.sqrt(
-                sum(c["frames"] * np.square(c["rms_error_px"]) for c in centroids) / frames).tolist()}
-        off_axis = [d["off_axis_deg"] for d in dim if "off_axis_deg" in d]
-        if off_axis:
-            frames = sum(o["frames"] for o in off_axis)
-            pooled["off_axis_deg"] = {"frames": frames, "mean_bright_dim": (
-                sum(o["frames"] * np.array(o["mean_bright_dim"]) for o in off_axis) / frames).tolist()}
+            keys = [k for k in ("rms_ra_dec_roll_arcsec", "rms_cross_roll_arcsec") if runs and all(k in r for r in runs)]
+            _pool_frames(pooled, name, runs, {key: True for key in keys})
+        _pool_frames(pooled, "stacked_centroid", [d["stacked_centroid"] for d in dim if "stacked_centroid" in d],
+                     {"rms_error_px": True})
+        _pool_frames(pooled, "off_axis_deg", [d["off_axis_deg"] for d in dim if "off_axis_deg" in d],
+                     {"mean_bright_dim": False})
         for name in ("filter_with_stacking", "filter_without_stacking"):
             values = [d[name]["rms_xyz_arcsec"] for d in dim if name in d]
             if values:

@@ -21,6 +21,7 @@ coordinates in pixels (σ_px = σ / S). For the bound each star's direction nois
 import numpy as np
 
 from navsim.schema import Table, Value
+from navsim.units import ARCSEC
 from navsim.studies.common import percent, progress_bar
 from startrack.attitude import SOLVERS, cramer_rao_covariance, get_solver
 from startrack.attitude_angles import (
@@ -29,7 +30,6 @@ from startrack.attitude_angles import (
 from startrack.fov_select import radec_window
 from startrack.sphere import radec_to_vector
 
-ARCSEC = np.pi / 180.0 / 3600.0
 ANGLES = ("alpha", "delta", "kappa")
 DISTRIBUTIONS = ("radec_window", "uniform", "clustered", "line")
 SOURCE = "003 §3"
@@ -147,6 +147,7 @@ def simulate_point(rng, sensor, n, sigma_arcsec, trials, q_true, distribution, s
     J = angle_jacobian(q_true)
     boresight = radec_roll_from_quaternion(q_true)[:2]
     sigma_px = sigma_arcsec / sensor.pixel_arcsec
+    solver_of = {name: get_solver(name) for name in solvers}
     errors = {name: [] for name in solvers}
     predicted = {name: [] for name in solvers}
     crb = []
@@ -157,8 +158,7 @@ def simulate_point(rng, sensor, n, sigma_arcsec, trials, q_true, distribution, s
         unit_sigma = exact[:, 2] ** 1.5 / (sensor.pixel_arcsec * sensor.focal)    # [rad] per 1" of noise
         scale = sigma_arcsec ** 2
         crb.append(scale * np.diag(J @ cramer_rao_covariance(exact, unit_sigma) @ J.T))
-        for name in solvers:
-            solver = get_solver(name)
+        for name, solver in solver_of.items():
             errors[name].append(angle_errors(solver.solve(ref, obs, unit_sigma).q_IS, q_true))
             predicted[name].append(scale * np.diag(J @ solver.solve(ref, exact, unit_sigma).P @ J.T))
     result = {"stars": n, "sigma_arcsec": sigma_arcsec, "crb_rms_arcsec": (np.sqrt(np.mean(crb, axis=0)) / ARCSEC).tolist()}

@@ -25,6 +25,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from navsim.schema import Table, Value
+from navsim.units import ARCSEC
 from navsim.studies.common import progress_bar
 from startrack import boresight as bs
 from startrack.attitude_angles import matrix_from_radec_roll
@@ -32,10 +33,9 @@ from startrack.camera import Camera
 from startrack.identify import StarIdentifier
 from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-from startrack.sphere import vector_to_radec
+from startrack.sphere import angular_distance, vector_to_radec
 from startrack.star_catalog import load_star_catalog
 
-ARCSEC = np.pi / 180.0 / 3600.0
 FALSE_MATCH_ARCSEC = 60.0
 TRIPLE_METHODS = ("scalar_known_f_normalised", "scalar_known_f_linearised", "scalar_unknown_f_numeric",
                   "vector_known_f_svd", "vector_unknown_f_analytic", "vector_unknown_f_numeric")
@@ -70,11 +70,6 @@ PARAMETERS = Table(
 
 def paper_setup_matches(p):
     return all(p[k] == v for k, v in PAPER_SETUP.items())
-
-
-def angle(a, b):
-    """Angles [rad] between direction arrays (..., 3)."""
-    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
 
 
 class MapGeometry:
@@ -137,38 +132,38 @@ def optical_axis_map(rng, stars, geometry, casadi):
         ("vector_unknown_f_numeric", lambda: bs.solve_vector_unknown_f(ref[t], xy[t], "numeric", g.focal_bounds)),
     ):
         try:
-            out[method] = float(min(angle(c, w) for c in call().candidates))
+            out[method] = float(min(angular_distance(c, w) for c in call().candidates))
         except bs.InputError:
             out[method] = np.nan              # no admissible root, or a degenerate triple
     out["crb_vector_triple"] = g.crb_vector(xy0[t])
     out["crb_scalar_triple"] = g.crb_scalar(xy0[t])
-    out["scalar_all_ols"] = float(angle(bs.solve_scalar_all_stars(ref, radii, g.focal).boresight_I, w))
-    out["scalar_all_constrained"] = float(angle(bs.solve_scalar_all_stars(ref, radii, g.focal, "constrained").boresight_I, w))
-    out["vector_all_ols"] = float(angle(bs.solve_vector_all_stars(ref, xy, g.focal).boresight_I, w))
+    out["scalar_all_ols"] = float(angular_distance(bs.solve_scalar_all_stars(ref, radii, g.focal).boresight_I, w))
+    out["scalar_all_constrained"] = float(angular_distance(bs.solve_scalar_all_stars(ref, radii, g.focal, "constrained").boresight_I, w))
+    out["vector_all_ols"] = float(angular_distance(bs.solve_vector_all_stars(ref, xy, g.focal).boresight_I, w))
     unknown = bs.solve_vector_all_stars(ref, xy)
-    out["vector_all_ols_unknown_f"] = float(angle(unknown.boresight_I, w))
-    out["vector_all_procrustes"] = float(angle(bs.solve_vector_constrained(ref, xy, focal_px=g.focal).boresight_I, w))
+    out["vector_all_ols_unknown_f"] = float(angular_distance(unknown.boresight_I, w))
+    out["vector_all_procrustes"] = float(angular_distance(bs.solve_vector_constrained(ref, xy, focal_px=g.focal).boresight_I, w))
     out["vector_all_constrained_ipopt"] = np.nan
     out["casadi_ms"] = np.nan
     if casadi:
         start = time.perf_counter()
         fit = bs.solve_vector_constrained(ref, xy)
         out["casadi_ms"] = 1e3 * (time.perf_counter() - start)
-        out["vector_all_constrained_ipopt"] = float(angle(fit.boresight_I, w))
+        out["vector_all_constrained_ipopt"] = float(angular_distance(fit.boresight_I, w))
 
     # rank among all triples (2.3.3 (二), 3.3.3 (二))
     triples = bs.all_triples(n)
     P_rows = ref[triples]
     well_posed = np.linalg.svd(P_rows, compute_uv=False)[:, 2] > 1e-9
     triples, P_rows = triples[well_posed], P_rows[well_posed]
-    scalar_all = angle(bs.scalar_known_f_batch(P_rows, bs.cos_gamma(radii[triples], g.focal)), w)
+    scalar_all = angular_distance(bs.scalar_known_f_batch(P_rows, bs.cos_gamma(radii[triples], g.focal)), w)
     _, vector_w = bs.vector_known_f_batch(P_rows, bs.sensor_directions(xy[triples], g.focal))
-    vector_all = angle(vector_w, w)
+    vector_all = angular_distance(vector_w, w)
     f_triples, _ = bs.focal_cubic_batch(P_rows, xy[triples])
     ok = np.isfinite(f_triples)
     _, vector_w_unknown = bs.vector_known_f_batch(P_rows[ok], bs.sensor_directions(xy[triples[ok]], f_triples[ok][:, None]))
     vector_unknown_all = np.full(len(triples), np.inf)           # a triple without a root counts as worst
-    vector_unknown_all[ok] = angle(vector_w_unknown, w)
+    vector_unknown_all[ok] = angular_distance(vector_w_unknown, w)
 
     def triple_error(best, errors):
         return errors[np.flatnonzero(np.all(triples == best, axis=1))[0]]

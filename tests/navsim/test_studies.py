@@ -158,7 +158,7 @@ def test_contest_maps_are_all_recognised_without_false_matches(contest):
     for summary in contest.summary["identification"].values():
         assert summary["recognised_percent"] == 100.0 and summary["false_matches"] == 0
         assert summary["cross_boresight_rms_arcsec"] < 1.5 * summary["cross_boresight_crb_rms_arcsec"]
-    assert contest.arrays["id_gate_3_sigma_ms"].shape == (40,)
+    assert contest.arrays["id_gate_3_sigma_ok"].shape == (40,)
     assert contest.arrays["optical_vector_all_ols"].shape == (120,)
 
 
