@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from navsim.montecarlo import run_campaign
+from navsim.campaign.montecarlo import run_campaign
 from navsim.simulation import run_batch
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity

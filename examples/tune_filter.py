@@ -1,4 +1,4 @@
-"""Tune the attitude filter from Python: a grid over the process-noise scale, then navsim.tuning.
+"""Tune the attitude filter from Python: a grid over the process-noise scale, then navsim.campaign.tuning.
 
 The filter below assumes a gyro twice as good as the one flown (ARW 0.05 instead of 0.1 deg/√h),
 so it is over-confident: its NEES per degree of freedom is well above 1. The grid shows how the
@@ -8,8 +8,8 @@ scale factors. Every batch uses the same seeds (common random numbers).
     .venv/bin/python examples/tune_filter.py
 """
 
+from navsim.campaign.tuning import batch_statistics, tune
 from navsim.simulation import run_batch
-from navsim.tuning import batch_statistics, tune
 
 SCENARIO = {
     "name": "tuning-example",

@@ -12,14 +12,14 @@ Monte Carlo campaigns, filter tuning, the static studies of the source documents
 PDF reports live in :mod:`navsim.report` (not imported here: it loads matplotlib and typst).
 """
 
-from navsim.filter import AttitudeFilter
-from navsim.gyro import GyroModel
-from navsim.montecarlo import run_campaign
+from navsim.campaign.montecarlo import run_campaign
+from navsim.campaign.tuning import tune
+from navsim.estimation.attitude_filter import AttitudeFilter
 from navsim.output import read_npz, write_run
 from navsim.scenario import Scenario, load_scenario
+from navsim.sensors.gyro import GyroModel
 from navsim.simulation import RunResult, prepare, run, run_batch, run_study, simulate
 from navsim.studies import StudyResult
-from navsim.tuning import tune
 
 __all__ = [
     "AttitudeFilter",

@@ -13,8 +13,8 @@ import json
 import sys
 from pathlib import Path
 
-from navsim.montecarlo import run_campaign
-from navsim.tuning import tune
+from navsim.campaign.montecarlo import run_campaign
+from navsim.campaign.tuning import tune
 from navsim.output import write_run, write_study
 from navsim.scenario import resolve_scenario
 from navsim.simulation import run, run_study

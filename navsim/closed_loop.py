@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim import quaternion as quat
+from navsim import kinematics
+from startrack import rotation as rot
 from startrack.attitude import SvdWahba, ThreeStarOptimal, Triad, cramer_rao_covariance
 from startrack.attitude_angles import radec_roll_from_quaternion
 from startrack.camera import Camera
@@ -149,7 +150,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
     camera, model = sensor.camera, sensor.model
     n_frames, ratio, dt = p.n_frames, p.ratio, p.dt
     q_BS_true = p.q_BS_true
-    R_SB_true = quat.to_matrix(q_BS_true).T
+    R_SB_true = rot.to_matrix(q_BS_true).T
     dropped = np.asarray(faults["dropped_frames_s"])
     jumps = sorted(faults["attitude_jumps"], key=lambda j: j["time_s"])
     jump_rng, storm_rng, render_rng = (np.random.default_rng(s) for s in seed.spawn(3))
@@ -192,12 +193,12 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
         while jump_index < len(jumps) and jumps[jump_index]["time_s"] <= t:
             axis = jump_rng.standard_normal(3)
             axis /= np.linalg.norm(axis)
-            filt.q = quat.normalize(quat.multiply(filt.q, quat.from_rotation_vector(np.radians(jumps[jump_index]["angle_deg"]) * axis)))
+            filt.q = rot.normalize(rot.multiply(filt.q, rot.from_rotation_vector(np.radians(jumps[jump_index]["angle_deg"]) * axis)))
             tracking = False
             cache.reset()
             jump_index += 1
-        q_IS_pred = quat.multiply(filt.q, filt.q_BS)
-        ra, dec = quat.boresight_radec(q_IS_pred)
+        q_IS_pred = rot.multiply(filt.q, filt.q_BS)
+        ra, dec = kinematics.boresight_radec(q_IS_pred)
         log["boresight_radec"][j] = (ra, dec)
         log["subcatalog_address"][j] = sensor.catalog.address(ra, dec)
         log["subcatalog_index"][j] = sensor.catalog.sub_catalog_index(ra, dec)
@@ -211,7 +212,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
             tracking = False
             cache.reset()
         else:
-            q_IS_true = quat.multiply(p.q_true[k], q_BS_true)
+            q_IS_true = rot.multiply(p.q_true[k], q_BS_true)
             omega_S = R_SB_true @ omega_true_frames[j]
             uv_pred, visible = camera.project(q_IS_pred, sensor.stars_I)
             predicted = np.flatnonzero(visible)
@@ -306,7 +307,7 @@ def run_image_loop(p, filt, omega_measured, frame_k, omega_true_frames, seed):
                 update = filt.update_stars(ref_I, obs_S, sigma)
                 if update.n_accepted == 0 and mode in ("subcatalog", "lost_in_space") and result.ok:
                     # the identification disagrees with the prediction: the filter lost track
-                    filt.q = quat.normalize(quat.multiply(result.q_IS, quat.conjugate(filt.q_BS)))
+                    filt.q = rot.normalize(rot.multiply(result.q_IS, rot.conjugate(filt.q_BS)))
                     filt.P[0:3, :] = 0.0
                     filt.P[:, 0:3] = 0.0
                     filt.P[0:3, 0:3] = P0_attitude
@@ -339,7 +340,7 @@ def _compare_solvers(errors, ref_I, obs_S, dim_ref_I, dim_obs_S, q_IS_true, sigm
     frame: errors in (RA, Dec, roll) [rad] against the truth, the same in S axes (cross x, y, roll),
     and the Cramér-Rao variances [rad²] in S axes of the two- and three-star sets."""
     truth = np.array(radec_roll_from_quaternion(q_IS_true))
-    R_SI = quat.to_matrix(q_IS_true).T
+    R_SI = rot.to_matrix(q_IS_true).T
     all_ref = np.vstack([ref_I, dim_ref_I])
     all_obs = np.vstack([obs_S, dim_obs_S])
     sigmas = np.array([sigma, sigma, sigma_dim])
@@ -350,7 +351,7 @@ def _compare_solvers(errors, ref_I, obs_S, dim_ref_I, dim_obs_S, q_IS_true, sigm
         error = (error + np.pi) % (2.0 * np.pi) - np.pi
         error[0] *= np.cos(truth[1])  # RA error as an angle on the sky
         errors[name].append(error)
-        errors[name + "_S"].append(quat.attitude_error(solution.q_IS, q_IS_true))
+        errors[name + "_S"].append(rot.attitude_error(solution.q_IS, q_IS_true))
     exact_S = all_ref @ R_SI.T
     errors["off_axis_rad"].append(np.arccos(np.clip(exact_S[:, 2], -1.0, 1.0)))
     errors["crb_two_star_S"].append(np.diag(cramer_rao_covariance(exact_S[:2], sigma)))
@@ -365,11 +366,11 @@ def _probe(sensor, found, q_IS_pred, q_IS_true, rng, angle_3sigma_deg):
     identification is off by degrees, while smeared centroids of a correct one can be off by an arcmin."""
     sigma = np.radians(angle_3sigma_deg) / 3.0
     phi = rng.normal(0.0, sigma, 3)
-    disturbed = quat.multiply(q_IS_pred, quat.from_rotation_vector(phi))
+    disturbed = rot.multiply(q_IS_pred, rot.from_rotation_vector(phi))
     trial = {"disturbance_deg": float(np.degrees(np.linalg.norm(phi)))}
     for method, identifier in sensor.probes.items():
         result = identifier.solve(found.uv, found.flux, prior=Prior(q_IS=disturbed))
-        error = np.linalg.norm(quat.attitude_error(q_IS_true, result.q_IS)) if result.ok else np.inf
+        error = np.linalg.norm(rot.attitude_error(q_IS_true, result.q_IS)) if result.ok else np.inf
         trial[method] = {"ok": bool(result.ok and error < np.radians(0.1)), "ms": float(result.solve_ms)}
     return trial
 

@@ -8,17 +8,15 @@ a pool or a cluster.
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
 
-from navsim import build, faults, kernels
 from navsim.closed_loop import (
     MODES,
     ImageSensor,
-    mode_statistics,
     dim_star_statistics,
+    mode_statistics,
     paper000_comparison,
     paper000_notes,
     paper004_comparison,
@@ -26,12 +24,14 @@ from navsim.closed_loop import (
     probe_statistics,
     run_image_loop,
 )
-from navsim import quaternion as quat
-from navsim import units
-from navsim.scenario import Scenario, resolve_scenario
-from navsim.star_sensor import AttitudeFixSensor
+from navsim.estimation import kernels
+from navsim.scenario import Scenario, build, resolve_scenario
+from navsim.sensors import faults
+from navsim.sensors.star_vector import AttitudeFixSensor
 from navsim.studies import STUDIES, StudyResult
-from navsim.truth import interval_mean_rates
+from navsim.truth.profiles import interval_mean_rates
+from startrack import rotation as rot
+from startrack import units
 from startrack.attitude_angles import quaternion_from_radec_roll
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
@@ -75,10 +75,10 @@ def initial_attitude(scenario):
     mounting) when given, else ``truth.initial_q_IB``."""
     radec_roll = scenario["truth"]["initial_radec_roll_deg"]
     if radec_roll is None:
-        return quat.normalize(scenario["truth"]["initial_q_IB"])
+        return rot.normalize(scenario["truth"]["initial_q_IB"])
     q_IS = quaternion_from_radec_roll(*np.radians(radec_roll))
     q_BS, _ = build.mounting(scenario)
-    return quat.normalize(quat.multiply(q_IS, quat.conjugate(q_BS)))
+    return rot.normalize(rot.multiply(q_IS, rot.conjugate(q_BS)))
 
 
 def prepare(scenario, overrides=(), star_catalog=None):
@@ -107,7 +107,7 @@ def prepare(scenario, overrides=(), star_catalog=None):
         n_frames=n_gyro // ratio,
         gyro=build.gyro_model(scenario),
         sensor=None if image else build.star_sensor(scenario, star_catalog),
-        R_BS=quat.to_matrix(q_BS),
+        R_BS=rot.to_matrix(q_BS),
         q_BS_true=q_BS_true,
         image_sensor=ImageSensor.build(scenario, star_catalog) if image else None,
     )
@@ -124,7 +124,7 @@ def simulate(prepared, seed):
                                                         scenario["faults"]["gyro_bias_steps"])
     P0 = build.initial_covariance(scenario, p.gyro)
     dtheta0 = np.sqrt(np.diag(P0)[0:3]) * np.random.default_rng(init_ss).standard_normal(3)
-    filt = build.attitude_filter(scenario, p.gyro, quat.multiply(p.q_true[0], quat.from_rotation_vector(dtheta0)), P0)
+    filt = build.attitude_filter(scenario, p.gyro, rot.multiply(p.q_true[0], rot.from_rotation_vector(dtheta0)), P0)
     frame_k = np.arange(1, p.n_frames + 1) * p.ratio  # gyro sample index of each frame
     t_frames = p.t_gyro[frame_k]
     log = {"t": t_frames, "q_true": p.q_true[frame_k], "bias_true": bias_true[frame_k - 1]}
@@ -138,7 +138,7 @@ def simulate(prepared, seed):
     else:
         image_log, extras = run_image_loop(p, filt, omega_measured, frame_k, p.omega_mean[frame_k - 1], sensor_ss)
         log.update(image_log)
-    log["attitude_error"] = quat.attitude_error(log["q_est"], log["q_true"])
+    log["attitude_error"] = rot.attitude_error(log["q_est"], log["q_true"])
     log["nees"] = nees(log)
     summary = summarize(scenario, seed, log, p.R_BS)
     if p.image_sensor is not None:
@@ -152,7 +152,7 @@ def simulate(prepared, seed):
         if extras["shadow_q_est"] is not None or any(extras["solver_errors"].values()):
             shadow_error = None
             if extras["shadow_q_est"] is not None:
-                shadow_error = quat.attitude_error(extras["shadow_q_est"], log["q_true"])
+                shadow_error = rot.attitude_error(extras["shadow_q_est"], log["q_true"])
                 log["attitude_error_without_stacking"] = shadow_error
             dim = dim_star_statistics(extras, log["attitude_error"], shadow_error, log["t"] >= scenario["settle_s"])
             summary["dim_star"] = dim
@@ -204,7 +204,7 @@ def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
 
 
 def run_vector_filter(filt, omega, ratio, dt, sensor, measurements, meas_scale=1.0, available=None):
-    """Run ``filt`` over a whole record in compiled code (:func:`navsim.kernels.run_filter`).
+    """Run ``filt`` over a whole record in compiled code (:func:`navsim.estimation.kernels.run_filter`).
 
     ``omega`` (F*ratio, 3) gyro samples; ``measurements``: the sensor's ``observe_frames`` output
     (q_IS per frame for an :class:`AttitudeFixSensor`, else :class:`StarFrames`); the sensor's

@@ -29,14 +29,14 @@ Each solution carries the first-order covariance of *that* estimator:
 attitude's prediction ``R_IS^T ref_I``.
 """
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-import math
 
 import numpy as np
 
-from startrack.attitude_angles import matrix_from_quaternion, quaternion_from_matrix
 from startrack.errors import InputError
+from startrack.rotation import from_matrix, nearest_rotation, skew, to_matrix
 
 UNIT_NORM_TOLERANCE = 1e-6
 
@@ -59,7 +59,7 @@ class AttitudeSolution:
     @property
     def R_IS(self):
         """(3, 3) rotation matrix taking S vectors into I."""
-        return matrix_from_quaternion(self.q_IS)
+        return to_matrix(self.q_IS)
 
 
 def cramer_rao_covariance(obs_S, sigma):
@@ -82,14 +82,6 @@ def _inverse_fisher(weighted_scatter, weight_sum):
     if not det > 0.0:
         raise InputError("the observed directions are all parallel; the attitude is not observable.")
     return np.array([[a11, a12, a13], [a12, a22, a23], [a13, a23, a33]]) / det
-
-
-def _skew(v):
-    """Cross-product matrices [v x] (..., 3, 3) of vectors (..., 3)."""
-    zero = np.zeros(v.shape[:-1])
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1),
-                     np.stack([-y, x, zero], -1)], -2)
 
 
 def _propagated_covariance(jacobians, obs, sigma2):
@@ -144,7 +136,7 @@ class AttitudeSolver(ABC):
         """
         ref, obs, sig = _validated(ref_I, obs_S, sigma, self.min_stars, self.name)
         q, P = self._solve(ref, obs, sig)
-        return AttitudeSolution(q_IS=q, P=P, residuals=_residuals(ref, obs, matrix_from_quaternion(q)),
+        return AttitudeSolution(q_IS=q, P=P, residuals=_residuals(ref, obs, to_matrix(q)),
                                 method=self.name)
 
     @abstractmethod
@@ -157,7 +149,7 @@ class _LinearisedSolver(AttitudeSolver):
 
     def _solve(self, ref, obs, sigma):
         q = self._estimate(ref, obs, sigma)
-        return q, self._covariance(ref, obs, sigma, matrix_from_quaternion(q))
+        return q, self._covariance(ref, obs, sigma, to_matrix(q))
 
     @abstractmethod
     def _estimate(self, ref, obs, sigma):
@@ -204,7 +196,7 @@ class Triad(_LinearisedSolver):
 
     def _estimate(self, ref, obs, sigma):
         i, j = _two_best(sigma)
-        return quaternion_from_matrix(self._triad(ref[i], ref[j]) @ self._triad(obs[i], obs[j]).T)
+        return from_matrix(self._triad(ref[i], ref[j]) @ self._triad(obs[i], obs[j]).T)
 
     def _triad(self, v1, v2):
         t2, _ = _unit_cross(v1, v2, self.name)
@@ -244,18 +236,18 @@ class ThreeStarOptimal(_LinearisedSolver):
         V = np.vstack([obs, v_ij]).T
         M = _solve_spd(V @ V.T, V @ U.T, self.name).T               # eq. 11: U V^T (V V^T)^-1
         M_s = 0.5 * (3.0 * np.eye(3) - M.T @ M) @ M.T               # eq. 12
-        return quaternion_from_matrix(M_s.T)
+        return from_matrix(M_s.T)
 
     def _covariance(self, ref, obs, sigma, R_IS):
         i, j = _two_best(sigma)
         v_ij, cross_norm = _unit_cross(obs[i], obs[j], self.name)
         V = np.vstack([obs, v_ij])
         G = np.linalg.solve(V.T @ V, V.T).T                         # rows g_k = (V V^T)^-1 V_k
-        J = -0.5 * _skew(G[:-1])                                     # dV_k x g_k = -[g_k x] dV_k
+        J = -0.5 * skew(G[:-1])                                     # dV_k x g_k = -[g_k x] dV_k
         D = (np.eye(3) - np.outer(v_ij, v_ij)) / cross_norm
-        G_ij = -0.5 * _skew(G[-1]) @ D
-        J[i] += G_ij @ -_skew(obs[j])
-        J[j] += G_ij @ _skew(obs[i])
+        G_ij = -0.5 * skew(G[-1]) @ D
+        J[i] += G_ij @ -skew(obs[j])
+        J[j] += G_ij @ skew(obs[i])
         return _propagated_covariance(J, obs, sigma ** 2)
 
 
@@ -280,16 +272,13 @@ class MultiVector(_LinearisedSolver):
         if singular[-1] <= 1e-12 * singular[0]:
             raise InputError(f"{self.name}: the reference vectors are coplanar with the origin; R^T R is "
                              "singular (use a Wahba solver).")
-        U, _, Vt = np.linalg.svd(B)                                 # eq. 1 via the polar factor
-        if _det3(U) * _det3(Vt) < 0.0:                               # improper polar factor: nearest rotation
-            U[:, 2] = -U[:, 2]
-        return quaternion_from_matrix(U @ Vt)
+        return from_matrix(nearest_rotation(B))                      # eq. 1: the polar factor U V^T
 
     def _covariance(self, ref, obs, sigma, R_IS):
         w = sigma ** -2
         C = R_IS.T @ np.linalg.inv(ref.T @ (ref * w[:, None]))
         c = (ref @ C.T) * w[:, None]
-        return _propagated_covariance(-0.5 * _skew(c), obs, sigma ** 2)
+        return _propagated_covariance(-0.5 * skew(c), obs, sigma ** 2)
 
 
 def _solve_spd(A, B, name):
@@ -329,16 +318,7 @@ class SvdWahba(_WahbaSolver):
     min_stars = 2
 
     def _from_profile(self, B):
-        U, _, Vt = np.linalg.svd(B)
-        if _det3(U) * _det3(Vt) < 0.0:
-            U[:, 2] = -U[:, 2]
-        return quaternion_from_matrix(Vt.T @ U.T)
-
-
-def _det3(M):
-    """Determinant of a 3x3 matrix (scalar arithmetic)."""
-    (a, b, c), (d, e, f), (g, h, i) = M.tolist()
-    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+        return from_matrix(nearest_rotation(B.T))
 
 
 def _davenport_parts(B):

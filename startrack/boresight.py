@@ -27,8 +27,8 @@ from itertools import combinations
 import numpy as np
 from scipy.optimize import brentq
 
-from startrack.attitude_angles import quaternion_from_matrix
 from startrack.errors import InputError
+from startrack.rotation import from_matrix, nearest_rotation
 
 RANK_TOLERANCE = 1e-9          # relative singular value below which ^0P counts as rank deficient
 COLLINEAR_TOLERANCE = 1e-4     # 1 - |P^+ b|^2 down to -this counts as tangent (noise in b), not a miss
@@ -273,24 +273,15 @@ def sensor_directions(xy_px, focal_px):
     return c / np.linalg.norm(c, axis=-1, keepdims=True)
 
 
-def _nearest_rotation(M):
-    """Rotation closest to M (..., 3, 3) in Frobenius norm: U diag(1, 1, det U V^T) V^T."""
-    U, _, Vt = np.linalg.svd(M)
-    d = np.sign(np.linalg.det(U @ Vt))
-    U = U.copy()
-    U[..., :, 2] *= d[..., None]
-    return U @ Vt
-
-
 def vector_known_f_batch(P_rows, C_rows):
     """001 3.1.1: R = Cc Pc^-1 projected onto the rotations by SVD; w = R^T e_3.  Stacks (K, 3, 3)."""
     R_raw = np.swapaxes(np.linalg.solve(P_rows, C_rows), -1, -2)   # Cc Pc^-1 = (P_rows^-1 C_rows)^T
-    R = _nearest_rotation(R_raw)
+    R = nearest_rotation(R_raw)
     return R, R[..., 2, :]
 
 
 def _solution_from_R(R, f, method):
-    return BoresightSolution(R[2].copy(), R[2][None].copy(), float(f), quaternion_from_matrix(R.T), method)
+    return BoresightSolution(R[2].copy(), R[2][None].copy(), float(f), from_matrix(R.T), method)
 
 
 def solve_vector_known_f(ref_I, xy_px, focal_px):
@@ -536,7 +527,7 @@ def solve_scalar_all_stars(ref_I, radii_px, focal_px, method="ols"):
 def _vector_ols(ref, c):
     """001 3.3.2 (一): R_hat = argmin |R Pc' - Cc'|^2 = Cc' Pc'^T (Pc' Pc'^T)^-1, projected by SVD."""
     R_raw = np.linalg.solve(ref.T @ ref, ref.T @ c).T
-    return _nearest_rotation(R_raw)
+    return nearest_rotation(R_raw)
 
 
 def solve_vector_all_stars(ref_I, xy_px, focal_px=None):
@@ -592,12 +583,12 @@ def solve_vector_constrained(ref_I, xy_px, focal_px=None, focal_bounds_px=None):
     xy = _as_xy(xy_px, ref.shape[0], what)
     if focal_px is not None:
         f = _as_focal(focal_px, what)
-        R = _nearest_rotation(sensor_directions(xy, f).T @ ref)
+        R = nearest_rotation(sensor_directions(xy, f).T @ ref)
         return _solution_from_R(R, f, "vector_constrained_procrustes")
     f0 = focal_from_angular_distances(ref, xy)[0]
     low, high = _as_bounds(focal_bounds_px, what) if focal_bounds_px is not None else (0.5 * f0, 2.0 * f0)
     f0 = min(max(f0, low), high)
-    R0 = _nearest_rotation(sensor_directions(xy, f0).T @ ref)
+    R0 = nearest_rotation(sensor_directions(xy, f0).T @ ref)
     solver = _constrained_fit_solver(ref.shape[0])
     x0 = np.concatenate([R0.T.ravel(), [1.0]])                 # casadi vec() is column-major
     params = np.concatenate([ref.ravel(), xy.ravel(), [f0]])   # vec(P) of 3 x n columns = ref rows
@@ -607,5 +598,5 @@ def solve_vector_constrained(ref_I, xy_px, focal_px=None, focal_bounds_px=None):
     if not solver.stats()["success"]:
         raise InputError(f"{what}: Ipopt did not converge ({solver.stats()['return_status']}).")
     x = np.asarray(result["x"]).ravel()
-    R = _nearest_rotation(x[:9].reshape(3, 3).T)
+    R = nearest_rotation(x[:9].reshape(3, 3).T)
     return _solution_from_R(R, x[9] * f0, "vector_constrained_ipopt")

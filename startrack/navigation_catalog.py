@@ -73,9 +73,7 @@ from startrack.cache import cache_dir
 from startrack.errors import InputError
 from startrack.kvector import KVector
 from startrack.sphere import radec_to_vector
-
-ARCSEC = np.pi / (180.0 * 3600.0)
-DEG = np.pi / 180.0
+from startrack.units import ARCSEC, DEG
 
 #: Numbers of 000 §5 / Table 1 (SKYMAP 2000, m_t = 6.0, 16 deg, n_d = 53) for comparison.
 REFERENCE_000 = types.MappingProxyType(

@@ -56,11 +56,11 @@ import numpy as np
 from startrack.cache import cache_dir
 from startrack.errors import InputError
 from startrack.sphere import local_frame, vector_to_radec
+from startrack.units import MILLIARCSEC
 
 #: Epoch of the Hipparcos-2 astrometry [Julian year].
 HIPPARCOS_EPOCH = 1991.25
 
-MAS_TO_RAD = np.pi / (180.0 * 3600.0 * 1000.0)
 
 #: Bessell (2000), Table 2: columns BT-VT, Delta(B-V) = (B-V) - (BT-VT), V - Hp [mag].
 BESSELL_2000_TABLE2 = np.array(
@@ -175,9 +175,9 @@ def parse_hip2(path) -> dict:
         "n_components": _field(records, *c["nc"], np.int8),
         "ra": ra,
         "dec": dec,
-        "parallax": _field(records, *c["parallax"], np.float64) * MAS_TO_RAD,
-        "pm_ra_cosdec": _field(records, *c["pm_ra"], np.float64) * MAS_TO_RAD,
-        "pm_dec": _field(records, *c["pm_dec"], np.float64) * MAS_TO_RAD,
+        "parallax": _field(records, *c["parallax"], np.float64) * MILLIARCSEC,
+        "pm_ra_cosdec": _field(records, *c["pm_ra"], np.float64) * MILLIARCSEC,
+        "pm_dec": _field(records, *c["pm_dec"], np.float64) * MILLIARCSEC,
         "hp_mag": _field(records, *c["hp_mag"], np.float64),
         "variability_annex": _field(records, *c["va"], np.int8),
         "b_v": _field(records, *c["b_v"], np.float64),

@@ -15,11 +15,10 @@ import matplotlib
 import numpy as np
 import typst
 
-from navsim import units
 from navsim.report import figures
 from navsim.report import statistics as stats
 from navsim.studies import STUDIES
-from startrack import address
+from startrack import address, units
 
 PREAMBLE = """\
 #set document(title: {title}, author: "navsim", date: none)

@@ -7,9 +7,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from navsim import units
 from navsim.report import statistics as stats
-from startrack import address
+from startrack import address, units
 
 WIDTH_IN = 6.5
 AXES = "xyz"

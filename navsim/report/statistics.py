@@ -12,8 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from navsim import units
-from startrack import address
+from startrack import address, units
 from startrack.errors import InputError
 
 BAND_PROBABILITY = 0.95

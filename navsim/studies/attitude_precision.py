@@ -20,15 +20,14 @@ coordinates in pixels (σ_px = σ / S). For the bound each star's direction nois
 
 import numpy as np
 
-from navsim.schema import Table, Value
-from navsim.units import ARCSEC
+from navsim.scenario.schema import Table, Value
 from navsim.studies.common import percent, progress_bar
 from startrack.attitude import SOLVERS, cramer_rao_covariance, get_solver
-from startrack.attitude_angles import (
-    matrix_from_quaternion, quaternion_from_matrix, quaternion_from_radec_roll, radec_roll_from_quaternion,
-)
+from startrack.attitude_angles import quaternion_from_radec_roll, radec_roll_from_quaternion
 from startrack.fov_select import radec_window
+from startrack.rotation import from_matrix, to_matrix
 from startrack.sphere import radec_to_vector
+from startrack.units import ARCSEC
 
 ANGLES = ("alpha", "delta", "kappa")
 DISTRIBUTIONS = ("radec_window", "uniform", "clustered", "line")
@@ -97,7 +96,7 @@ def angle_errors(q, q_true):
 
 def angle_jacobian(q_true, step=1e-6):
     """∂(α, δ, κ)/∂δθ (3 x 3) for R = R_true exp([δθ×]) (central differences)."""
-    R = matrix_from_quaternion(q_true)
+    R = to_matrix(q_true)
     J = np.zeros((3, 3))
     for k in range(3):
         columns = []
@@ -106,7 +105,7 @@ def angle_jacobian(q_true, step=1e-6):
             K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
             angle = sign * step
             R_k = R @ (np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K)
-            columns.append(angle_errors(quaternion_from_matrix(R_k), q_true))
+            columns.append(angle_errors(from_matrix(R_k), q_true))
         J[:, k] = (columns[0] - columns[1]) / (2 * step)
     return J
 
@@ -143,7 +142,7 @@ def star_field(rng, sensor, n, distribution, R_IS, boresight):
 def simulate_point(rng, sensor, n, sigma_arcsec, trials, q_true, distribution, solvers):
     """Monte Carlo of 003 §3.1 at one point: per solver the RMS (α, δ, κ) ["], the largest |error| and
     the first-order prediction, and the Cramér-Rao RMS."""
-    R_IS = matrix_from_quaternion(q_true)
+    R_IS = to_matrix(q_true)
     J = angle_jacobian(q_true)
     boresight = radec_roll_from_quaternion(q_true)[:2]
     sigma_px = sigma_arcsec / sensor.pixel_arcsec

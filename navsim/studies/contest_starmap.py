@@ -24,8 +24,7 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from navsim.schema import Table, Value
-from navsim.units import ARCSEC
+from navsim.scenario.schema import Table, Value
 from navsim.studies.common import progress_bar
 from startrack import boresight as bs
 from startrack.attitude_angles import matrix_from_radec_roll
@@ -35,6 +34,7 @@ from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
 from startrack.sphere import angular_distance, vector_to_radec
 from startrack.star_catalog import load_star_catalog
+from startrack.units import ARCSEC
 
 FALSE_MATCH_ARCSEC = 60.0
 TRIPLE_METHODS = ("scalar_known_f_normalised", "scalar_known_f_linearised", "scalar_unknown_f_numeric",

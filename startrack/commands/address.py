@@ -14,8 +14,7 @@ import numpy as np
 
 from startrack.commands.catalog import check_option
 from startrack.errors import InputError
-
-DEG = math.pi / 180.0
+from startrack.units import DEG
 
 
 def register(subparsers):

@@ -16,9 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from startrack.errors import InputError
-
-DEG = math.pi / 180.0
-ARCSEC = DEG / 3600.0
+from startrack.units import ARCSEC, DEG
 
 #: Option -> (low, high) accepted range, in the option's unit.
 _RANGES = {

@@ -13,8 +13,7 @@ import math
 import numpy as np
 
 from startrack.errors import InputError
-
-DEG = math.pi / 180.0
+from startrack.units import DEG
 
 
 def _finite(option, value, low, high):

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from startrack.errors import InputError
+from startrack.units import DEG
 
-DEG = math.pi / 180.0
 _IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.attitude_angles import quaternion_from_matrix, radec_roll_from_matrix
+from startrack.attitude_angles import radec_roll_from_matrix
 from startrack.errors import InputError
 from startrack.identify.features import FrameFeatures
 from startrack.identify.lost_in_space import LostInSpace, PairTable, PatternMatcher
@@ -32,6 +32,7 @@ from startrack.identify.result import IdentificationResult
 from startrack.identify.subcatalog import SubCatalog
 from startrack.identify.tracking import Tracking, propagate
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
+from startrack.rotation import from_matrix
 
 #: Strategy names in the order they are tried.
 METHODS = ("tracking", "subcatalog", "lost_in_space")
@@ -226,7 +227,7 @@ class StarIdentifier:
         if strategy.name == "tracking":
             lost, entered = strategy.lost_and_entered(prior, verified.R_IS, hip)
         return IdentificationResult(
-            status="ok", q_IS=quaternion_from_matrix(verified.R_IS),
+            status="ok", q_IS=from_matrix(verified.R_IS),
             matches=np.column_stack([centroid[order], hip]), obs_S=frame.obs_S[verified.obs_index[order]],
             ref_I=self.field.vectors[star_index], sigma=self.centroid_sigma_px / self.camera.focal_px,
             false_match_probability=verified.false_match_probability, method=strategy.name,

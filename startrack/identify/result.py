@@ -13,13 +13,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from startrack.attitude import cramer_rao_covariance
-from startrack.attitude_angles import matrix_from_quaternion, radec_roll_from_quaternion
+from startrack.attitude_angles import radec_roll_from_quaternion
+from startrack.rotation import to_matrix
+from startrack.units import ARCSEC
 
 #: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
 #: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
 STATUSES = ("ok", "no_match", "too_few", "error")
 
-_ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,7 +88,7 @@ class IdentificationResult:
         """(M,) angle [rad] between each matched direction and its prediction R_IS^T ref_I."""
         if not self.ok:
             return np.zeros(0)
-        chord = self.obs_S - self.ref_I @ matrix_from_quaternion(self.q_IS)
+        chord = self.obs_S - self.ref_I @ to_matrix(self.q_IS)
         return 2.0 * np.arcsin(np.minimum(0.5 * np.sqrt(np.einsum("ij,ij->i", chord, chord)), 1.0))
 
     @functools.cached_property
@@ -112,14 +113,14 @@ class IdentificationResult:
         if self.reason:
             out["reason"] = self.reason
         if self.ok:
-            sigma = np.sqrt(np.clip(np.diag(self.covariance), 0.0, None)) * _ARCSEC_PER_RAD
+            sigma = np.sqrt(np.clip(np.diag(self.covariance), 0.0, None)) / ARCSEC
             out.update(
                 q_IS=[float(x) for x in self.q_IS],
                 ra_deg=math.degrees(self.ra),
                 dec_deg=math.degrees(self.dec),
                 roll_deg=math.degrees(self.roll),
                 matches=[[int(i), int(h)] for i, h in self.matches],
-                residuals_arcsec=[round(float(r) * _ARCSEC_PER_RAD, 4) for r in self.residuals],
+                residuals_arcsec=[round(float(r) / ARCSEC, 4) for r in self.residuals],
                 sigma_arcsec=[float(s) for s in sigma],
                 false_match_probability=float(self.false_match_probability),
             )

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import navsim
-from navsim import units
 from navsim.closed_loop import MODE_CODE
+from startrack import units
 from startrack.errors import InputError
 
 

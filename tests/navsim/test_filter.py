@@ -10,10 +10,11 @@ from scipy.linalg import expm, solve_discrete_are
 from scipy.stats import chi2
 
 import navsim
-from navsim import kernels, units
-from navsim import quaternion as quat
-from navsim.analytic import farrenkopf_steady_state
-from navsim.filter import AttitudeFilter
+from navsim.estimation import kernels
+from navsim.estimation.analytic import farrenkopf_steady_state
+from navsim.estimation.attitude_filter import AttitudeFilter
+from startrack import rotation as rot
+from startrack import units
 
 RNG = np.random.default_rng(3)
 
@@ -29,7 +30,7 @@ def test_transition_is_the_exponential_of_the_error_dynamics():
     d = np.array([0.31, -0.49, 0.21])
     dt = 0.1
     F = np.zeros((9, 9))
-    F[0:3, 0:3] = -quat.skew(omega)
+    F[0:3, 0:3] = -rot.skew(omega)
     F[0:3, 3:6] = -np.eye(3)
     F[0:3, 6:9] = -np.diag(d)
     np.testing.assert_allclose(kernels.transition(omega, d, dt, 9, 6), expm(F * dt), atol=1e-14)
@@ -38,7 +39,7 @@ def test_transition_is_the_exponential_of_the_error_dynamics():
 
 def _f6(omega):
     F = np.zeros((6, 6))
-    F[0:3, 0:3] = -quat.skew(omega)
+    F[0:3, 0:3] = -rot.skew(omega)
     F[0:3, 3:6] = -np.eye(3)
     return F
 
@@ -63,7 +64,7 @@ def test_predict_and_update_equal_filterpy():
     b = np.array([1e-4, -2e-4, 5e-5])
     s = np.array([1e-4, 0.0, -1e-4])
     dt, arw, rrw, sf_rw = 0.1, 1e-4, 1e-6, 1e-5
-    q0 = quat.from_rotation_vector([0.1, 0.2, 0.3])
+    q0 = rot.from_rotation_vector([0.1, 0.2, 0.3])
     _, P_pred = kernels.predict(q0, P, b, s, omega_measured, dt, arw, rrw, sf_rw, 1.0, 6)
     d = omega_measured[0] - b
     kf = KalmanFilter(dim_x=n, dim_z=4)
@@ -177,7 +178,7 @@ def test_torque_free_tumble_with_10_arcsec_fixes(base_scenario):
                                         "initial_rate_deg_per_s": [w, w, w]}}
     scenario["star_sensor"].update(attitude_sigma_cross_arcsec=10.0, attitude_sigma_roll_arcsec=10.0, rate_hz=1.0)
     results, nees, t = _monte_carlo(scenario, 12)
-    angle_turned = np.degrees(np.linalg.norm(quat.attitude_error(results[0].series["q_true"][0], results[0].series["q_true"]), axis=1))
+    angle_turned = np.degrees(np.linalg.norm(rot.attitude_error(results[0].series["q_true"][0], results[0].series["q_true"]), axis=1))
     assert angle_turned.max() > 179.0
     _assert_nees_consistent(nees, t, settle_s=60.0, min_fraction=0.85)
     for r in results:
@@ -211,19 +212,19 @@ def test_two_stars_make_the_attitude_fully_observable():
 def test_a_star_update_moves_the_estimate_to_the_truth():
     """Noise-free stars and a 90 arcsec initial error: one update leaves only the second-order
     linearisation error (< 0.1 arcsec)."""
-    q_true = quat.from_rotation_vector([2e-4, -3e-4, 2.5e-4])
+    q_true = rot.from_rotation_vector([2e-4, -3e-4, 2.5e-4])
     filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=np.diag([1e-6] * 3 + [1e-10] * 3), arw=1e-5, rrw=1e-8)
     ref_I = np.array([[0, 0, 1.0], [0.1, 0, 1.0], [0, 0.12, 1.0], [-0.08, -0.05, 1.0]])
     ref_I /= np.linalg.norm(ref_I, axis=1, keepdims=True)
-    obs_S = quat.rotate(quat.conjugate(q_true), ref_I)
+    obs_S = rot.rotate(rot.conjugate(q_true), ref_I)
     filt.update_stars(ref_I, obs_S, units.arcsec_to_rad(0.01))
-    assert units.rad_to_arcsec(np.linalg.norm(quat.attitude_error(filt.q, q_true))) < 0.1
+    assert units.rad_to_arcsec(np.linalg.norm(rot.attitude_error(filt.q, q_true))) < 0.1
 
 
 def test_gating_rejects_an_outlier_and_leaves_the_state_alone():
     P0 = np.diag([units.arcsec_to_rad(20.0) ** 2] * 3 + [1e-10] * 3)
     filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=1e-5, rrw=1e-8, gate_probability=0.9999)
-    outlier = quat.from_rotation_vector(np.radians([1.0, 0, 0]))
+    outlier = rot.from_rotation_vector(np.radians([1.0, 0, 0]))
     P_before = filt.P.copy()
     result = filt.update_attitude(outlier, np.eye(3) * units.arcsec_to_rad(10.0) ** 2)
     assert result.n_rejected == 1 and result.nis[0] > 1e3

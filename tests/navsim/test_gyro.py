@@ -4,8 +4,8 @@ import allantools
 import numpy as np
 import pytest
 
-from navsim import units
-from navsim.gyro import GyroModel, allan_variance, bias_instability_to_sigma
+from navsim.sensors.gyro import GyroModel, allan_variance, bias_instability_to_sigma
+from startrack import units
 
 RATE_HZ = 10.0
 

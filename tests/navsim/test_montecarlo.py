@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import navsim.montecarlo as mc
+import navsim.campaign.montecarlo as mc
 from navsim.simulation import run, run_batch
 from startrack.errors import InputError
 

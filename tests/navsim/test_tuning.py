@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from navsim.tuning import tune
+from navsim.campaign.tuning import tune
 
 ROOT = Path(__file__).resolve().parents[2]
 

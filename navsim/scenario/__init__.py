@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from navsim.schema import ListOfTables, Table, Value
+from navsim.scenario.schema import ListOfTables, Table, Value
 from navsim.studies import STUDIES
 from startrack.errors import InputError
 

@@ -10,8 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim import kernels
-from navsim import quaternion as quat
+from navsim.kinematics_jit import quat_derivative
+from startrack import rotation as rot
+from startrack.jit import njit
 
 
 def _uniform_step(t):
@@ -33,8 +34,8 @@ class ConstantRate:
     def simulate(self, t, q0):
         t, _ = _uniform_step(t)
         omega = np.asarray(self.rate, dtype=float)
-        q = quat.multiply(q0, quat.from_rotation_vector(t[:, None] * omega))
-        return quat.normalize(q), np.broadcast_to(omega, (t.size, 3)).copy()
+        q = rot.multiply(q0, rot.from_rotation_vector(t[:, None] * omega))
+        return rot.normalize(q), np.broadcast_to(omega, (t.size, 3)).copy()
 
 
 @dataclass(frozen=True)
@@ -58,8 +59,8 @@ class SinusoidalAxis:
         arg = self.angular_frequency * t + self.phase
         theta = self.theta0 + self.amplitude * np.sin(arg)
         theta_dot = self.amplitude * self.angular_frequency * np.cos(arg)
-        q = quat.multiply(q0, quat.from_rotation_vector(theta[:, None] * axis))
-        return quat.normalize(q), theta_dot[:, None] * axis
+        q = rot.multiply(q0, rot.from_rotation_vector(theta[:, None] * axis))
+        return rot.normalize(q), theta_dot[:, None] * axis
 
 
 @dataclass(frozen=True)
@@ -84,10 +85,10 @@ class RateSegments:
         q = np.asarray(q0, dtype=float)
         for k, (duration, _) in enumerate(self.segments):
             q_start[k] = q
-            q = quat.multiply(q, quat.from_rotation_vector(table[k] * duration))
+            q = rot.multiply(q, rot.from_rotation_vector(table[k] * duration))
         phi = table[seg] * (t - starts[seg])[:, None]
-        q_t = quat.multiply(q_start[seg], quat.from_rotation_vector(phi))
-        return quat.normalize(q_t), table[seg]
+        q_t = rot.multiply(q_start[seg], rot.from_rotation_vector(phi))
+        return rot.normalize(q_t), table[seg]
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,7 @@ class RigidBody:
 
     def simulate(self, t, q0):
         t, dt = _uniform_step(t)
-        return kernels.rigid_body_rk4(
+        return rigid_body_rk4(
             np.asarray(q0, dtype=float),
             np.asarray(self.initial_rate, dtype=float),
             np.asarray(self.inertia, dtype=float),
@@ -134,5 +135,38 @@ def interval_mean_rates(q_fine, factor, dt_gyro):
     q_fine = np.asarray(q_fine, dtype=float)
     n_intervals = (q_fine.shape[0] - 1) // factor
     q = q_fine[: n_intervals * factor + 1]
-    delta = quat.to_rotation_vector(quat.multiply(quat.conjugate(q[:-1]), q[1:]))
+    delta = rot.to_rotation_vector(rot.multiply(rot.conjugate(q[:-1]), q[1:]))
     return delta.reshape(n_intervals, factor, 3).sum(axis=1) / dt_gyro
+
+
+@njit
+def rigid_body_rk4(q0, omega0, J, torques, dt):
+    """Integrate q̇ = ½ q ⊗ [ω, 0] and J ω̇ = τ − ω × J ω (Euler) jointly by RK4.
+
+    ``torques`` (m, 3) body torque [N m] held over each of the m steps of dt [s];
+    returns q (m+1, 4) and ω (m+1, 3)."""
+    m = torques.shape[0]
+    J_inv = np.linalg.inv(J)
+    q = np.empty((m + 1, 4))
+    w = np.empty((m + 1, 3))
+    q[0] = q0 / np.sqrt(np.sum(q0 * q0))
+    w[0] = omega0
+    for k in range(m):
+        tau = torques[k]
+        qk = q[k]
+        wk = w[k]
+        k1q = quat_derivative(qk, wk)
+        k1w = J_inv @ (tau - np.cross(wk, J @ wk))
+        w2 = wk + 0.5 * dt * k1w
+        k2q = quat_derivative(qk + 0.5 * dt * k1q, w2)
+        k2w = J_inv @ (tau - np.cross(w2, J @ w2))
+        w3 = wk + 0.5 * dt * k2w
+        k3q = quat_derivative(qk + 0.5 * dt * k2q, w3)
+        k3w = J_inv @ (tau - np.cross(w3, J @ w3))
+        w4 = wk + dt * k3w
+        k4q = quat_derivative(qk + dt * k3q, w4)
+        k4w = J_inv @ (tau - np.cross(w4, J @ w4))
+        q_next = qk + dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q)
+        q[k + 1] = q_next / np.sqrt(np.sum(q_next * q_next))
+        w[k + 1] = wk + dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w)
+    return q, w

@@ -17,7 +17,7 @@ Output sample k is the measured rate averaged over its interval [t_(k-1), t_k] o
 - then saturation (clip to ± saturation) and quantisation of the accumulated angle to the
   LSB (so quantisation error does not accumulate).
 
-Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`navsim.units`.
+Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`startrack.units`.
 """
 
 from dataclasses import dataclass, field
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
-from navsim import units
+from startrack import units
 
 #: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
 #: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,

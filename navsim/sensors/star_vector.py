@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim import quaternion as quat
+from startrack import rotation as rot
 
 
 def tangent_basis(s):
@@ -65,10 +65,10 @@ class StarVectorSensor:
         brightest are reported, brightest first; the direction noise is isotropic in the plane
         perpendicular to the true direction.
         """
-        q_IS = quat.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
+        q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         order = np.argsort(self.star_mags, kind="stable")
         catalog = self.star_vectors[order]
-        boresight = quat.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
+        boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
         cos_half = np.cos(0.5 * self.fov)
         frames, stars = [], []
         for start in range(0, len(q_IS), chunk):
@@ -80,7 +80,7 @@ class StarVectorSensor:
         frame = np.concatenate(frames)
         index = order[np.concatenate(stars)]
         ref_I = self.star_vectors[index]
-        s_true = quat.rotate(quat.conjugate(q_IS[frame]), ref_I)
+        s_true = rot.rotate(rot.conjugate(q_IS[frame]), ref_I)
         noise = np.einsum("nij,ni->nj", tangent_basis(s_true), self.sigma * rng.standard_normal((len(index), 2)))
         obs = s_true + noise
         obs /= np.linalg.norm(obs, axis=1, keepdims=True)
@@ -102,7 +102,7 @@ class AttitudeFixSensor:
 
     def observe_frames(self, q_IB_true, rng):
         """Measured q_IS = q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true (F, 4)."""
-        q_IS = quat.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
+        q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
         nu = sigma * rng.standard_normal((len(q_IS), 3))
-        return quat.multiply(q_IS, quat.from_rotation_vector(nu))
+        return rot.multiply(q_IS, rot.from_rotation_vector(nu))

@@ -10,12 +10,12 @@ q_BS,true = q_BS ⊗ δq(δm) (δm in sensor axes), as DESIGN.md fixes.
 
 Propagation at the gyro rate: q by RK4 (eq. 9 of 000) with ω = (I − diag s)(ω̃ − b) held over
 the interval; P ← Φ P Φᵀ + Q with the closed-form Φ and Farrenkopf's discrete Q
-(:func:`navsim.kernels.transition`, :func:`navsim.kernels.process_noise`). Updates: an attitude
+(:func:`navsim.estimation.kernels.transition`, :func:`navsim.estimation.kernels.process_noise`). Updates: an attitude
 fix (3-dim) or one 2-dim tangent-plane residual per identified star; each is gated by its
 chi-square NIS against the prior, the accepted ones update together in Joseph form, and the
 error estimate is reset into the nominal state.
 
-The linear algebra is compiled (:mod:`navsim.kernels`); it is tested equal to filterpy's
+The linear algebra is compiled (:mod:`navsim.estimation.kernels`); it is tested equal to filterpy's
 ``KalmanFilter.predict``/``update`` (Joseph form), which is the reference engine.
 """
 
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from navsim import kernels
+from navsim.estimation import kernels
 
 
 @dataclass(frozen=True)
@@ -90,7 +90,7 @@ class AttitudeFilter:
 
     def predict(self, omega_measured, dt):
         """Propagate q (RK4) and P (Φ P Φᵀ + Q) over one gyro sample (3,) or several
-        consecutive samples (m, 3), each held for dt [s] (:func:`navsim.kernels.predict`)."""
+        consecutive samples (m, 3), each held for dt [s] (:func:`navsim.estimation.kernels.predict`)."""
         if np.ndim(omega_measured) != 2:
             omega_measured = np.atleast_2d(np.asarray(omega_measured, dtype=float))
         self.q, self.P = kernels.predict(
@@ -100,7 +100,7 @@ class AttitudeFilter:
 
     def update_attitude(self, q_IS, R_S):
         """Update with a star-sensor attitude fix q_IS and its 3x3 covariance R_S in sensor axes
-        (:func:`navsim.kernels.attitude_update`: z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes,
+        (:func:`navsim.estimation.kernels.attitude_update`: z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes,
         H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ), gated at 3 dof."""
         self.q, self.b, self.s, q_BS, self.P, z, nis, accepted = kernels.attitude_update(
             self.q, self.b, self.s, self.q_BS, self.P, np.asarray(q_IS, dtype=float), R_S,

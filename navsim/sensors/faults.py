@@ -7,7 +7,7 @@ image-fidelity closed loop (:mod:`navsim.closed_loop`).
 
 import numpy as np
 
-from navsim import units
+from startrack import units
 
 
 def apply_bias_steps(omega, bias, t_samples, steps):

@@ -1,0 +1,1 @@
+"""Truth motion: prescribed attitude profiles and rigid-body dynamics (:mod:`navsim.truth.profiles`)."""
