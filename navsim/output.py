@@ -47,7 +47,7 @@ def write_run(directory, result, max_frames=None):
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     write_json(directory / "scenario.json", result.scenario)
-    write_json(directory / "summary.json", result.summary)
+    write_json(directory / "summary.json", result.summary.to_json())
     series = result.series
     frames = len(series["t"])
     if max_frames is not None and frames > max_frames:

@@ -2,7 +2,7 @@
 
 Layout of a campaign directory::
 
-    DIR/campaign.json            what was asked (scenario, overrides, base seed, runs)
+    DIR/campaign.json            what was asked (scenario, overrides, base seed, runs) and the backend
     DIR/runs/run_00000/          one finished run: scenario.json, summary.json, timeseries.npz
     DIR/runs/run_00007/error.json   a run that raised: its error and traceback
     DIR/summary.json             the aggregate of all finished runs
@@ -23,17 +23,18 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import chi2
 from tqdm import tqdm
 
-from navsim.closed_loop import DIM_STAR_SOLVERS, paper000_comparison, paper000_notes, paper004_comparison, paper004_notes
+from navsim.estimation.consistency import nees_statistics
 from navsim.output import read_npz, write_json, write_run
+from navsim.records import CampaignSummary, RunSummary
 from navsim.scenario import Scenario, resolve_scenario
-from navsim.simulation import NEES_DOF, prepare, simulate
+from navsim.simulation import prepare, simulate
+from navsim.studies import OBSERVERS
 from startrack import units
 from startrack.errors import InputError
 
-RUN_FORMAT = "run_{:05d}"
+RUN_DIR = "run_{:05d}"
 
 
 def run_seed(base_seed, index):
@@ -74,12 +75,13 @@ def run_chunk(scenario_data, source, members):
     return errors
 
 
-def _prepare(directory, scenario, runs, base_seed):
+def _prepare(directory, scenario, runs, base_seed, backend):
     directory = Path(directory)
     request = {
         "scenario": scenario.name,
         "source": scenario.source,
         "base_seed": base_seed,
+        "backend": backend,
         "runs": runs,
         "scenario_data": scenario.data,
         "seeds": [run_seed(base_seed, k) for k in range(runs)],
@@ -111,7 +113,7 @@ def pending_runs(directory, request):
     runs_dir = Path(directory) / "runs"
     todo = []
     for k in range(request["runs"]):
-        run_dir = runs_dir / RUN_FORMAT.format(k)
+        run_dir = runs_dir / RUN_DIR.format(k)
         if not (run_dir / "summary.json").exists() and not (run_dir / "error.json").exists():
             todo.append(k)
     return todo
@@ -130,10 +132,10 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a Monte Carlo campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
-    directory, request = _prepare(out, scenario, runs, base_seed)
-    todo = pending_runs(directory, request)
-    members = [(request["seeds"][k], str(directory / "runs" / RUN_FORMAT.format(k))) for k in todo]
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)
+    directory, request = _prepare(out, scenario, runs, base_seed, _backend(scheduler, n_workers))
+    todo = pending_runs(directory, request)
+    members = [(request["seeds"][k], str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
     size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
     chunks = [members[i : i + size] for i in range(0, len(members), size)]
     bar = tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
@@ -156,8 +158,15 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     finally:
         bar.close()
     summary = aggregate(directory)
-    write_json(directory / "summary.json", summary)
+    write_json(directory / "summary.json", summary.to_json())
     return summary
+
+
+def _backend(scheduler, n_workers):
+    """How the runs are produced (recorded in campaign.json; the results do not depend on it)."""
+    if scheduler is not None:
+        return f"dask {scheduler if isinstance(scheduler, str) else 'client'}"
+    return "serial" if n_workers == 1 else f"{n_workers} local processes"
 
 
 def _run_dask(scenario, chunks, scheduler, bar):
@@ -176,53 +185,19 @@ def _run_dask(scenario, chunks, scheduler, bar):
             client.close()
 
 
-def _pool_frames(pooled, name, runs, keys):
-    """pooled[name]: the frame-weighted pool of per-run lists, an RMS for keys marked True, a mean otherwise."""
-    frames = sum(r["frames"] for r in runs)
-    if not frames:
-        return
-    pooled[name] = {"frames": frames}
-    for key, rms in keys.items():
-        mean = sum(r["frames"] * (np.square(r[key]) if rms else np.asarray(r[key], dtype=float)) for r in runs) / frames
-        pooled[name][key] = [float(v) for v in (np.sqrt(mean) if rms else mean)]
-
-
-def _pooled_paper_comparison(summaries):
-    """Pool the source-document experiments over runs: 004's dim-star RMS (frame-weighted) and 000's
-    tracking-failure probes (trial-weighted), with their comparison rows."""
-    out, rows = {}, []
-    dim = [s["dim_star"] for s in summaries if "dim_star" in s]
-    if dim:
-        pooled = {}
-        for name in (*DIM_STAR_SOLVERS, "crb_two_star", "crb_three_star"):
-            runs = [d[name] for d in dim if name in d]
-            keys = [k for k in ("rms_ra_dec_roll_arcsec", "rms_cross_roll_arcsec") if runs and all(k in r for r in runs)]
-            _pool_frames(pooled, name, runs, {key: True for key in keys})
-        _pool_frames(pooled, "stacked_centroid", [d["stacked_centroid"] for d in dim if "stacked_centroid" in d],
-                     {"rms_error_px": True})
-        _pool_frames(pooled, "off_axis_deg", [d["off_axis_deg"] for d in dim if "off_axis_deg" in d],
-                     {"mean_bright_dim": False})
-        for name in ("filter_with_stacking", "filter_without_stacking"):
-            values = [d[name]["rms_xyz_arcsec"] for d in dim if name in d]
-            if values:
-                pooled[name] = {"rms_xyz_arcsec": [float(v) for v in np.sqrt(np.mean(np.square(values), axis=0))]}
-        out["dim_star"] = pooled
-        rows += paper004_comparison(pooled)
-        out["notes"] = paper004_notes(pooled)
-    probes = [s["tracking_failure_probes"] for s in summaries if "tracking_failure_probes" in s]
-    if probes:
-        trials = sum(p["trials"] for p in probes)
-        pooled = {"trials": trials, "disturbance_deg_max": max(p["disturbance_deg_max"] for p in probes)}
-        for method in ("subcatalog", "lost_in_space"):
-            pooled[method] = {key: float(sum(p["trials"] * p[method][key] for p in probes) / trials)
-                              for key in ("recognition_rate", "ms_mean")}
-        pooled["time_ratio"] = pooled["subcatalog"]["ms_mean"] / pooled["lost_in_space"]["ms_mean"]
-        out["tracking_failure_probes"] = pooled
-        rows += paper000_comparison(pooled)
-        out["notes"] = out.get("notes", []) + paper000_notes(pooled)
-    if rows:
-        out["paper_comparison"] = rows
-    return out
+def _pooled_findings(summaries):
+    """The observers' findings pooled over the runs (:data:`navsim.studies.OBSERVERS`), with their
+    comparison rows and notes."""
+    findings, rows, notes = {}, [], []
+    for kind in OBSERVERS:
+        pooled = kind.pool(summaries)
+        if pooled is not None:
+            findings[pooled.key] = pooled.stats
+            rows += pooled.rows
+            notes += pooled.notes
+    if not findings:
+        return {}
+    return {"findings": findings, "paper_comparison": rows, "notes": notes}
 
 
 def load_runs(directory):
@@ -231,89 +206,71 @@ def load_runs(directory):
     request = json.loads((directory / "campaign.json").read_text())
     finished, failed = [], []
     for k in range(request["runs"]):
-        run_dir = directory / "runs" / RUN_FORMAT.format(k)
+        run_dir = directory / "runs" / RUN_DIR.format(k)
         if (run_dir / "summary.json").exists():
-            finished.append((k, json.loads((run_dir / "summary.json").read_text()), read_npz(run_dir / "timeseries.npz")))
+            finished.append((k, RunSummary.read(run_dir / "summary.json"), read_npz(run_dir / "timeseries.npz")))
         elif (run_dir / "error.json").exists():
             failed.append((k, json.loads((run_dir / "error.json").read_text())["error"]))
     return request, finished, failed
 
 
 def aggregate(directory):
-    """Campaign statistics from the run files (deterministic: no wall-clock values)."""
+    """The :class:`~navsim.records.CampaignSummary` of the run files (deterministic: no wall-clock values)."""
     request, finished, failed = load_runs(directory)
-    out = {
-        "scenario": request["scenario"],
-        "base_seed": request["base_seed"],
-        "runs_requested": request["runs"],
-        "runs_finished": len(finished),
-        "runs_failed": len(failed),
-        "failures": [{"run": k, "error": message} for k, message in failed],
-    }
+    base = {"scenario": request["scenario"], "base_seed": request["base_seed"], "runs_requested": request["runs"],
+            "runs_finished": len(finished), "runs_failed": len(failed),
+            "failures": [{"run": k, "error": message} for k, message in failed]}
     if not finished:
-        return out
-    settle = request["scenario_data"]["settle_s"]
-    errors, cross, roll, nees_runs, sigma_runs = [], [], [], [], []
-    divergent = []
+        return CampaignSummary(**base)
+    summaries = [summary for _, summary, _ in finished]
+    return CampaignSummary(**base, **_error_statistics(finished, request["scenario_data"]["settle_s"]),
+                           updates={key: int(sum(s["updates"][key] for s in summaries)) for key in ("accepted", "rejected")},
+                           identification=_identification(summaries), **_pooled_findings(summaries))
+
+
+def _error_statistics(finished, settle):
+    """Attitude errors pooled over every steady frame, per-run RMS spread, run-averaged NEES, divergent runs."""
+    errors, sigmas, nees_runs, divergent = [], [], [], []
+    dof = finished[0][1]["nees"]["dof"]
     for k, summary, series in finished:
         steady = series["t"] >= settle
-        err = series["attitude_error"][steady]
-        errors.append(err)
-        cross.append(summary["cross_boresight_rms_arcsec"])
-        roll.append(summary["roll_rms_arcsec"])
+        errors.append(series["attitude_error"][steady])
+        sigmas.append(np.sqrt(series["P_diag"][steady, :3]))
         nees_runs.append(series["nees"])
-        sigma = np.sqrt(series["P_diag"][steady, :3])
-        sigma_runs.append(sigma)
-        if np.any(np.abs(err) > 5.0 * sigma) or summary["nees"]["mean"] > 5.0 * NEES_DOF:
+        if np.any(np.abs(errors[-1]) > 5.0 * sigmas[-1]) or summary["nees"]["mean"] > 5.0 * dof:
             divergent.append(k)
-    stacked = np.concatenate(errors)
+    stacked, sigma = np.concatenate(errors), np.concatenate(sigmas)
     arcsec = units.rad_to_arcsec
-    m = len(finished)
-    lengths = {len(n) for n in nees_runs}
     nees_block = {}
-    if len(lengths) == 1:
+    if len({len(n) for n in nees_runs}) == 1:
         mean_nees = np.mean(np.array(nees_runs), axis=0)
-        t = finished[0][2]["t"]
-        lo, hi = chi2.ppf([0.025, 0.975], m * NEES_DOF) / m
-        steady = t >= settle
-        nees_block = {
-            "dof": NEES_DOF,
-            "runs": m,
-            "band_95": [float(lo), float(hi)],
-            "mean": float(mean_nees[steady].mean()),
-            "fraction_in_band": float(np.mean((mean_nees[steady] >= lo) & (mean_nees[steady] <= hi))),
-        }
-    out.update(
-        {
-            "attitude_error_rms_arcsec": {axis: float(arcsec(np.sqrt(np.mean(stacked[:, i] ** 2)))) for i, axis in enumerate("xyz")},
-            "attitude_error_percentiles_arcsec": {
-                axis: {f"p{p}": float(arcsec(np.percentile(np.abs(stacked[:, i]), p))) for p in (50, 95, 99)}
-                for i, axis in enumerate("xyz")
-            },
-            "filter_sigma_mean_arcsec": {axis: float(arcsec(np.mean(np.concatenate([s[:, i] for s in sigma_runs]))))
-                                         for i, axis in enumerate("xyz")},
-            "cross_boresight_rms_arcsec": {"mean": float(np.mean(cross)), "p50": float(np.percentile(cross, 50)),
-                                           "p95": float(np.percentile(cross, 95)), "max": float(np.max(cross))},
-            "roll_rms_arcsec": {"mean": float(np.mean(roll)), "p50": float(np.percentile(roll, 50)),
-                                "p95": float(np.percentile(roll, 95)), "max": float(np.max(roll))},
-            "nees": nees_block,
-            "updates": {
-                "accepted": int(sum(s["updates"]["accepted"] for _, s, _ in finished)),
-                "rejected": int(sum(s["updates"]["rejected"] for _, s, _ in finished)),
-            },
-            "divergent_runs": divergent,
-        }
-    )
-    comparison = _pooled_paper_comparison([summary for _, summary, _ in finished])
-    out.update(comparison)
+        nees_block = nees_statistics(mean_nees[finished[0][2]["t"] >= settle], dof, len(finished))
+    return {
+        "attitude_error_rms_arcsec": {axis: float(arcsec(np.sqrt(np.mean(stacked[:, i] ** 2)))) for i, axis in enumerate("xyz")},
+        "attitude_error_percentiles_arcsec": {
+            axis: {f"p{p}": float(arcsec(np.percentile(np.abs(stacked[:, i]), p))) for p in (50, 95, 99)}
+            for i, axis in enumerate("xyz")},
+        "filter_sigma_mean_arcsec": {axis: float(arcsec(np.mean(sigma[:, i]))) for i, axis in enumerate("xyz")},
+        "cross_boresight_rms_arcsec": _spread([s["cross_boresight_rms_arcsec"] for _, s, _ in finished]),
+        "roll_rms_arcsec": _spread([s["roll_rms_arcsec"] for _, s, _ in finished]),
+        "nees": nees_block,
+        "divergent_runs": divergent,
+    }
+
+
+def _spread(values):
+    return {"mean": float(np.mean(values)), "p50": float(np.percentile(values, 50)),
+            "p95": float(np.percentile(values, 95)), "max": float(np.max(values))}
+
+
+def _identification(summaries):
+    """Frames per identification mode over the runs and the fraction of frames with a fix (image fidelity)."""
     per_mode = {}
-    for _, summary, _ in finished:
-        for mode, stats in summary.get("identification", {}).get("per_mode", {}).items():
+    for summary in summaries:
+        for mode, stats in (summary.identification or {}).get("per_mode", {}).items():
             per_mode[mode] = per_mode.get(mode, 0) + stats["frames"]
-    if per_mode:
-        frames = sum(per_mode.values())
-        out["identification"] = {
-            "frames_per_mode": per_mode,
-            "fix_fraction": 1.0 - (per_mode.get("no_fix", 0) + per_mode.get("outage", 0) + per_mode.get("dropped", 0)) / frames,
-        }
-    return out
+    if not per_mode:
+        return None
+    frames = sum(per_mode.values())
+    lost = sum(per_mode.get(mode, 0) for mode in ("no_fix", "outage", "dropped"))
+    return {"frames_per_mode": per_mode, "fix_fraction": 1.0 - lost / frames}

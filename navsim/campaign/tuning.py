@@ -18,7 +18,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from navsim.scenario import resolve_scenario
-from navsim.simulation import NEES_DOF, run_batch
+from navsim.simulation import run_batch
 
 
 @dataclass
@@ -56,6 +56,7 @@ class TuneResult:
 def batch_statistics(results, settle_s):
     """(NEES per dof, NIS per dof, mean cross-boresight RMS, mean roll RMS) over a batch."""
     nees, nis, dof = [], 0.0, 0
+    nees_dof = results[0].summary["nees"]["dof"]
     for result in results:
         steady = result.series["t"] >= settle_s
         nees.append(result.series["nees"][steady])
@@ -63,7 +64,7 @@ def batch_statistics(results, settle_s):
         nis += float(np.sum(result.series["nis"][accepted]))
         dof += int(np.sum(result.series["nis_dof"][accepted]))
     return (
-        float(np.mean(np.concatenate(nees))) / NEES_DOF,
+        float(np.mean(np.concatenate(nees))) / nees_dof,
         nis / max(dof, 1),
         float(np.mean([r.summary["cross_boresight_rms_arcsec"] for r in results])),
         float(np.mean([r.summary["roll_rms_arcsec"] for r in results])),
@@ -81,8 +82,6 @@ def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0
     scenario.require_simulation("filter tuning")
     base_seed = scenario["seed"] if seed is None else int(seed)
     seeds = [base_seed + k for k in range(runs)]
-    q_scale = scenario["filter"]["process_noise_scale"]
-    r_scale = scenario["filter"]["measurement_noise_scale"]
     outcome = TuneResult()
 
     def evaluate(log_scales):

@@ -3,20 +3,24 @@
 Nominal state: attitude q_IB (scalar-last), gyro bias b [rad/s], optionally gyro scale-factor
 errors s [-] and the star-sensor mounting q_BS. Error state x (zero between updates):
 
-    x = [δθ (3), δb (3), δs (3) if scale factors, δm (3) if misalignment]
+    x = [δθ (3), δb (3), δs (3) if scale factors, δm (3) if mounting]
 
 with q_true = q ⊗ δq(δθ) (δθ in body axes), δb = b_true − b, δs = s_true − s, and
-q_BS,true = q_BS ⊗ δq(δm) (δm in sensor axes), as DESIGN.md fixes.
+q_BS,true = q_BS ⊗ δq(δm) (δm in sensor axes), as docs/design.md fixes.
 
-Propagation at the gyro rate: q by RK4 (eq. 9 of 000) with ω = (I − diag s)(ω̃ − b) held over
-the interval; P ← Φ P Φᵀ + Q with the closed-form Φ and Farrenkopf's discrete Q
-(:func:`navsim.estimation.kernels.transition`, :func:`navsim.estimation.kernels.process_noise`). Updates: an attitude
-fix (3-dim) or one 2-dim tangent-plane residual per identified star; each is gated by its
-chi-square NIS against the prior, the accepted ones update together in Joseph form, and the
-error estimate is reset into the nominal state.
+Propagation at the gyro rate: q by RK4 (eq. 9 of 000) with ω = (1 − s)(ω̃ − b) held over the
+interval; P ← Φ P Φᵀ + Q with the closed-form Φ and Farrenkopf's discrete Q
+(:func:`navsim.estimation.kernels.transition`, :func:`~navsim.estimation.kernels.process_noise`).
+Updates: an attitude fix (3-dim) or one 2-dim tangent-plane residual per identified star; each is
+gated by its chi-square NIS against the prior, the accepted ones update together in Joseph form,
+and the error estimate is reset into the nominal state.
 
-The linear algebra is compiled (:mod:`navsim.estimation.kernels`); it is tested equal to filterpy's
-``KalmanFilter.predict``/``update`` (Joseph form), which is the reference engine.
+The filter owns its state: q, b, s, q_BS and P are read-only views; only its methods change them
+(predict, the updates, :meth:`AttitudeFilter.reinitialise` after a lost track and
+:meth:`AttitudeFilter.disturb` for the attitude-jump fault). :meth:`AttitudeFilter.process_record`
+is the compiled fast path over a whole record, tested equal to the step-by-step path.
+The linear algebra is compiled (:mod:`navsim.estimation.kernels`); it is tested equal to
+filterpy's ``KalmanFilter.predict``/``update`` (Joseph form), which is the reference engine.
 """
 
 from dataclasses import dataclass
@@ -25,16 +29,20 @@ import numpy as np
 from scipy.stats import chi2
 
 from navsim.estimation import kernels
+from navsim.estimation.kernels import FilterModel
+from startrack import rotation as rot
 
 
 @dataclass(frozen=True)
 class UpdateResult:
     """Outcome of one measurement update: innovations z (one row per measurement), NIS per
-    measurement against the prior, and the accepted mask."""
+    measurement against the prior, the accepted mask, and whether the attitude was re-initialised
+    from the sensor's own fix before it (a lost track)."""
 
     z: np.ndarray
     nis: np.ndarray
     accepted: np.ndarray
+    reinitialised: bool = False
 
     @property
     def n_accepted(self):
@@ -44,69 +52,80 @@ class UpdateResult:
     def n_rejected(self):
         return self.accepted.size - self.n_accepted
 
+    def statistics(self):
+        """(accepted, NIS sum of the accepted, its dof, RMS of their innovations [rad])."""
+        if self.z.shape[1] == 3:
+            if not self.accepted[0]:
+                return 0, np.nan, 0, np.nan
+            return 1, float(self.nis[0]), 3, float(np.sqrt(np.sum(self.z * self.z) / 3.0))
+        return kernels.star_statistics(self.z, self.nis, self.accepted)
+
+
+def _read_only(array):
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
 
 class AttitudeFilter:
     """MEKF with textbook names: error state x, covariance P; Φ, Q, H, R, K inside each step.
 
     Parameters: ``q`` (q_IB estimate), ``b`` (bias estimate, rad/s), ``P`` (initial covariance,
     n x n), ``arw``/``rrw`` (gyro noise the filter assumes, SI), ``q_BS`` (nominal sensor mounting,
-    rotating S vectors into B; identity by default), ``estimate_scale_factor``/``estimate_misalignment`` (extra states; their initial σ
-    are in P), ``scale_factor_rw`` (σ of a scale-factor random walk, 1/√s),
-    ``process_noise_scale`` (multiplies Q, for tuning) and ``gate_probability`` (chi-square gate).
+    rotating S vectors into B; identity by default), ``estimate_scale_factor``/``estimate_misalignment``
+    (extra states; their initial σ are in P), ``scale_factor_rw`` (σ of a scale-factor random walk,
+    1/√s), ``process_noise_scale`` (multiplies Q) and ``measurement_noise_scale`` (multiplies the
+    sensor's σ) for tuning studies, and ``gate_probability`` (chi-square gate).
     """
 
-    def __init__(
-        self,
-        q,
-        b,
-        P,
-        arw,
-        rrw,
-        q_BS=None,
-        estimate_scale_factor=False,
-        estimate_misalignment=False,
-        scale_factor_rw=0.0,
-        process_noise_scale=1.0,
-        gate_probability=0.9999,
-    ):
-        self.n = 6 + 3 * int(estimate_scale_factor) + 3 * int(estimate_misalignment)
+    def __init__(self, q, b, P, arw, rrw, q_BS=None, estimate_scale_factor=False, estimate_misalignment=False,
+                 scale_factor_rw=0.0, process_noise_scale=1.0, measurement_noise_scale=1.0, gate_probability=0.9999):
+        self.model = FilterModel(arw=float(arw), rrw=float(rrw), sf_rw=float(scale_factor_rw),
+                                 q_scale=float(process_noise_scale), n_cal=3 * int(estimate_scale_factor),
+                                 mounting=bool(estimate_misalignment))
+        self.n = 6 + self.model.n_cal + 3 * int(self.model.mounting)
         P = np.array(P, dtype=float)
         if P.shape != (self.n, self.n):
             raise ValueError(f"P must be {self.n}x{self.n} for the chosen states, got {P.shape}")
         q = np.asarray(q, dtype=float)
-        self.q = q / np.linalg.norm(q)
-        self.b = np.array(b, dtype=float)
-        self.s = np.zeros(3)
-        self.P = P
-        self.q_BS = np.array([0.0, 0.0, 0.0, 1.0] if q_BS is None else q_BS, dtype=float)
-        self.R_BS = kernels.quat_to_matrix(self.q_BS)
-        self.arw = float(arw)
-        self.rrw = float(rrw)
-        self.scale_factor_rw = float(scale_factor_rw)
-        self.process_noise_scale = float(process_noise_scale)
+        q_BS = np.array([0.0, 0.0, 0.0, 1.0] if q_BS is None else q_BS, dtype=float)
+        self._x = np.concatenate([q / np.linalg.norm(q), np.asarray(b, dtype=float), np.zeros(3), q_BS])
+        self._P = P
+        self._P0_attitude = P[0:3, 0:3].copy()
+        self.variance_scale = float(measurement_noise_scale) ** 2
         self.gate = {dof: float(chi2.ppf(gate_probability, dof)) for dof in (2, 3)}
-        self.sf_start = 6 if estimate_scale_factor else -1
-        self.mis_start = self.n - 3 if estimate_misalignment else -1
+
+    q = property(lambda self: _read_only(self._x[0:4]), doc="q_IB estimate (4,)")
+    b = property(lambda self: _read_only(self._x[4:7]), doc="gyro bias estimate (3,) [rad/s]")
+    s = property(lambda self: _read_only(self._x[7:10]), doc="gyro scale-factor error estimate (3,)")
+    q_BS = property(lambda self: _read_only(self._x[10:14]), doc="mounting estimate q_BS (4,)")
+    P = property(lambda self: _read_only(self._P), doc="error covariance (n, n)")
+
+    @property
+    def R_BS(self):
+        """Mounting estimate as a matrix (S -> B)."""
+        return rot.to_matrix(self._x[10:14])
 
     def predict(self, omega_measured, dt):
         """Propagate q (RK4) and P (Φ P Φᵀ + Q) over one gyro sample (3,) or several
         consecutive samples (m, 3), each held for dt [s] (:func:`navsim.estimation.kernels.predict`)."""
         if np.ndim(omega_measured) != 2:
             omega_measured = np.atleast_2d(np.asarray(omega_measured, dtype=float))
-        self.q, self.P = kernels.predict(
-            self.q, self.P, self.b, self.s, omega_measured, dt,
-            self.arw, self.rrw, self.scale_factor_rw, self.process_noise_scale, self.sf_start,
-        )
+        self._x, self._P = kernels.predict(self._x, self._P, omega_measured, dt, self.model)
+
+    def sensor_prediction(self, omega_measured):
+        """(q_IS, ω_S): the predicted sensor attitude q_IB ⊗ q_BS and the body rate the filter
+        believes from the gyro sample ``omega_measured`` (3,), in sensor axes [rad/s]."""
+        omega, _ = kernels.corrected_rate(self._x, np.asarray(omega_measured, dtype=float))
+        return rot.multiply(self._x[0:4], self._x[10:14]), self.R_BS.T @ omega
 
     def update_attitude(self, q_IS, R_S):
         """Update with a star-sensor attitude fix q_IS and its 3x3 covariance R_S in sensor axes
         (:func:`navsim.estimation.kernels.attitude_update`: z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes,
         H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ), gated at 3 dof."""
-        self.q, self.b, self.s, q_BS, self.P, z, nis, accepted = kernels.attitude_update(
-            self.q, self.b, self.s, self.q_BS, self.P, np.asarray(q_IS, dtype=float), R_S,
-            self.gate[3], self.sf_start, self.mis_start,
-        )
-        self._set_mounting(q_BS)
+        R = self.variance_scale * np.asarray(R_S, dtype=float)
+        self._x, self._P, z, nis, accepted = kernels.attitude_update(
+            self._x, self._P, np.asarray(q_IS, dtype=float), R, self.gate[3], self.model)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
     def update_stars(self, ref_I, obs_S, sigma):
@@ -120,15 +139,50 @@ class AttitudeFilter:
         """
         ref_I = np.ascontiguousarray(ref_I, dtype=float)
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
-        variance = np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (ref_I.shape[0],)).copy()
-        self.q, self.b, self.s, q_BS, self.P, z, nis, accepted = kernels.stars_update(
-            self.q, self.b, self.s, self.q_BS, self.P, ref_I, obs_S, variance, self.gate[2],
-            self.sf_start, self.mis_start,
-        )
-        self._set_mounting(q_BS)
+        variance = self._variance(sigma, ref_I.shape[0])
+        self._x, self._P, z, nis, accepted = kernels.stars_update(
+            self._x, self._P, ref_I, obs_S, variance, self.gate[2], self.model)
         return UpdateResult(z=z, nis=nis, accepted=accepted)
 
-    def _set_mounting(self, q_BS):
-        if self.mis_start >= 0:
-            self.q_BS = q_BS
-            self.R_BS = kernels.quat_to_matrix(q_BS)
+    def _variance(self, sigma, count):
+        return self.variance_scale * np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (count,)).copy()
+
+    def reinitialise(self, q_IS):
+        """Restart the attitude from a sensor fix q_IS after a lost track: q_IB = q_IS ⊗ q_BS⁻¹, the
+        attitude block of P back to its initial value and its correlations cleared."""
+        self._x[0:4] = rot.normalize(rot.multiply(q_IS, rot.conjugate(self._x[10:14])))
+        self._P[0:3, :] = 0.0
+        self._P[:, 0:3] = 0.0
+        self._P[0:3, 0:3] = self._P0_attitude
+
+    def disturb(self, rotation_vector):
+        """The attitude-jump fault: the estimate is knocked off by ``rotation_vector`` [rad] (body
+        axes), as by a disturbance the filter is not told about; P is left as it was."""
+        self._x[0:4] = rot.normalize(rot.multiply(self._x[0:4], rot.from_rotation_vector(rotation_vector)))
+
+    def snapshot(self):
+        """What the run log keeps of the filter at a frame: q_est, bias_est and P."""
+        return {"q_est": self._x[0:4].copy(), "bias_est": self._x[4:7].copy(), "P": self._P.copy()}
+
+    def process_record(self, omega, ratio, dt, record):
+        """The compiled fast path: run the whole record at once (:func:`kernels.run_fixes` or
+        :func:`kernels.run_stars`) and return the per-frame log that the step-by-step loop of
+        :mod:`navsim.closed_loop` would have written.
+
+        ``omega`` (F*ratio, 3) gyro samples; ``record`` a :class:`navsim.sensors.star_vector.Record`
+        (fixes q_IS (F, 4) with R_S, or the stars of every frame) with the frames ``available``.
+        """
+        omega = np.ascontiguousarray(omega)
+        available = np.asarray(record.available, dtype=np.bool_)
+        if record.fixes is not None:
+            out = kernels.run_fixes(self._x, self._P, omega, ratio, dt, self.model, np.ascontiguousarray(record.fixes),
+                                    self.variance_scale * record.R_S, self.gate[3], available)
+        else:
+            stars = record.stars
+            out = kernels.run_stars(self._x, self._P, omega, ratio, dt, self.model, stars.offsets.astype(np.int64),
+                                    np.ascontiguousarray(stars.ref_I), np.ascontiguousarray(stars.obs_S),
+                                    self._variance(record.sigma, len(stars.ref_I)), self.gate[2], available)
+        x_log, P_log = out[0], out[1]
+        self._x, self._P = x_log[-1].copy(), P_log[-1].copy()
+        log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[2:]))
+        return {"q_est": x_log[:, 0:4], "bias_est": x_log[:, 4:7], "P": P_log, **log}

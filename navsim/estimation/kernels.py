@@ -1,10 +1,17 @@
-"""Compiled inner loops of the MEKF (numba): propagation, Joseph update, star residuals.
+"""Compiled inner loops of the attitude filter (numba): propagation, gated Joseph updates, star
+residuals and the whole-record loops of the fast path.
 
-These are the scalar forms of :mod:`navsim.kinematics` and :mod:`navsim.estimation.attitude_filter`'s maths,
-compiled because a filter step runs tens of thousands of times per simulated minute. Each is
-tested against its numpy / filterpy counterpart. Conventions are those of DESIGN.md
-(scalar-last Hamilton quaternions, error state δθ in body axes).
+These are the scalar forms of :mod:`navsim.estimation.attitude_filter`'s maths, compiled because a
+filter step runs tens of thousands of times per simulated minute; each is tested against its
+numpy / filterpy counterpart. Conventions are those of docs/design.md (scalar-last Hamilton
+quaternions, error state δθ in body axes).
+
+Nominal state ``x`` (14,): q_IB [0:4], gyro bias b [4:7] (rad/s), gyro scale-factor errors s [7:10],
+star-sensor mounting q_BS [10:14]. Error state (n,): δθ [0:3], δb [3:6], then δs [6:6+n_cal] and, with
+``model.mounting``, δm [n-3:n]. ``model`` is a :class:`FilterModel`.
 """
+
+from collections import namedtuple
 
 import numpy as np
 
@@ -12,6 +19,10 @@ from navsim.kinematics_jit import rk4_hold
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, rotation_vector, skew
 
+#: What the filter assumes of the gyro and which states it carries: ARW σ_v [rad/√s], RRW σ_u
+#: [rad/s^(3/2)], scale-factor random walk σ_s [1/√s], the factor on Q, the number of gyro
+#: calibration states (0 or 3) and whether the mounting error δm is a state.
+FilterModel = namedtuple("FilterModel", "arw rrw sf_rw q_scale n_cal mounting")
 
 @njit
 def mm(A, B):
@@ -76,19 +87,21 @@ def inverse_small(S):
     return np.linalg.inv(S)
 
 
-
-
-
+@njit
+def corrected_rate(x, omega_measured):
+    """(ω, d): the body rate the filter believes, ω = (1 − s)(ω̃ − b), and d = ω̃ − b [rad/s]."""
+    d = omega_measured - x[4:7]
+    return (1.0 - x[7:10]) * d, d
 
 
 @njit
-def transition(omega, d_scale, dt, n, sf_start):
+def transition(omega, d, dt, n, n_cal):
     """Closed-form transition matrix Φ (n x n) of the error state over dt (Crassidis & Junkins,
     *Optimal Estimation of Dynamic Systems*, 2nd ed., §7.2.1), w = |ω|:
 
     Φ11 = I − [ω×] sin(wΔt)/w + [ω×]² (1 − cos wΔt)/w²,
     Φ12 = −IΔt + [ω×](1 − cos wΔt)/w² − [ω×]²(wΔt − sin wΔt)/w³,
-    Φ_θs = Φ12 diag(ω̃ − b) (δs enters like δb), all other blocks identity/zero.
+    Φ_θs = Φ12 diag(d), d = ω̃ − b (δs enters like δb), all other blocks identity/zero.
     """
     w = np.sqrt(omega[0] ** 2 + omega[1] ** 2 + omega[2] ** 2)
     wt = w * dt
@@ -108,44 +121,45 @@ def transition(omega, d_scale, dt, n, sf_start):
             F[i, j] += -a * W[i, j] + b * W2[i, j]
             F[i, 3 + j] = b * W[i, j] - c * W2[i, j]
         F[i, 3 + i] -= dt
-    if sf_start >= 0:
+    if n_cal > 0:
         for i in range(3):
             for j in range(3):
-                F[i, sf_start + j] = F[i, 3 + j] * d_scale[j]
+                F[i, 6 + j] = F[i, 3 + j] * d[j]
     return F
 
 
 @njit
-def process_noise(arw, rrw, sf_rw, dt, n, sf_start):
-    """Discrete Q (n x n): Farrenkopf's attitude/bias blocks for ARW σ_v [rad/√s] and RRW σ_u
-    [rad/s^(3/2)] — Q11 = (σ_v²Δt + σ_u²Δt³/3) I, Q12 = −σ_u²Δt²/2 I, Q22 = σ_u²Δt I — and a
-    scale-factor random walk σ_s²Δt I."""
+def process_noise(model, dt, n):
+    """Discrete Q (n x n), before ``model.q_scale``: Farrenkopf's attitude/bias blocks for ARW σ_v and
+    RRW σ_u — Q11 = (σ_v²Δt + σ_u²Δt³/3) I, Q12 = −σ_u²Δt²/2 I, Q22 = σ_u²Δt I — and a scale-factor
+    random walk σ_s²Δt I."""
+    arw, rrw = model.arw, model.rrw
     Q = np.zeros((n, n))
     for i in range(3):
         Q[i, i] = arw * arw * dt + rrw * rrw * dt**3 / 3.0
         Q[i, 3 + i] = Q[3 + i, i] = -0.5 * rrw * rrw * dt * dt
         Q[3 + i, 3 + i] = rrw * rrw * dt
-        if sf_start >= 0:
-            Q[sf_start + i, sf_start + i] = sf_rw * sf_rw * dt
+        if model.n_cal > 0:
+            Q[6 + i, 6 + i] = model.sf_rw * model.sf_rw * dt
     return Q
 
 
 @njit
-def predict(q, P, b, s, omega_measured, dt, arw, rrw, sf_rw, q_scale, sf_start):
-    """MEKF propagation over consecutive gyro samples ``omega_measured`` (m, 3), each held for dt:
-    ω = (1 − s)(ω̃ − b), q by RK4 (eq. 9 of 000), P ← Φ P Φᵀ + q_scale Q. Returns (q, P).
+def predict(x, P, omega_measured, dt, model):
+    """Propagation over consecutive gyro samples ``omega_measured`` (m, 3), each held for dt:
+    q by RK4 (eq. 9 of 000) with the corrected rate, P ← Φ P Φᵀ + q_scale Q. Returns (x, P).
 
     Φ = I + E with E non-zero only in the three attitude rows, so Φ P Φᵀ = P + E P + (E P)ᵀ
     + E P Eᵀ is formed from the 3 x n product E P alone.
     """
     n = P.shape[0]
-    Q = q_scale * process_noise(arw, rrw, sf_rw, dt, n, sf_start)
+    Q = model.q_scale * process_noise(model, dt, n)
     P = P.copy()
+    x = x.copy()
     EP = np.empty((3, n))
     for k in range(omega_measured.shape[0]):
-        d_scale = omega_measured[k] - b
-        omega = (1.0 - s) * d_scale
-        F = transition(omega, d_scale, dt, n, sf_start)
+        omega, d = corrected_rate(x, omega_measured[k])
+        F = transition(omega, d, dt, n, model.n_cal)
         for i in range(3):
             F[i, i] -= 1.0  # E = Φ − I
         for i in range(3):
@@ -168,8 +182,8 @@ def predict(q, P, b, s, omega_measured, dt, arw, rrw, sf_rw, q_scale, sf_start):
                 value = 0.5 * (P[i, j] + P[j, i]) + Q[i, j]
                 P[i, j] = value
                 P[j, i] = value
-        q = rk4_hold(q, omega, dt)
-    return q, P
+        x[0:4] = rk4_hold(x[0:4], omega, dt)
+    return x, P
 
 
 @njit
@@ -234,15 +248,16 @@ def joseph_update_attitude(P, R, z):
 
 
 @njit
-def star_residuals(q_IB, R_BS, ref_I, obs_S, n, mis_start):
+def star_residuals(x, ref_I, obs_S, n, mounting):
     """Tangent-plane residuals of identified stars and their Jacobians.
 
     ŝ = R_SB R_IBᵀ r; T (2x3) spans the plane ⟂ ŝ; z = T (s − ŝ);
-    H = T [R_SB [b̂×], 0, …, ([ŝ×] at ``mis_start`` if ≥ 0)]. Returns (z (N, 2), H (N, 2, n)).
+    H = T [R_SB [b̂×], 0, …, ([ŝ×] in the last three columns when ``mounting``)].
+    Returns (z (N, 2), H (N, 2, n)).
     """
     m = ref_I.shape[0]
-    R_IB = quat_to_matrix(q_IB)
-    R_SB = R_BS.T
+    R_IB = quat_to_matrix(x[0:4])
+    R_SB = quat_to_matrix(x[10:14]).T
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     for k in range(m):
@@ -267,11 +282,11 @@ def star_residuals(q_IB, R_BS, ref_I, obs_S, n, mis_start):
         for j in range(3):
             H[k, 0, j] = e1[0] * A[0, j] + e1[1] * A[1, j] + e1[2] * A[2, j]
             H[k, 1, j] = e2[0] * A[0, j] + e2[1] * A[1, j] + e2[2] * A[2, j]
-        if mis_start >= 0:
+        if mounting:
             B = skew(s_hat)
             for j in range(3):
-                H[k, 0, mis_start + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
-                H[k, 1, mis_start + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
+                H[k, 0, n - 3 + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
+                H[k, 1, n - 3 + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
     return z, H
 
 
@@ -290,23 +305,24 @@ def block_nis(H, P, z, variance):
 
 
 @njit
-def attitude_update(q, b, s, q_BS, P, q_IS, R_S, gate, sf_start, mis_start):
+def attitude_update(x, P, q_IS, R_S, gate, model):
     """Gated update with an attitude fix q_IS (covariance R_S in sensor axes), then the reset.
 
     z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes, H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ.
-    Returns (q, b, s, q_BS, P, z, nis, accepted); the state is unchanged when rejected.
+    Returns (x, P, z, nis, accepted); the state is unchanged when rejected.
     """
     n = P.shape[0]
     conj = np.array([-1.0, -1.0, -1.0, 1.0])
+    q_BS = x[10:14]
     q_IB_measured = quat_multiply(q_IS, q_BS * conj)
-    z = rotation_vector(quat_multiply(q * conj, q_IB_measured))
+    z = rotation_vector(quat_multiply(x[0:4] * conj, q_IB_measured))
     R_BS = quat_to_matrix(q_BS)
     H = np.zeros((3, n))
     for i in range(3):
         H[i, i] = 1.0
-        if mis_start >= 0:
+        if model.mounting:
             for j in range(3):
-                H[i, mis_start + j] = R_BS[i, j]
+                H[i, n - 3 + j] = R_BS[i, j]
     R = mm_t(mm(R_BS, R_S), R_BS)
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
@@ -315,27 +331,26 @@ def attitude_update(q, b, s, q_BS, P, q_IS, R_S, gate, sf_start, mis_start):
         for j in range(3):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
-        return q, b, s, q_BS, P, z, nis, False
-    if mis_start >= 0:
+        return x, P, z, nis, False
+    if model.mounting:
         dx, P_next = joseph_update(P, H, R, z)
     else:
         dx, P_next = joseph_update_attitude(P, R, z)
-    q, b, s, q_BS = reset(q, b, s, q_BS, dx, sf_start, mis_start)
-    return q, b, s, q_BS, P_next, z, nis, True
+    return reset(x, dx, model), P_next, z, nis, True
 
 
 @njit
-def stars_update(q, b, s, q_BS, P, ref_I, obs_S, variance, gate, sf_start, mis_start):
+def stars_update(x, P, ref_I, obs_S, variance, gate, model):
     """Gated update with identified stars (see :func:`star_residuals`): each star's 2-dof NIS
     against the prior is compared with ``gate``; the accepted stars update together, then the
-    reset. Returns (q, b, s, q_BS, P, z (N, 2), nis (N,), accepted (N,))."""
+    reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
     n = P.shape[0]
-    z, H = star_residuals(q, quat_to_matrix(q_BS), ref_I, obs_S, n, mis_start)
+    z, H = star_residuals(x, ref_I, obs_S, n, model.mounting)
     nis = block_nis(H, P, z, variance)
     accepted = nis <= gate
     m = int(np.sum(accepted))
     if m == 0:
-        return q, b, s, q_BS, P, z, nis, accepted
+        return x, P, z, nis, accepted
     Ha = np.empty((2 * m, n))
     za = np.empty(2 * m)
     Ra = np.zeros((2 * m, 2 * m))
@@ -348,86 +363,89 @@ def stars_update(q, b, s, q_BS, P, ref_I, obs_S, variance, gate, sf_start, mis_s
                 Ra[row, row] = variance[k]
                 row += 1
     dx, P_next = joseph_update(P, Ha, Ra, za)
-    q, b, s, q_BS = reset(q, b, s, q_BS, dx, sf_start, mis_start)
-    return q, b, s, q_BS, P_next, z, nis, accepted
+    return reset(x, dx, model), P_next, z, nis, accepted
 
 
 @njit
-def reset(q, b, s, q_BS, dx, sf_start, mis_start):
+def reset(x, dx, model):
     """Move the error estimate dx into the nominal state (first-order reset):
-    q ← q ⊗ δq(δθ), b ← b + δb, s ← s + δs, q_BS ← q_BS ⊗ δq(δm). Returns (q, b, s, q_BS)."""
-    q_next = quat_multiply(q, quat_from_rotation_vector(dx[0:3]))
-    q_next /= np.sqrt(np.sum(q_next * q_next))
-    b_next = b + dx[3:6]
-    s_next = s.copy()
-    if sf_start >= 0:
-        s_next += dx[sf_start : sf_start + 3]
-    q_BS_next = q_BS.copy()
-    if mis_start >= 0:
-        q_BS_next = quat_multiply(q_BS, quat_from_rotation_vector(dx[mis_start : mis_start + 3]))
-        q_BS_next /= np.sqrt(np.sum(q_BS_next * q_BS_next))
-    return q_next, b_next, s_next, q_BS_next
-
+    q ← q ⊗ δq(δθ), b ← b + δb, s ← s + δs, q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
+    n = dx.shape[0]
+    out = x.copy()
+    q_next = quat_multiply(x[0:4], quat_from_rotation_vector(dx[0:3]))
+    out[0:4] = q_next / np.sqrt(np.sum(q_next * q_next))
+    out[4:7] = x[4:7] + dx[3:6]
+    if model.n_cal > 0:
+        out[7:10] = x[7:10] + dx[6:9]
+    if model.mounting:
+        q_BS_next = quat_multiply(x[10:14], quat_from_rotation_vector(dx[n - 3 : n]))
+        out[10:14] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
+    return out
 
 
 @njit
-def run_filter(q, b, s, q_BS, P, omega, ratio, dt, arw, rrw, sf_rw, q_scale, sf_start, mis_start,
-               fix_mode, q_meas, R_S, offsets, ref_I, obs_S, variance, gate, available):
-    """The vector-fidelity filter loop of one run, compiled: for each frame f, ``ratio`` gyro
-    samples of ``omega`` (M, 3) propagate the filter (:func:`predict`), then the frame's
-    measurements update it — an attitude fix ``q_meas[f]`` with covariance ``R_S`` when
-    ``fix_mode``, else the stars ``offsets[f]:offsets[f+1]`` of ``ref_I``/``obs_S``/``variance``
-    (:func:`attitude_update`, :func:`stars_update`) — all gated at ``gate``; frames whose
-    ``available`` is False (outage, dropped) only propagate.
+def star_statistics(z, nis, accepted):
+    """(accepted, NIS sum of the accepted, its dof, RMS of their innovations [rad]) of one star frame."""
+    m = 0
+    total = 0.0
+    squares = 0.0
+    for k in range(z.shape[0]):
+        if accepted[k]:
+            m += 1
+            total += nis[k]
+            squares += z[k, 0] ** 2 + z[k, 1] ** 2
+    if m == 0:
+        return 0, np.nan, 0, np.nan
+    return m, total, 2 * m, np.sqrt(squares / (2 * m))
 
-    Returns per frame: q (F, 4), b (F, 3), P (F, n, n), measurements, accepted, NIS of the
-    accepted, its degrees of freedom, and the RMS of the accepted innovations [rad].
-    """
-    n_frames = offsets.shape[0] - 1
-    n = P.shape[0]
-    q_log = np.empty((n_frames, 4))
-    b_log = np.empty((n_frames, 3))
-    P_log = np.empty((n_frames, n, n))
-    n_meas = np.zeros(n_frames, dtype=np.int32)
-    n_acc = np.zeros(n_frames, dtype=np.int32)
-    nis_log = np.full(n_frames, np.nan)
-    dof_log = np.zeros(n_frames, dtype=np.int32)
-    innov_log = np.full(n_frames, np.nan)
+
+@njit
+def _allocate_logs(n_frames, n):
+    return (np.empty((n_frames, 14)), np.empty((n_frames, n, n)), np.zeros(n_frames, dtype=np.int32),
+            np.zeros(n_frames, dtype=np.int32), np.full(n_frames, np.nan), np.zeros(n_frames, dtype=np.int32),
+            np.full(n_frames, np.nan))
+
+
+@njit
+def run_fixes(x, P, omega, ratio, dt, model, q_meas, R_S, gate, available):
+    """The whole-record loop of the fast path with attitude fixes: for each frame f, ``ratio`` gyro
+    samples of ``omega`` (F*ratio, 3) propagate the filter (:func:`predict`), then the fix
+    ``q_meas[f]`` (covariance R_S) updates it (:func:`attitude_update`); frames not ``available``
+    only propagate. Returns per frame: x (F, 14), P (F, n, n), measurements, accepted, NIS of the
+    accepted, its dof and the RMS of the accepted innovations [rad]."""
+    n_frames = available.shape[0]
+    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
     for f in range(n_frames):
-        q, P = predict(q, P, b, s, omega[f * ratio : (f + 1) * ratio], dt, arw, rrw, sf_rw, q_scale, sf_start)
-        if not available[f]:
-            pass
-        elif fix_mode:
-            q, b, s, q_BS, P, z, nis, ok = attitude_update(q, b, s, q_BS, P, q_meas[f], R_S, gate, sf_start, mis_start)
+        x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
+        if available[f]:
+            x, P, z, nis, ok = attitude_update(x, P, q_meas[f], R_S, gate, model)
             n_meas[f] = 1
             if ok:
                 n_acc[f] = 1
                 nis_log[f] = nis
                 dof_log[f] = 3
                 innov_log[f] = np.sqrt(np.sum(z * z) / 3.0)
-        else:
-            lo, hi = offsets[f], offsets[f + 1]
-            if hi > lo:
-                q, b, s, q_BS, P, z, nis, acc = stars_update(
-                    q, b, s, q_BS, P, ref_I[lo:hi], obs_S[lo:hi], variance[lo:hi], gate, sf_start, mis_start
-                )
-                m = int(np.sum(acc))
-                n_meas[f] = hi - lo
-                n_acc[f] = m
-                if m > 0:
-                    total = 0.0
-                    squares = 0.0
-                    for k in range(hi - lo):
-                        if acc[k]:
-                            total += nis[k]
-                            squares += z[k, 0] ** 2 + z[k, 1] ** 2
-                    nis_log[f] = total
-                    dof_log[f] = 2 * m
-                    innov_log[f] = np.sqrt(squares / (2 * m))
-        q_log[f] = q
-        b_log[f] = b
+        x_log[f] = x
         P_log[f] = P
-    return q_log, b_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
+    return x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
+
+
+@njit
+def run_stars(x, P, omega, ratio, dt, model, offsets, ref_I, obs_S, variance, gate, available):
+    """:func:`run_fixes` with star vectors: frame f updates with the stars offsets[f]:offsets[f+1]
+    of ``ref_I``/``obs_S``/``variance`` (:func:`stars_update`)."""
+    n_frames = available.shape[0]
+    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
+    for f in range(n_frames):
+        x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
+        lo, hi = offsets[f], offsets[f + 1]
+        if available[f] and hi > lo:
+            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], variance[lo:hi], gate, model)
+            n_meas[f] = hi - lo
+            n_acc[f], nis_log[f], dof_log[f], innov_log[f] = star_statistics(z, nis, accepted)
+        x_log[f] = x
+        P_log[f] = P
+    return x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
 
 
 @njit

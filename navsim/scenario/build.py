@@ -3,11 +3,19 @@
 import numpy as np
 
 from navsim.estimation.attitude_filter import AttitudeFilter
+from navsim.sensors.faults import SensorFaults
 from navsim.sensors.gyro import GyroModel, bias_instability_to_sigma
+from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
+from navsim.studies import OBSERVERS
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
 from startrack import rotation as rot
 from startrack import units
+from startrack.camera import Camera
+from startrack.errors import InputError
+from startrack.identify.identifier import StarIdentifier
+from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+from startrack.render import SensorModel
 
 
 def truth_profile(scenario):
@@ -69,16 +77,21 @@ def mounting(scenario):
     return q_BS, q_BS_true
 
 
-def star_sensor(scenario, star_catalog):
-    """The vector-fidelity sensor of ``scenario['star_sensor']``; ``star_catalog`` is a
-    :class:`startrack.star_catalog.StarCatalog` (used for the 'stars' measurement)."""
+def star_sensor(scenario, star_catalog, frame_interval):
+    """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with the faults that
+    act on it; ``star_catalog`` a :class:`startrack.star_catalog.StarCatalog` (stars measured or
+    rendered), ``frame_interval`` the time between frames [s]."""
     sensor = scenario["star_sensor"]
     _, q_BS_true = mounting(scenario)
+    sensor_faults = SensorFaults.from_scenario(scenario["faults"], frame_interval)
+    if sensor["fidelity"] == "image":
+        return image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults)
     if sensor["measurement"] == "attitude":
         return AttitudeFixSensor(
             sigma_cross=float(units.arcsec_to_rad(sensor["attitude_sigma_cross_arcsec"])),
             sigma_roll=float(units.arcsec_to_rad(sensor["attitude_sigma_roll_arcsec"])),
             q_BS_true=q_BS_true,
+            faults=sensor_faults,
         )
     stars = star_catalog.brighter_than(sensor["mag_limit"])
     return StarVectorSensor(
@@ -89,7 +102,45 @@ def star_sensor(scenario, star_catalog):
         sigma=float(units.arcsec_to_rad(sensor["star_sigma_arcsec"])),
         max_stars=sensor["max_stars"],
         q_BS_true=q_BS_true,
+        faults=sensor_faults,
     )
+
+
+def image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults):
+    """The image-fidelity sensor of ``scenario['star_sensor']`` and its ``image`` table: camera,
+    detector, navigation catalog (eq. 1-8 of 000) and identifier, the stars drawn into the frames."""
+    sensor, image = scenario["star_sensor"], scenario["star_sensor"]["image"]
+    fov = float(units.deg_to_rad(sensor["fov_deg"]))
+    camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
+    model = SensorModel(psf_sigma_px=image["psf_sigma_px"], exposure_s=image["exposure_s"],
+                        zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"])
+    params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],
+                                     max_delta=float(units.deg_to_rad(image["catalog_max_pointing_error_deg"])),
+                                     epoch=scenario["epoch_jyear"])
+    identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera,
+                                centroid_sigma_px=image["centroid_sigma_px"], max_stars=image["max_identified_stars"])
+    stars = _rendered_stars(star_catalog, image)
+    return ImageStarSensor(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
+                           stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
+                           detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
+                           stacking=image["dim_star_stacking"], centroid_sigma=image["centroid_sigma_px"] / camera.focal_px,
+                           start_tracking=image["start_tracking"], q_BS_true=q_BS_true, faults=sensor_faults)
+
+
+def _rendered_stars(star_catalog, image):
+    """The stars drawn into the frames: to ``render_mag_limit``, or only the ``sky_hip`` stars."""
+    if not image["sky_hip"]:
+        return star_catalog.brighter_than(image["render_mag_limit"])
+    wanted = np.asarray(image["sky_hip"], dtype=np.int64)
+    missing = np.setdiff1d(wanted, np.asarray(star_catalog.hip))
+    if missing.size:
+        raise InputError(f"star_sensor.image.sky_hip: HIP {', '.join(map(str, missing))} not in the catalog")
+    return star_catalog.select(np.isin(np.asarray(star_catalog.hip), wanted))
+
+
+def observers(scenario, sensor):
+    """The per-frame observers (:data:`navsim.studies.OBSERVERS`) the scenario asks for, built once."""
+    return tuple(kind.build(scenario, sensor) for kind in OBSERVERS if kind.wanted(scenario))
 
 
 def initial_covariance(scenario, gyro):
@@ -127,5 +178,6 @@ def attitude_filter(scenario, gyro, q0, P0):
         estimate_scale_factor=f["estimate_scale_factor"],
         estimate_misalignment=f["estimate_misalignment"],
         process_noise_scale=f["process_noise_scale"],
+        measurement_noise_scale=f["measurement_noise_scale"],
         gate_probability=f["gate_probability"],
     )

@@ -1,9 +1,11 @@
-"""Faults a scenario can switch on (``[faults]``), applied to the truth and the sensor stream.
+"""Faults a scenario can switch on (``[faults]``), built once in SI units.
 
-Gyro bias steps change the true bias (and so the gyro output) from their time on; outages and
-dropped frames remove star-sensor frames. Attitude jumps and false-star storms act inside the
-image-fidelity closed loop (:mod:`navsim.closed_loop`).
+Gyro bias steps change the true bias (and so the gyro output) from their time on
+(:func:`apply_bias_steps`); outages, dropped frames and false-star storms act on the star sensor
+(:class:`SensorFaults`); attitude jumps knock the filter's estimate off (:class:`AttitudeJumps`).
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,11 +27,56 @@ def apply_bias_steps(omega, bias, t_samples, steps):
     return omega, bias
 
 
-def frames_available(t_frames, faults, frame_interval):
-    """False for frames inside an outage or dropped (within half a frame interval of a listed time)."""
-    available = np.ones(len(t_frames), dtype=bool)
-    for outage in faults["outages"]:
-        available &= ~((t_frames >= outage["start_s"]) & (t_frames < outage["end_s"]))
-    for t in faults["dropped_frames_s"]:
-        available &= np.abs(t_frames - t) >= 0.5 * frame_interval
-    return available
+@dataclass(frozen=True)
+class SensorFaults:
+    """Outages (start, end [s], reason), dropped frame times [s] and false-star storms (start, end
+    [s], tracks per frame) of ``scenario['faults']``; ``frame_interval`` [s]."""
+
+    outages: tuple
+    dropped_s: np.ndarray
+    storms: tuple
+    frame_interval: float
+
+    @classmethod
+    def from_scenario(cls, faults, frame_interval):
+        return cls(outages=tuple((o["start_s"], o["end_s"], o["reason"]) for o in faults["outages"]),
+                   dropped_s=np.asarray(faults["dropped_frames_s"], dtype=float),
+                   storms=tuple((s["start_s"], s["end_s"], s["count"]) for s in faults["false_star_storms"]),
+                   frame_interval=frame_interval)
+
+    def status(self, t):
+        """(mode, reason) when the frame at t [s] is lost to an outage or dropped, else None."""
+        for start, end, reason in self.outages:
+            if start <= t < end:
+                return "outage", reason
+        if self.dropped_s.size and np.any(np.abs(self.dropped_s - t) < 0.5 * self.frame_interval):
+            return "dropped", "frame dropped"
+        return None
+
+    def available(self, t_frames):
+        """False for the frames (times t_frames [s]) that :meth:`status` takes away."""
+        return np.array([self.status(t) is None for t in t_frames], dtype=bool)
+
+    def storm_count(self, t):
+        """False-star tracks per frame at t [s] (0 outside a storm)."""
+        return next((count for start, end, count in self.storms if start <= t < end), 0)
+
+
+class AttitudeJumps:
+    """The attitude-jump fault: at each ``time_s`` the filter's estimate is knocked off by
+    ``angle_deg`` about a random axis drawn from ``rng`` (a tracking loss the sensor must recover)."""
+
+    def __init__(self, jumps, rng):
+        ordered = sorted(jumps, key=lambda j: j["time_s"])
+        self._pending = [(j["time_s"], units.deg_to_rad(j["angle_deg"])) for j in ordered]
+        self._rng = rng
+
+    def due(self, t):
+        """Rotation vectors [rad] of the jumps at or before t [s] not yet applied, in time order."""
+        out = []
+        while self._pending and self._pending[0][0] <= t:
+            _, angle = self._pending.pop(0)
+            axis = self._rng.standard_normal(3)
+            axis /= np.linalg.norm(axis)
+            out.append(angle * axis)
+        return out

@@ -1,19 +1,23 @@
 """Vector-fidelity star sensor: what the sensor would report, without images.
 
-Two measurement models (DESIGN.md, fidelity ``vector``):
+Two measurement models (docs/design.md, fidelity ``vector``):
 
 - :class:`StarVectorSensor` returns the catalog stars inside the circular field as noisy unit
   vectors in the sensor frame S (one per identified star, brightest first);
 - :class:`AttitudeFixSensor` returns a noisy attitude q_IS with its covariance in S
   (cross-boresight σ on x and y, roll σ about the boresight z).
 
-Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S).
+Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S). Their
+noise does not depend on the filter, so a run draws every frame's measurements when it starts
+(:meth:`StarVectorSensor.start`): the loop reads them frame by frame (:class:`VectorRun`), or the
+filter takes the whole :class:`Record` at once on its compiled fast path.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.sensors.star_sensor import StarFrame
 from startrack import rotation as rot
 
 
@@ -57,6 +61,12 @@ class StarVectorSensor:
     sigma: float
     max_stars: int
     q_BS_true: np.ndarray
+    faults: object  # navsim.sensors.faults.SensorFaults
+
+    def start(self, seed, q_IB_frames, t_frames):
+        """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames."""
+        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed))
+        return VectorRun(Record(available=self.faults.available(t_frames), stars=stars, sigma=self.sigma))
 
     def observe_frames(self, q_IB_true, rng, chunk=512):
         """Noisy star vectors for every true attitude q_IB_true (F, 4) -> :class:`StarFrames`.
@@ -95,6 +105,12 @@ class AttitudeFixSensor:
     sigma_cross: float
     sigma_roll: float
     q_BS_true: np.ndarray
+    faults: object  # navsim.sensors.faults.SensorFaults
+
+    def start(self, seed, q_IB_frames, t_frames):
+        """A run's sensor: every frame's fix drawn from ``seed`` for the true attitudes q_IB_frames."""
+        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed))
+        return VectorRun(Record(available=self.faults.available(t_frames), fixes=fixes, R_S=self.R_S))
 
     @property
     def R_S(self):
@@ -106,3 +122,47 @@ class AttitudeFixSensor:
         sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
         nu = sigma * rng.standard_normal((len(q_IS), 3))
         return rot.multiply(q_IS, rot.from_rotation_vector(nu))
+
+
+@dataclass(frozen=True)
+class Record:
+    """Every frame's measurements of a vector-fidelity run: attitude ``fixes`` (F, 4) with ``R_S``,
+    or ``stars`` (:class:`StarFrames`) with their direction σ [rad]; ``available`` (F,) False for
+    frames lost to an outage or dropped."""
+
+    available: np.ndarray
+    fixes: np.ndarray | None = None
+    R_S: np.ndarray | None = None
+    stars: StarFrames | None = None
+    sigma: float = 0.0
+
+
+class VectorRun:
+    """The per-run sensor of :class:`StarVectorSensor` and :class:`AttitudeFixSensor`: it reads its
+    :class:`Record` frame by frame; tracking state and faults other than lost frames do not apply."""
+
+    log_fields = {}
+    sample = None
+
+    def __init__(self, record):
+        self._record = record
+
+    def record(self):
+        return self._record
+
+    def observe(self, request):
+        r, j = self._record, request.index
+        if not r.available[j]:
+            return StarFrame(mode="no_fix")
+        if r.fixes is not None:
+            return StarFrame(mode="tracking", q_IS=r.fixes[j], R_S=r.R_S)
+        ref_I, obs_S, _ = r.stars.frame(j)
+        if not len(ref_I):
+            return StarFrame(mode="no_fix")
+        return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, sigma=np.full(len(ref_I), r.sigma))
+
+    def after_update(self, update):
+        pass
+
+    def lose_track(self):
+        pass

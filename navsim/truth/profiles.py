@@ -124,6 +124,25 @@ class RigidBody:
         )
 
 
+@dataclass(frozen=True)
+class TruthRecord:
+    """The truth on the gyro grid: times t (M+1,) [s], attitude q_IB (M+1, 4) and the mean body rate
+    of each gyro interval omega_mean (M, 3) [rad/s] (what an ideal rate-integrating gyro reports)."""
+
+    t: np.ndarray
+    q_IB: np.ndarray
+    omega_mean: np.ndarray
+
+
+def sample_truth(profile, q0, n_gyro, gyro_hz, factor):
+    """Simulate ``profile`` from q0 on a grid ``factor`` times denser than the gyro's (``n_gyro``
+    intervals at ``gyro_hz``) and return the :class:`TruthRecord` on the gyro grid."""
+    dt = 1.0 / gyro_hz
+    q_fine, _ = profile.simulate(np.arange(n_gyro * factor + 1) / (gyro_hz * factor), q0)
+    return TruthRecord(t=np.arange(n_gyro + 1) * dt, q_IB=q_fine[::factor],
+                       omega_mean=interval_mean_rates(q_fine, factor, dt))
+
+
 def interval_mean_rates(q_fine, factor, dt_gyro):
     """Mean body rate over each gyro interval [t_k, t_(k+1)] of length dt_gyro [s].
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import navsim
-from navsim.closed_loop import MODE_CODE
+from navsim.sensors.star_sensor import MODE_CODE
 from startrack import units
 from startrack.errors import InputError
 

@@ -33,8 +33,12 @@ def test_transition_is_the_exponential_of_the_error_dynamics():
     F[0:3, 0:3] = -rot.skew(omega)
     F[0:3, 3:6] = -np.eye(3)
     F[0:3, 6:9] = -np.diag(d)
-    np.testing.assert_allclose(kernels.transition(omega, d, dt, 9, 6), expm(F * dt), atol=1e-14)
-    np.testing.assert_allclose(kernels.transition(omega * 1e-6, d, dt, 6, -1), expm(F[:6, :6] * 1e-6 * 0 + _f6(omega * 1e-6) * dt), atol=1e-14)
+    np.testing.assert_allclose(kernels.transition(omega, d, dt, 9, 3), expm(F * dt), atol=1e-14)
+    np.testing.assert_allclose(kernels.transition(omega * 1e-6, d, dt, 6, 0), expm(F[:6, :6] * 1e-6 * 0 + _f6(omega * 1e-6) * dt), atol=1e-14)
+
+
+def _model(arw, rrw, sf_rw=0.0, n_cal=0):
+    return kernels.FilterModel(arw=arw, rrw=rrw, sf_rw=sf_rw, q_scale=1.0, n_cal=n_cal, mounting=False)
 
 
 def _f6(omega):
@@ -53,7 +57,7 @@ def test_process_noise_is_the_van_loan_integral():
     B = expm(A)
     Phi = B[6:, 6:].T
     Q_van_loan = Phi @ B[:6, 6:]
-    np.testing.assert_allclose(kernels.process_noise(arw, rrw, 0.0, dt, 6, -1), Q_van_loan, rtol=1e-10, atol=1e-30)
+    np.testing.assert_allclose(kernels.process_noise(_model(arw, rrw), dt, 6), Q_van_loan, rtol=1e-10, atol=1e-30)
 
 
 def test_predict_and_update_equal_filterpy():
@@ -65,11 +69,13 @@ def test_predict_and_update_equal_filterpy():
     s = np.array([1e-4, 0.0, -1e-4])
     dt, arw, rrw, sf_rw = 0.1, 1e-4, 1e-6, 1e-5
     q0 = rot.from_rotation_vector([0.1, 0.2, 0.3])
-    _, P_pred = kernels.predict(q0, P, b, s, omega_measured, dt, arw, rrw, sf_rw, 1.0, 6)
+    model = _model(arw, rrw, sf_rw, n_cal=3)
+    x0 = np.concatenate([q0, b, s, [0.0, 0.0, 0.0, 1.0]])
+    _, P_pred = kernels.predict(x0, P, omega_measured, dt, model)
     d = omega_measured[0] - b
     kf = KalmanFilter(dim_x=n, dim_z=4)
     kf.P = P.copy()
-    kf.predict(F=kernels.transition((1 - s) * d, d, dt, n, 6), Q=kernels.process_noise(arw, rrw, sf_rw, dt, n, 6))
+    kf.predict(F=kernels.transition((1 - s) * d, d, dt, n, 3), Q=kernels.process_noise(model, dt, n))
     np.testing.assert_allclose(P_pred, kf.P, rtol=1e-12, atol=1e-24)
     H = RNG.standard_normal((4, n))
     R = np.diag([1e-9, 2e-9, 1e-9, 3e-9])
@@ -100,8 +106,8 @@ def test_steady_state_matches_riccati_and_farrenkopf(omega_deg_per_s):
     sigma_n, dt = units.arcsec_to_rad(10.0), 0.1
     omega = np.radians([omega_deg_per_s, -0.5 * omega_deg_per_s, 0.3 * omega_deg_per_s])
     P_pre, P_post = _steady_state_filter(omega, dt, 1, arw, rrw, sigma_n)
-    F = kernels.transition(omega, omega, dt, 6, -1)
-    Q = kernels.process_noise(arw, rrw, 0.0, dt, 6, -1)
+    F = kernels.transition(omega, omega, dt, 6, 0)
+    Q = kernels.process_noise(_model(arw, rrw), dt, 6)
     H = np.hstack([np.eye(3), np.zeros((3, 3))])
     P_dare = solve_discrete_are(F.T, H.T, Q, np.eye(3) * sigma_n**2)
     np.testing.assert_allclose(np.diag(P_pre), np.diag(P_dare), rtol=1e-6)

@@ -1,0 +1,272 @@
+"""Image-fidelity star sensor: every frame is rendered and processed (docs/design.md, fidelity ``image``).
+
+Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_IS and rate:
+
+1. the predicted boresight gives the sub-catalog address (eq. 7-8 of 000), logged every frame;
+2. the frame is rendered from the true attitude (true mounting, smear from the true body rate):
+   windows around the predicted stars while tracking, the full frame otherwise — windows sized to
+   hold the smear trail the predicted rate implies;
+3. detection and centroids; identification with the prediction as prior — tracking first, then the
+   predicted sub-catalog with its 4 redundant neighbours, then full-sky lost-in-space
+   (:class:`startrack.identify.StarIdentifier`); while tracking, stars the identifier leaves are
+   window-matched to their predictions;
+4. with fewer than 3 stars identified while tracking, the brightest undetected predicted star is
+   stacked over the last 4 frames (shifted-window superposition, eq. 13-18 of 004), its centroid
+   corrected by the sub-pixel phases the predictions give (an extension of 004: integer shifts alone
+   leave ~0.25 px per axis);
+5. one unit vector per identified star (the stacked dim star last, with its own larger σ), the
+   identification's attitude for a re-initialisation when it came from the sub-catalog or full sky.
+
+Faults acting on the sensor (outages, dropped frames, false-star storms) are applied here; the
+tracking state follows the filter's verdict (:meth:`ImageRun.after_update`).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim import kinematics
+from navsim.sensors.star_sensor import MODE_CODE, StarFrame
+from startrack import rotation as rot
+from startrack.detection import detect, detect_windows
+from startrack.identify.identifier import Prior
+from startrack.render import Windows, cosmic_ray, render_star_field
+from startrack.stacking import DimStarCache
+
+#: σ per axis of a stacked dim-star centroid [px]. The loop uses the phase-corrected centroid
+#: (startrack.stacking: integer shifts average the 4 frames' sub-pixel phases, ~0.25 px per axis, and
+#: the filter's predictions put the phase back); measured in scenarios/paper004_dim_star.toml over
+#: 24 seeds (176 stacked frames): (0.35, 0.25) px RMS in (u, v), against (0.45, 0.38) px uncorrected.
+STACKED_SIGMA_PX = 0.30
+
+#: Per-frame log quantities: name -> (trailing shape, dtype, value before the frame is logged).
+LOG_FIELDS = {
+    "mode": ((), np.int8, 0), "n_detected": ((), np.int32, 0), "n_identified": ((), np.int32, 0),
+    "n_stacked": ((), np.int32, 0), "id_ms": ((), np.float64, np.nan), "boresight_radec": ((2,), np.float64, np.nan),
+    "subcatalog_index": ((), np.int32, 0), "subcatalog_address": ((2,), np.int32, 0),
+}
+
+
+@dataclass(frozen=True)
+class ImageStarSensor:
+    """The seed-free image-fidelity sensor, built once per scenario (:func:`navsim.scenario.build.star_sensor`):
+    camera and detector model, the identifier over the navigation catalog, the stars drawn into the
+    frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n,
+    tracking window half-width [px], dim-star stacking on/off, the centroid σ [rad] the filter is
+    told, whether the first frame is already tracked (004's set-up), the true mounting and the faults."""
+
+    camera: object
+    model: object
+    identifier: object
+    stars_I: np.ndarray
+    stars_mag: np.ndarray
+    stars_hip: np.ndarray
+    detection_sigmas: float
+    window_half_px: int
+    stacking: bool
+    centroid_sigma: float
+    start_tracking: bool
+    q_BS_true: np.ndarray
+    faults: object
+
+    @property
+    def catalog(self):
+        return self.identifier.catalog
+
+    def start(self, storm_rng, render_rng, n_frames, full_frames=frozenset()):
+        """A run's sensor; ``full_frames``: frame indices read in full whatever the mode (observers')."""
+        return ImageRun(self, storm_rng, render_rng, n_frames, full_frames)
+
+
+class ImageRun:
+    """The per-run state of an :class:`ImageStarSensor`: tracking flag, the 4-frame stacking cache,
+    the random streams of rendering and false stars, and one full frame kept for the report."""
+
+    log_fields = LOG_FIELDS
+
+    def __init__(self, sensor, storm_rng, render_rng, n_frames, full_frames):
+        self.sensor = sensor
+        self._storm_rng, self._render_rng = storm_rng, render_rng
+        self._tracking = sensor.start_tracking  # previous frame identified: read windows around predicted stars
+        self._cache = DimStarCache(half_width=2, depth=4)
+        self._full_frames = frozenset(full_frames)
+        self._sample_at, self._last = n_frames // 2, n_frames - 1
+        self._R_SB_true = rot.to_matrix(sensor.q_BS_true).T
+        self.sample = None
+
+    def record(self):
+        return None
+
+    def lose_track(self):
+        self._tracking = False
+        self._cache.reset()
+
+    def after_update(self, update):
+        """Tracking continues while the filter accepts two stars (one, once tracking)."""
+        accepted = 0 if update is None else update.n_accepted
+        self._tracking = accepted >= 2 or (self._tracking and accepted >= 1)
+
+    def observe(self, request):
+        info = self._address(request.q_IS_pred)
+        lost = self.sensor.faults.status(request.t)
+        if lost is not None:
+            self.lose_track()
+            return StarFrame(mode=lost[0], reason=lost[1], info=info | {"mode": MODE_CODE[lost[0]]})
+        s = self.sensor
+        q_IS_true = rot.multiply(request.q_IB_true, s.q_BS_true)
+        uv_pred, visible = s.camera.project(request.q_IS_pred, s.stars_I)
+        predicted = np.flatnonzero(visible)
+        full = (not self._tracking or len(predicted) == 0 or request.index == self._sample_at
+                or request.index in self._full_frames)
+        image, windows, found = self._read(request, q_IS_true, uv_pred[predicted], full)
+        result = s.identifier.solve(found.uv, found.flux, prior=Prior(q_IS=request.q_IS_pred))
+        ref_I, obs_S, mode, reason = self._identified(result, found, uv_pred, predicted)
+        info |= {"n_detected": len(found), "n_identified": len(ref_I), "id_ms": result.solve_ms}
+        diagnostics = {"q_IS_true": q_IS_true, "detections": found}
+        stacked = self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I)) if self._stacks(predicted) else None
+        sigma = np.full(len(ref_I), s.centroid_sigma)
+        if stacked is not None:
+            stacked["uv_true"] = s.camera.project(q_IS_true, s.stars_I[stacked["index"]][None])[0][0]
+            diagnostics["stacked"] = stacked
+            ref_I, obs_S = np.vstack([ref_I, stacked["ref_I"]]), np.vstack([obs_S, stacked["obs_S"]])
+            sigma = np.append(sigma, stacked["sigma"])
+            mode, reason = "stacked", f"{len(ref_I) - 1} stars and the stacked dim star HIP {stacked['hip']}"
+        if not len(ref_I):
+            mode = "no_fix"
+        if self.sample is None and full and (request.index >= self._sample_at or request.index == self._last):
+            self.sample = _sample_frame(image, found, result)
+        return StarFrame(mode=mode, reason=reason, ref_I=ref_I, obs_S=obs_S, sigma=sigma,
+                         n_stacked=int(stacked is not None),
+                         fix_q_IS=result.q_IS if mode in ("subcatalog", "lost_in_space") else None,
+                         info=info | {"mode": MODE_CODE[mode], "n_stacked": int(stacked is not None)},
+                         diagnostics=diagnostics)
+
+    def _address(self, q_IS_pred):
+        """Predicted boresight (RA, Dec) [rad] and its sub-catalog address and flat index (eq. 7-8 of 000)."""
+        ra, dec = kinematics.boresight_radec(q_IS_pred)
+        catalog = self.sensor.catalog
+        return {"boresight_radec": (ra, dec), "subcatalog_address": catalog.address(ra, dec),
+                "subcatalog_index": catalog.sub_catalog_index(ra, dec)}
+
+    def _read(self, request, q_IS_true, uv_predicted, full):
+        """(image, windows or None, detections) of the frame: rendered from the truth, read in full
+        or in windows around the predicted stars sized to the smear the predicted rate implies."""
+        s, camera, model = self.sensor, self.sensor.camera, self.sensor.model
+        windows = None
+        if not full:
+            smear_px = np.hypot(request.omega_S_pred[0], request.omega_S_pred[1]) * model.exposure_s * camera.focal_px
+            half = max(s.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
+            windows = Windows.around(uv_predicted, half, camera.height, camera.width)
+        frame = render_star_field(camera, model, q_IS_true, s.stars_I, s.stars_mag, self._render_rng,
+                                  omega_S=self._R_SB_true @ request.omega_B_true, windows=windows,
+                                  extra_sources=self._false_stars(request.t))
+        b, sigma_n = model.background_dn, model.noise_dn
+        if full:
+            found = detect(frame.image, background=b, sigma_n=sigma_n, a=s.detection_sigmas,
+                           saturation_dn=model.saturation_dn)
+        else:
+            found = _unique(detect_windows(frame.image, windows.row0, windows.col0, b, sigma_n, a=s.detection_sigmas,
+                                           saturation_dn=model.saturation_dn))
+        return frame.image, windows, found
+
+    def _false_stars(self, t):
+        """Cosmic-ray tracks of a false-star storm at t [s] (none outside a storm)."""
+        count = self.sensor.faults.storm_count(t)
+        if not count:
+            return ()
+        camera, rng = self.sensor.camera, self._storm_rng
+        u0 = rng.uniform(0, camera.width - 1, count)
+        v0 = rng.uniform(0, camera.height - 1, count)
+        du, dv = rng.normal(0, 3.0, (2, count))
+        return tuple(cosmic_ray(a, b, a + c, b + d, 4.0e4) for a, b, c, d in zip(u0, v0, du, dv))
+
+    def _identified(self, result, found, uv_pred, predicted):
+        """(ref_I, obs_S, mode, reason) of the identification; while tracking, stars it did not
+        identify are matched to their predicted positions instead (mode None: nothing found)."""
+        s = self.sensor
+        if result.ok:
+            return result.ref_I, result.obs_S, result.method, f"{len(result.ref_I)} stars identified"
+        if self._tracking:
+            det, pred = _match_predicted(found.uv, uv_pred[predicted], 3.0 * s.window_half_px / 2)
+            if det.size:
+                return (s.stars_I[predicted[pred]], s.camera.unproject(found.uv[det]), "tracking",
+                        f"{det.size} stars matched to their predictions")
+        return np.zeros((0, 3)), np.zeros((0, 3)), None, result.reason
+
+    def _stacks(self, predicted):
+        return self.sensor.stacking and self._tracking and len(predicted) > 0
+
+    def _stack(self, image, windows, found, uv_pred, predicted, full, n_identified):
+        """004 §3: push the brightest undetected predicted star's window into the 4-frame cache and,
+        with fewer than 3 stars identified and a full cache, stack it (eq. 13-18 of 004). Returns the
+        stacked star (its catalog and measured vectors, σ, centroid and true position, HIP) or None."""
+        s = self.sensor
+        _, pred_match = _match_predicted(found.uv, uv_pred[predicted], 3.0)
+        undetected = np.setdiff1d(np.arange(len(predicted)), pred_match)
+        if not undetected.size:
+            return None
+        candidate = predicted[undetected[np.argmin(s.stars_mag[predicted[undetected]])]]
+        self._push(image, windows, uv_pred[candidate], int(candidate), full, predicted)
+        if n_identified >= 3 or not self._cache.full:
+            return None
+        stacked = self._cache.stack(s.model.background_dn, s.model.noise_dn, a=s.detection_sigmas)
+        if not stacked.detected:
+            return None
+        uv = np.array([[stacked.u_corrected, stacked.v_corrected]])
+        return {"ref_I": s.stars_I[candidate], "obs_S": s.camera.unproject(uv)[0], "uv": uv[0],
+                "sigma": STACKED_SIGMA_PX / s.camera.focal_px, "hip": s.stars_hip[candidate], "index": int(candidate)}
+
+    def _push(self, image, windows, uv, candidate, full, predicted):
+        """The candidate's l = 2 window into the cache: cut from the full frame or from its readout window."""
+        if full:
+            self._cache.push(image, uv, star_id=candidate)
+            return
+        w = int(np.flatnonzero(predicted == candidate)[0])
+        centre = np.rint(uv[::-1]).astype(int) - (windows.row0[w], windows.col0[w])
+        window = image[w][centre[0] - 2 : centre[0] + 3, centre[1] - 2 : centre[1] + 3]
+        if window.shape == (5, 5):
+            self._cache.push_window(window, uv, star_id=candidate)
+        else:
+            self._cache.reset()
+
+
+def _match_predicted(uv, uv_predicted, gate_px):
+    """One-to-one nearest matches (detection index, predicted index) within ``gate_px``."""
+    if len(uv) == 0 or len(uv_predicted) == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    d = np.linalg.norm(uv[:, None, :] - uv_predicted[None, :, :], axis=2)
+    pairs = []
+    used_d, used_p = set(), set()
+    for flat in np.argsort(d, axis=None):
+        i, k = divmod(int(flat), d.shape[1])
+        if d[i, k] > gate_px:
+            break
+        if i not in used_d and k not in used_p:
+            pairs.append((i, k))
+            used_d.add(i)
+            used_p.add(k)
+    if not pairs:
+        return np.zeros(0, int), np.zeros(0, int)
+    det, pred = np.array(pairs).T
+    return det, pred
+
+
+def _unique(found):
+    """Windows around close stars overlap: keep one detection per star image (1 px)."""
+    if len(found) < 2:
+        return found
+    uv = found.uv
+    keep = np.ones(len(found), bool)
+    for i in range(len(found)):
+        if keep[i]:
+            close = np.linalg.norm(uv[i + 1 :] - uv[i], axis=1) < 1.0
+            keep[i + 1 :][close] = False
+    return found.select(keep)
+
+
+def _sample_frame(image, found, result):
+    hip = {int(c): int(h) for c, h in result.matches} if result.ok else {}
+    return {
+        "image": np.asarray(image),
+        "detections": [{"u": float(u), "v": float(v), "hip": hip.get(i)} for i, (u, v) in enumerate(found.uv)],
+    }

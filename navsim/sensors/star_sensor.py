@@ -1,0 +1,65 @@
+"""The star sensor as the closed loop sees it: one request per frame in, one :class:`StarFrame` out.
+
+A star sensor (vector fidelity: :mod:`navsim.sensors.star_vector`; image fidelity:
+:mod:`navsim.sensors.star_image`) is built once from the validated scenario, in SI units, and
+shared by the runs of a batch. ``sensor.start(seed, ...)`` returns the run's own sensor state,
+which answers three calls:
+
+- ``observe(request) -> StarFrame``: the frame's measurements (identified star vectors with their
+  σ, or an attitude fix), the mode used, counts, timings and the diagnostics observers read;
+- ``after_update(update)``: the filter's verdict on the frame (tracking continues while it accepts
+  the stars), ``None`` when nothing was fused;
+- ``lose_track()``: the estimate was knocked off (attitude-jump fault), start acquiring again.
+
+``record()`` returns the measurements of every frame when they are known before the run (vector
+fidelity: they do not depend on the filter), which lets the filter take its compiled fast path;
+otherwise None. ``log_fields`` declares the per-frame quantities the sensor adds to the run log.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Frame modes, in the order of their integer codes in the time series.
+MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped")
+MODE_CODE = {name: code for code, name in enumerate(MODES)}
+
+
+@dataclass(frozen=True)
+class FrameRequest:
+    """What the loop knows at a frame: its index and time [s], the truth (q_IB, the body rate over
+    the last gyro interval [rad/s]) from which the sky is seen, and the filter's prediction of the
+    sensor attitude q_IS and of the rate in sensor axes [rad/s]."""
+
+    index: int
+    t: float
+    q_IB_true: np.ndarray
+    omega_B_true: np.ndarray
+    q_IS_pred: np.ndarray
+    omega_S_pred: np.ndarray
+
+
+@dataclass(frozen=True)
+class StarFrame:
+    """One frame's output. Measurements: ``ref_I``/``obs_S`` (N, 3) with direction σ (N,) [rad]
+    (a stacked dim star last, counted by ``n_stacked``), or an attitude fix ``q_IS`` with covariance
+    ``R_S`` in sensor axes. ``fix_q_IS``: the attitude of a sub-catalog or full-sky identification,
+    from which the filter may be re-initialised when it rejects the stars (a lost track).
+    ``info``: the per-frame log quantities (``log_fields``); ``diagnostics``: what observers read
+    (detections, the stacked star, the true sensor attitude)."""
+
+    mode: str
+    reason: str = ""
+    ref_I: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    obs_S: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    n_stacked: int = 0
+    q_IS: np.ndarray | None = None
+    R_S: np.ndarray | None = None
+    fix_q_IS: np.ndarray | None = None
+    info: dict = field(default_factory=dict)
+    diagnostics: dict = field(default_factory=dict)
+
+    @property
+    def has_measurements(self):
+        return self.q_IS is not None or len(self.ref_I) > 0
