@@ -12,29 +12,16 @@ Monte Carlo campaigns, filter tuning, the static studies of the source documents
 PDF reports live in :mod:`navsim.report` (not imported here: it loads matplotlib and typst).
 """
 
-from navsim.campaign.montecarlo import run_campaign
-from navsim.campaign.tuning import tune
-from navsim.estimation.attitude_filter import AttitudeFilter
-from navsim.output import read_npz, write_run
-from navsim.scenario import Scenario, load_scenario
-from navsim.sensors.gyro import GyroModel
-from navsim.simulation import RunResult, prepare, run, run_batch, run_study, simulate
-from navsim.studies import StudyResult
+from startrack.lazy import lazy_exports
 
-__all__ = [
-    "AttitudeFilter",
-    "GyroModel",
-    "RunResult",
-    "Scenario",
-    "StudyResult",
-    "load_scenario",
-    "prepare",
-    "read_npz",
-    "run",
-    "run_batch",
-    "run_campaign",
-    "run_study",
-    "simulate",
-    "tune",
-    "write_run",
-]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "navsim.campaign.montecarlo": ("run_campaign",),
+    "navsim.campaign.tuning": ("tune",),
+    "navsim.estimation.attitude_filter": ("AttitudeFilter",),
+    "navsim.output": ("read_npz", "write_run"),
+    "navsim.records": ("CampaignSummary", "RunSummary"),
+    "navsim.scenario": ("Scenario", "load_scenario"),
+    "navsim.sensors.gyro": ("GyroModel",),
+    "navsim.simulation": ("RunResult", "prepare", "run", "run_batch", "run_study", "simulate"),
+    "navsim.studies": ("StudyResult",),
+})

@@ -13,13 +13,9 @@ import json
 import sys
 from pathlib import Path
 
-from navsim.campaign.montecarlo import run_campaign
-from navsim.campaign.tuning import tune
-from navsim.output import write_run, write_study
-from navsim.scenario import resolve_scenario
-from navsim.simulation import run, run_study
-from navsim.studies import STUDIES
 from startrack.errors import InputError, run_command
+
+# Each command imports what it needs when it runs, so ``navsim --help`` starts at once.
 
 
 def _print_summary(summary, out):
@@ -42,6 +38,11 @@ def _print_summary(summary, out):
 
 
 def _run(args):
+    from navsim.output import write_run, write_study
+    from navsim.scenario import resolve_scenario
+    from navsim.simulation import run, run_study
+    from navsim.studies import STUDIES
+
     if args.report and Path(args.report).suffix.lower() != ".pdf":
         raise InputError(f"--report {args.report}: the report file name must end in .pdf.")
     scenario = resolve_scenario(args.scenario, args.set or ())
@@ -72,6 +73,8 @@ def _report(args):
 
 
 def _montecarlo(args):
+    from navsim.campaign.montecarlo import run_campaign
+
     if args.workers is not None and args.scheduler is not None:
         raise InputError("give either --workers or --scheduler, not both")
     if args.workers is not None and args.workers < 1:
@@ -93,6 +96,8 @@ def _montecarlo(args):
 
 
 def _tune(args):
+    from navsim.campaign.tuning import tune
+
     if args.runs < 1:
         raise InputError(f"--runs must be at least 1, got {args.runs}")
     result = tune(args.scenario, runs=args.runs, seed=args.seed, overrides=args.set or (), evaluations=args.evaluations)

@@ -27,9 +27,9 @@ Frame convention (DESIGN.md, binding):
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from startrack.errors import InputError
+from startrack.rotation import from_rotation_vector, to_matrix
 
 #: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
 _NEWTON_ITERATIONS = 12
@@ -183,7 +183,7 @@ class Camera:
         q = np.asarray(q_IS, dtype=float)
         if q.shape != (4,) or not np.all(np.isfinite(q)) or np.linalg.norm(q) == 0:
             raise InputError(f"attitude quaternion q_IS must be 4 finite numbers, not all zero, got {q_IS!r}")
-        return np.atleast_2d(np.asarray(vectors_I, dtype=float)) @ Rotation.from_quat(q).as_matrix()
+        return np.atleast_2d(np.asarray(vectors_I, dtype=float)) @ to_matrix(q)
 
     def unproject(self, uv):
         """Unit vectors (N,3) in S of image points (N,2) [px] (distortion removed)."""
@@ -221,7 +221,7 @@ class Camera:
         """
         v_S0 = self.to_sensor(q_IS_mid, vectors_I)
         rotvecs = np.asarray(times_s, dtype=float)[:, None] * np.asarray(omega_S, dtype=float)[None, :]
-        mats = Rotation.from_rotvec(rotvecs).as_matrix()  # (K,3,3) S(t) -> S(0)
+        mats = to_matrix(from_rotation_vector(rotvecs))  # (K,3,3) S(t) -> S(0)
         v_S = np.einsum("nj,kji->nki", v_S0, mats)  # R^T v
         z = v_S[..., 2]
         with np.errstate(divide="ignore", invalid="ignore"):

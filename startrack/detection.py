@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from scipy.stats import norm
+from scipy.special import ndtr
 
 from startrack.errors import InputError
 from startrack.photometry import detection_threshold
@@ -161,7 +161,8 @@ def estimate_background(image, clip=3.0, iterations=5):
         sigma = float(np.std(sample))
     if sigma == 0.0:
         return level, 0.0
-    truncation = np.sqrt(1.0 - 2.0 * clip * norm.pdf(clip) / (2.0 * norm.cdf(clip) - 1.0))
+    density = np.exp(-0.5 * clip * clip) / np.sqrt(2.0 * np.pi)  # standard normal pdf at the clip
+    truncation = np.sqrt(1.0 - 2.0 * clip * density / (2.0 * ndtr(clip) - 1.0))
     n_kept = -1
     for _ in range(iterations):
         kept = sample[np.abs(sample - level) <= clip * sigma]

@@ -30,7 +30,7 @@ from navsim.output import read_npz, write_json, write_run
 from navsim.records import CampaignSummary, RunSummary
 from navsim.scenario import Scenario, resolve_scenario
 from navsim.simulation import prepare, simulate
-from navsim.studies import OBSERVERS
+from navsim.studies import observers
 from startrack import units
 from startrack.errors import InputError
 
@@ -186,10 +186,10 @@ def _run_dask(scenario, chunks, scheduler, bar):
 
 
 def _pooled_findings(summaries):
-    """The observers' findings pooled over the runs (:data:`navsim.studies.OBSERVERS`), with their
+    """The observers' findings pooled over the runs (:func:`navsim.studies.observers`), with their
     comparison rows and notes."""
     findings, rows, notes = {}, [], []
-    for kind in OBSERVERS:
+    for kind in observers():
         pooled = kind.pool(summaries)
         if pooled is not None:
             findings[pooled.key] = pooled.stats

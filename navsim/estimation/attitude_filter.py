@@ -26,9 +26,9 @@ filterpy's ``KalmanFilter.predict``/``update`` (Joseph form), which is the refer
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
 
 from navsim.estimation import kernels
+from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
 from startrack import rotation as rot
 
@@ -93,7 +93,7 @@ class AttitudeFilter:
         self._P = P
         self._P0_attitude = P[0:3, 0:3].copy()
         self.variance_scale = float(measurement_noise_scale) ** 2
-        self.gate = {dof: float(chi2.ppf(gate_probability, dof)) for dof in (2, 3)}
+        self.gate = {dof: float(chi2_quantile(gate_probability, dof)) for dof in (2, 3)}
 
     q = property(lambda self: _read_only(self._x[0:4]), doc="q_IB estimate (4,)")
     b = property(lambda self: _read_only(self._x[4:7]), doc="gyro bias estimate (3,) [rad/s]")

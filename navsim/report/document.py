@@ -198,10 +198,8 @@ def _key_results(doc, run):
     rms = [get("attitude_error_rms_arcsec", axis) for axis in "xyz"]
     if any(v is not None for v in rms):
         sentences.append(f"Per body axis the RMS errors are {xyz(rms)} arcsec.")
-    dof = get("nees", "dof") or stats.NEES_DOF
+    dof, band = summary["nees"]["dof"], summary["nees"]["band_95"]
     if get("nees", "mean") is not None:
-        band = summary["nees"].get("band_95")
-        band = band if isinstance(band, list) and len(band) == 2 else stats.chi2_band(dof)
         sentences.append(
             f"The NEES ({dof:g} dof) averages {number(get('nees', 'mean'))} and "
             f"{number(get('nees', 'fraction_in_band'), 1, 100)} % of the frames lie inside the 95 % "
@@ -511,7 +509,7 @@ def campaign_report(campaign) -> bytes:
             doc.figure(figures.identification_success(success, criterion), "Identification success per mode.")
 
         if campaign.summary:
-            rows = [(k, _short(general(v))) for k, v in flatten(campaign.summary)]
+            rows = [(k, _short(general(v))) for k, v in flatten(campaign.summary.to_json())]
             if rows:
                 doc.heading("Aggregate summary")
                 doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))

@@ -114,7 +114,7 @@ def consistency(run):
     row = 0
     if has_nees:
         ax = axes[row, 0]
-        dof = int(run.summary.get("nees", {}).get("dof", stats.NEES_DOF))
+        dof = int(run.summary["nees"]["dof"])
         lo, hi = stats.chi2_band(dof)
         ax.plot(t, s["nees"], lw=0.7, color="tab:blue", label=f"NEES ({dof} dof)")
         _log_y(ax)

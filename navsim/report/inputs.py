@@ -1,10 +1,11 @@
 """Read what a report is made from: a run directory, a static-study directory or a Monte Carlo
 campaign directory.
 
-A run directory holds ``summary.json`` and ``timeseries.npz`` (and usually ``scenario.json``;
-optionally ``frame.npy`` with ``frame_detections.json``). A campaign directory holds
-``campaign.json`` and ``runs/run_NNNNN/`` run directories (a run that raised leaves
-``error.json`` instead), with the aggregate in ``summary.json``. Only the arrays a report
+A run directory holds ``summary.json`` (a :class:`~navsim.records.RunSummary`), ``timeseries.npz``
+and ``scenario.json`` (optionally ``frame.npy`` with ``frame_detections.json``). A campaign directory
+holds ``campaign.json`` (with the validated scenario) and ``runs/run_NNNNN/`` run directories (a run
+that raised leaves ``error.json`` instead), with the aggregate in ``summary.json`` (a
+:class:`~navsim.records.CampaignSummary`). Only the arrays a report
 draws are checked; everything optional may be absent. Bad input raises
 :class:`~startrack.errors.InputError` with one sentence naming the file and the problem.
 """
@@ -16,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from navsim.records import CampaignSummary, RunSummary
 from navsim.studies import STUDIES
 from startrack.errors import InputError
 
@@ -147,10 +149,9 @@ def directory_kind(directory: Path) -> str:
 
 
 def load_run(directory: Path) -> RunData:
-    summary = read_json(directory / "summary.json")
+    summary = RunSummary.read(directory / "summary.json")
     series = read_series(directory / "timeseries.npz")
-    scenario_path = directory / "scenario.json"
-    scenario = read_json(scenario_path) if scenario_path.is_file() else None
+    scenario = read_json(directory / "scenario.json")
     frame, detections = None, None
     if (directory / "frame.npy").is_file():
         frame = _read_frame(directory / "frame.npy")
@@ -215,13 +216,8 @@ def _read_detections(path: Path) -> list:
 def load_campaign(directory: Path) -> CampaignData:
     campaign = read_json(directory / "campaign.json")
     summary_path = directory / "summary.json"
-    summary = read_json(summary_path) if summary_path.is_file() else None
-    scenario_path = directory / "scenario.json"
-    scenario = read_json(scenario_path) if scenario_path.is_file() else None
-    for key in ("scenario_data", "scenario"):  # the validated scenario may be embedded in campaign.json
-        if scenario is None and isinstance(campaign.get(key), dict):
-            scenario = campaign[key]
-    data = CampaignData(directory, campaign, summary, scenario=scenario)
+    summary = CampaignSummary.read(summary_path) if summary_path.is_file() else None
+    data = CampaignData(directory, campaign, summary, scenario=campaign.get("scenario_data"))
     runs_dir = directory / "runs"
     run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir()) if runs_dir.is_dir() else []
     for run_dir in run_dirs:
@@ -231,7 +227,7 @@ def load_campaign(directory: Path) -> CampaignData:
             data.failed.append(FailedRun(run_dir.name, str(message)))
         elif (run_dir / "summary.json").is_file() and (run_dir / "timeseries.npz").is_file():
             series = read_series(run_dir / "timeseries.npz", CAMPAIGN_SERIES)
-            data.runs.append(RunData(run_dir, read_json(run_dir / "summary.json"), series))
+            data.runs.append(RunData(run_dir, RunSummary.read(run_dir / "summary.json"), series))
     if not data.runs:
         raise InputError(f"{directory}: the campaign has no finished runs under runs/ "
                          f"({len(data.failed)} failed); nothing to report.")

@@ -1,33 +1,23 @@
 """The numbers a report quotes and draws, computed once from a run or a campaign.
 
 Units at this edge: attitude in arcsec, gyro bias in deg/h, times in seconds and milliseconds.
-The consistency bands are the two-sided 95 % chi-square intervals of Bar-Shalom, Li and
-Kirubarajan (Estimation with Applications to Tracking and Navigation, §5.4.2): for a
-consistent filter the NEES of one run is χ²(n), and the NEES averaged over M independent
-runs, ε̄ = (1/M) Σ εᵢ, satisfies M ε̄ ~ χ²(M n).
+The consistency bands are those of :mod:`navsim.estimation.consistency`; the NEES dof is the one
+each run's summary records.
 """
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
 
+from navsim.estimation.consistency import chi2_band
 from startrack import address, units
 from startrack.errors import InputError
 
-BAND_PROBABILITY = 0.95
 #: A frame counts as identified when at least this many stars were identified (two fix an attitude).
 MIN_IDENTIFIED = 2
 #: Error of the attitude states is rows 0:3 of the filter state, the gyro bias rows 3:6.
 ATTITUDE, BIAS = slice(0, 3), slice(3, 6)
-NEES_DOF = 6
-
-
-def chi2_band(dof, runs=1, probability=BAND_PROBABILITY):
-    """Two-sided ``probability`` interval of the NEES averaged over ``runs`` runs of ``dof`` dof each."""
-    tail = (1.0 - probability) / 2.0
-    total = np.multiply(dof, runs)
-    return chi2.ppf(tail, total) / runs, chi2.ppf(1.0 - tail, total) / runs
 
 
 def mode_names(summary, codes):
@@ -91,14 +81,13 @@ def mode_table(run):
 def declination_divisions(run):
     """n_d of the base-point grid the run addressed, or None.
 
-    Taken from a key ``n_d`` anywhere in scenario.json or summary.json; otherwise the n_d for
+    Taken from the scenario (``star_sensor.image.catalog_nd``); for a run without it, the n_d for
     which the logged addresses (l_d, l_ra) and flat indices agree (eq. 7-8 and the flat index
     of document 000), searched over the grids whose ring count covers the largest l_d.
     """
-    for source in (run.scenario, run.summary):
-        found = _find_key(source, "n_d")
-        if found is not None:
-            return found
+    image = ((run.scenario or {}).get("star_sensor") or {}).get("image")
+    if image and "catalog_nd" in image:
+        return int(image["catalog_nd"])
     s = run.series
     if "subcatalog_address" not in s or "subcatalog_index" not in s:
         return None
@@ -126,21 +115,6 @@ def sub_catalog_indices(series, n_d):
     return index[(index >= 0) & (index < address.base_point_count(n_d))]
 
 
-def _find_key(tree, key):
-    if isinstance(tree, dict):
-        value = tree.get(key)
-        if isinstance(value, int) and not isinstance(value, bool) and 3 <= value <= 2000:
-            return value
-        children = tree.values()
-    elif isinstance(tree, list):
-        children = tree
-    else:
-        return None
-    for child in children:
-        found = _find_key(child, key)
-        if found is not None:
-            return found
-    return None
 
 
 # --------------------------------------------------------------------------- campaigns
@@ -211,9 +185,9 @@ def averaged_nees(campaign):
     t = common_frames(campaign)
     mean = np.mean(np.stack([r.series["nees"][: t.size] for r in campaign.runs]), axis=0)
     m = len(campaign.runs)
-    dof = int(campaign.runs[0].summary.get("nees", {}).get("dof", NEES_DOF))
+    dof = int(campaign.runs[0].summary["nees"]["dof"])
     lo, hi = chi2_band(dof, m)
-    settle = float(campaign.runs[0].summary.get("settle_s", 0.0))
+    settle = float(campaign.runs[0].summary["settle_s"])
     steady = t >= settle
     if not steady.any():
         steady = np.ones_like(t, dtype=bool)
@@ -313,7 +287,7 @@ def metric_table(campaign):
 def lookup(tree, path):
     """The finite number at ``path`` (keys or list indices) in nested JSON, else None."""
     for key in path:
-        if isinstance(tree, dict) and key in tree:
+        if isinstance(tree, Mapping) and key in tree:
             tree = tree[key]
         elif isinstance(tree, list) and isinstance(key, int) and -len(tree) <= key < len(tree):
             tree = tree[key]

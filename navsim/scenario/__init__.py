@@ -2,12 +2,13 @@
 
 ``load_scenario(path, overrides)`` reads a file, applies ``--set key=value`` overrides
 (dotted keys, TOML values), validates everything against :data:`SCHEMA` (a simulation) or
-:data:`STUDY_SCHEMA` (a static study: a file with a ``[study]`` table, see :mod:`navsim.studies`)
+:func:`study_schema` (a static study: a file with a ``[study]`` table, see :mod:`navsim.studies`)
 and returns a :class:`Scenario` (the validated plain dictionary plus the name of its file). Every
 problem ends in one :class:`InputError` naming the file, the key and what is wrong.
 """
 
 import copy
+import functools
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -193,16 +194,20 @@ SCHEMA = Table(
 )
 
 
-STUDY_SCHEMA = Table(
-    {
-        "name": Value("str"),
-        "description": Value("str", default=""),
-        "seed": Value("int", default=0, minimum=0),
-        "study": Table({"kind": Value("str", choices=tuple(STUDIES))}
-                       | {kind: Table(module.PARAMETERS.entries, optional=True)
-                          for kind, module in STUDIES.items()}),
-    }
-)
+@functools.cache
+def study_schema():
+    """The schema of a static study: its kind and the kind's own parameters (built when first needed,
+    so a simulation scenario does not import the studies)."""
+    return Table(
+        {
+            "name": Value("str"),
+            "description": Value("str", default=""),
+            "seed": Value("int", default=0, minimum=0),
+            "study": Table({"kind": Value("str", choices=tuple(STUDIES))}
+                           | {kind: Table(module.PARAMETERS.entries, optional=True)
+                              for kind, module in STUDIES.items()}),
+        }
+    )
 
 
 @dataclass(frozen=True)
@@ -344,7 +349,7 @@ def _only_chosen(table, where, selector, options, source):
 
 def _validate_study(data, source):
     """A static study: the kind's own table (all defaults when absent), no other kind's table."""
-    checked = _checked(STUDY_SCHEMA, data, source)
+    checked = _checked(study_schema(), data, source)
     study = checked["study"]
     kind = study["kind"]
     _only_chosen(study, "study", "kind", STUDIES, source)

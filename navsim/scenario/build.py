@@ -7,7 +7,7 @@ from navsim.sensors.faults import SensorFaults
 from navsim.sensors.gyro import GyroModel, bias_instability_to_sigma
 from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
-from navsim.studies import OBSERVERS
+from navsim.studies import observers as observer_kinds
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
 from startrack import rotation as rot
 from startrack import units
@@ -139,8 +139,11 @@ def _rendered_stars(star_catalog, image):
 
 
 def observers(scenario, sensor):
-    """The per-frame observers (:data:`navsim.studies.OBSERVERS`) the scenario asks for, built once."""
-    return tuple(kind.build(scenario, sensor) for kind in OBSERVERS if kind.wanted(scenario))
+    """The per-frame observers (:func:`navsim.studies.observers`) the scenario asks for, built once;
+    they watch the image chain, so a vector-fidelity run has none."""
+    if scenario["star_sensor"]["fidelity"] != "image":
+        return ()
+    return tuple(kind.build(scenario, sensor) for kind in observer_kinds() if kind.wanted(scenario))
 
 
 def initial_covariance(scenario, gyro):

@@ -23,9 +23,9 @@ Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`startra
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import lfilter
 
 from startrack import units
+from startrack.jit import njit
 
 #: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
 #: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,
@@ -132,12 +132,9 @@ class GyroModel:
             noise_rng.standard_normal(3),
         )
         walk = np.vstack([np.zeros(3), np.cumsum(self.rrw * np.sqrt(dt) * n_walk, axis=0)])
-        gm = np.empty((m + 1, 3))
-        gm[0] = self.bias_instability_sigma * gm0
         phi = np.exp(-dt / self.bias_correlation_time)
         drive = self.bias_instability_sigma * np.sqrt(1.0 - phi * phi) * n_gm
-        # g_(k+1) = φ g_k + drive_k as a first-order recursive filter with initial state g_0.
-        gm[1:] = lfilter([1.0], [1.0, -phi], drive, axis=0, zi=phi * gm[0][None, :])[0]
+        gm = gauss_markov(self.bias_instability_sigma * gm0, phi, drive)
         sigma_white = np.sqrt(self.arw**2 / dt + self.rrw**2 * dt / 12.0)
         omega = (
             omega_mean @ matrix.T
@@ -153,6 +150,17 @@ class GyroModel:
             counts = np.diff(np.vstack([np.zeros(3), counts]), axis=0)
             omega = counts * self.quantization / dt
         return GyroRecord(omega=omega, bias=bias_c + walk[1:] + gm[1:], matrix=matrix)
+
+
+@njit
+def gauss_markov(g0, phi, drive):
+    """The first-order Gauss-Markov sequence g_(k+1) = φ g_k + drive_k from g_0 (3,): (M+1, 3)."""
+    g = np.empty((drive.shape[0] + 1, drive.shape[1]))
+    g[0] = g0
+    for k in range(drive.shape[0]):
+        for i in range(drive.shape[1]):
+            g[k + 1, i] = drive[k, i] + phi * g[k, i]
+    return g
 
 
 def bias_instability_to_sigma(bias_instability):

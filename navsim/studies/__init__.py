@@ -10,21 +10,48 @@ typesets it. Each kind is a module with ``PARAMETERS`` (its schema), ``run(param
 Per-frame observers: experiments of the source documents that run inside a simulation — the
 tracking-failure probes of 000 §5 (:mod:`~navsim.studies.tracking_failure_probes`) and the dim-star
 comparison of 004 §3 (:mod:`~navsim.studies.dim_star_comparison`). A scenario registers one by the
-table or option that asks for it (``wanted(scenario)``); each has a seed-free part
+table or option that asks for it (``wanted(scenario)``; :func:`observers` lists them); each has a seed-free part
 (``build(scenario, sensor)``), a per-run part (``start(filter, rng, n_frames)``, which sees every
 prediction and frame and lists the frames it wants read in full, then ``finish(series, steady)``) and
 a campaign pool (``pool(run summaries)``). Their findings carry ``key``, ``stats``, ``rows`` (the
 comparison table), ``notes`` and extra ``series``.
 """
 
-from navsim.studies import attitude_precision, contest_starmap
+import importlib
+from collections.abc import Mapping
+
 from navsim.studies.common import StudyResult
-from navsim.studies.dim_star_comparison import DimStarComparison
-from navsim.studies.tracking_failure_probes import TrackingFailureProbes
+
+
+class _Modules(Mapping):
+    """kind -> module of this package, imported on first use (a study's dependencies load only when
+    that study runs)."""
+
+    def __init__(self, kinds):
+        self._kinds = tuple(kinds)
+
+    def __getitem__(self, kind):
+        if kind not in self._kinds:
+            raise KeyError(kind)
+        return importlib.import_module(f"{__name__}.{kind}")
+
+    def __iter__(self):
+        return iter(self._kinds)
+
+    def __len__(self):
+        return len(self._kinds)
+
 
 #: study.kind -> module
-STUDIES = {"attitude_precision": attitude_precision, "contest_starmap": contest_starmap}
-#: Per-frame observers, in the order their findings appear in a summary.
-OBSERVERS = (TrackingFailureProbes, DimStarComparison)
+STUDIES = _Modules(("attitude_precision", "contest_starmap"))
 
-__all__ = ["OBSERVERS", "STUDIES", "StudyResult"]
+
+def observers():
+    """The per-frame observer kinds, in the order their findings appear in a summary."""
+    from navsim.studies.dim_star_comparison import DimStarComparison
+    from navsim.studies.tracking_failure_probes import TrackingFailureProbes
+
+    return (TrackingFailureProbes, DimStarComparison)
+
+
+__all__ = ["STUDIES", "StudyResult", "observers"]

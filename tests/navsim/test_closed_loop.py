@@ -1,13 +1,19 @@
-"""The image-fidelity closed loop: acquisition, tracking, re-acquisition after a tracking loss,
-outages, false stars, and the faults at vector fidelity."""
+"""The closed loop: acquisition, tracking, re-acquisition after a tracking loss, outages, false stars,
+the faults at vector fidelity, the loop driven by stub filter and sensor, and the filter's compiled
+fast path against the step-by-step loop."""
 
 import copy
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import navsim
-from navsim.sensors.star_sensor import MODE_CODE
+from navsim.closed_loop import FrameGrid, run_loop
+from navsim.estimation.attitude_filter import UpdateResult
+from navsim.sensors.faults import AttitudeJumps
+from navsim.sensors.star_sensor import MODE_CODE, StarFrame
+from navsim.simulation import prepare, simulate
 from startrack import units
 from startrack.errors import InputError
 
@@ -134,3 +140,99 @@ def test_paper004_dim_star_is_stacked_and_fused():
     assert max(bound) <= 0.0
     # the phase-corrected stacked centroid: within 1 px of the true star position (~0.3 px RMS per axis)
     assert max(dim["stacked_centroid"]["rms_error_px"]) < 1.0
+
+
+class _RecordingFilter:
+    """Only the filter interface the loop may use; every call is recorded."""
+
+    def __init__(self):
+        self.calls = []
+        self.q = np.array([0.0, 0.0, 0.0, 1.0])
+
+    def predict(self, samples, dt):
+        self.calls.append(("predict", len(samples), dt))
+
+    def sensor_prediction(self, last_sample):
+        self.calls.append(("sensor_prediction",))
+        return self.q, np.zeros(3)
+
+    def update_stars(self, ref_I, obs_S, sigma):
+        self.calls.append(("update_stars", len(ref_I)))
+        first = sum(c[0] == "update_stars" for c in self.calls) == 1  # the first identification is rejected
+        accepted = np.full(len(ref_I), not first)
+        return UpdateResult(z=np.zeros((len(ref_I), 2)), nis=np.ones(len(ref_I)), accepted=accepted)
+
+    def update_attitude(self, q_IS, R_S):
+        self.calls.append(("update_attitude",))
+        return UpdateResult(z=np.zeros((1, 3)), nis=np.ones(1), accepted=np.ones(1, bool))
+
+    def reinitialise(self, q_IS):
+        self.calls.append(("reinitialise",))
+
+    def disturb(self, rotation_vector):
+        self.calls.append(("disturb", float(np.linalg.norm(rotation_vector))))
+
+    def snapshot(self):
+        return {"q_est": self.q.copy()}
+
+
+class _ScriptedSensor:
+    """Frame 0: three stars from a sub-catalog identification; 1: an attitude fix; 2: nothing; then stars."""
+
+    log_fields = {"mode": ((), np.int8, 0)}
+    sample = None
+
+    def __init__(self):
+        self.verdicts, self.lost = [], 0
+
+    def record(self):
+        return None
+
+    def observe(self, request):
+        stars = np.tile([0.0, 0.0, 1.0], (3, 1))
+        if request.index == 1:
+            return StarFrame(mode="tracking", q_IS=request.q_IS_pred, R_S=np.eye(3), info={"mode": 0})
+        if request.index == 2:
+            return StarFrame(mode="no_fix", info={"mode": MODE_CODE["no_fix"]})
+        return StarFrame(mode="subcatalog", ref_I=stars, obs_S=stars, sigma=np.ones(3), fix_q_IS=request.q_IS_pred,
+                         info={"mode": MODE_CODE["subcatalog"]})
+
+    def after_update(self, update):
+        self.verdicts.append(None if update is None else update.n_accepted)
+
+    def lose_track(self):
+        self.lost += 1
+
+
+def test_the_loop_needs_nothing_but_the_filter_interface():
+    """A stub filter and a stub sensor: the loop predicts over each frame's samples, asks for the
+    prediction, fuses fixes and stars, re-initialises after a rejected identification, applies the
+    attitude jump and tells the sensor every verdict."""
+    filt, sensor = _RecordingFilter(), _ScriptedSensor()
+    grid = FrameGrid(dt=0.1, ratio=5, n_frames=4)
+    truth = SimpleNamespace(q_IB=np.tile([0.0, 0.0, 0.0, 1.0], (21, 1)), omega_mean=np.zeros((20, 3)))
+    jumps = AttitudeJumps([{"time_s": 1.0, "angle_deg": 2.0}], np.random.default_rng(0))
+    log = run_loop(filt, sensor, np.zeros((20, 3)), truth, grid, jumps)
+    names = [c[0] for c in filt.calls]
+    assert names[:4] == ["predict", "sensor_prediction", "update_stars", "reinitialise"]
+    assert filt.calls[0] == ("predict", 5, 0.1)
+    assert names.count("predict") == 4 and names.count("update_attitude") == 1
+    assert ("disturb", pytest.approx(np.radians(2.0))) in filt.calls and sensor.lost == 1
+    assert sensor.verdicts == [3, 1, None, 3]
+    assert log.transitions[0]["reason"].endswith("attitude re-initialised from the fix")
+    assert list(log.arrays["n_measurements"]) == [3, 1, 0, 3]
+
+
+@pytest.mark.parametrize("overrides", [
+    {},
+    {"star_sensor.measurement": "stars", "star_sensor.mag_limit": 5.0},
+    {"star_sensor.measurement": "stars", "filter.estimate_scale_factor": True, "filter.estimate_misalignment": True,
+     "star_sensor.misalignment_arcsec": [20.0, -10.0, 30.0], "faults.outages": [{"start_s": 5.0, "end_s": 9.0}],
+     "filter.measurement_noise_scale": 1.5},
+])
+def test_compiled_fast_path_equals_the_step_by_step_loop(base_scenario, overrides):
+    base_scenario["duration_s"] = 20.0
+    prepared = prepare(base_scenario, overrides)
+    fast, steps = simulate(prepared, 11), simulate(prepared, 11, compiled=False)
+    for name in ("q_est", "bias_est", "P_diag", "n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"):
+        np.testing.assert_array_equal(fast.series[name], steps.series[name], err_msg=name)

@@ -13,6 +13,7 @@ from scipy.stats import chi2
 
 import navsim
 from navsim import cli
+from navsim.campaign.montecarlo import aggregate, run_campaign
 from navsim.output import read_npz, write_json, write_npz, write_run
 from navsim.report import statistics, write_report
 from navsim.report.inputs import RunData
@@ -42,21 +43,16 @@ def run_dir(tmp_path_factory, catalog):
 
 
 @pytest.fixture(scope="module")
-def campaign_dir(tmp_path_factory, catalog):
-    """Three finished runs and one failed run in the campaign layout."""
-    root = tmp_path_factory.mktemp("campaign")
-    seeds = [11, 12, 13]
-    for k, seed in enumerate(seeds):
-        result = navsim.run(DEMO, seed=seed, overrides=SHORT, star_catalog=catalog)
-        run = write_run(root / "runs" / f"run_{k:05d}", result)
-        (run / "scenario.json").unlink()
-        if k == 0:
-            write_json(root / "scenario.json", result.scenario)
+def campaign_dir(tmp_path_factory):
+    """A real four-run campaign whose last run then failed (its result replaced by the error a
+    failing run records), aggregated again."""
+    root = tmp_path_factory.mktemp("campaign") / "mc"
+    run_campaign(DEMO, runs=4, out=root, overrides=SHORT, workers=1, progress=False)
     failed = root / "runs" / "run_00003"
+    shutil.rmtree(failed)
     failed.mkdir()
-    write_json(failed / "error.json", {"error": "FloatingPointError: covariance lost positive definiteness"})
-    write_json(root / "campaign.json", {"scenario": "demo", "runs": 4, "seeds": seeds + [14], "backend": "local"})
-    write_json(root / "summary.json", {"runs": 4, "finished": 3, "failed": 1})
+    write_json(failed / "error.json", {"seed": 14, "error": "FloatingPointError: covariance lost positive definiteness"})
+    write_json(root / "summary.json", aggregate(root).to_json())
     return root
 
 
@@ -136,12 +132,12 @@ def test_declination_divisions_from_other_grid():
     l_d, l_ra = address.address(ra, dec, n_d)
     series = {"subcatalog_address": np.stack([l_d, l_ra], 1), "subcatalog_index": address.base_index(l_d, l_ra, n_d)}
     assert statistics.declination_divisions(RunData(Path("."), {}, series)) == n_d
-    assert statistics.declination_divisions(RunData(Path("."), {}, series, {"star_sensor": {"n_d": 53}})) == 53
+    assert statistics.declination_divisions(RunData(Path("."), {}, series, {"star_sensor": {"image": {"catalog_nd": 53}}})) == 53
 
 
 def test_campaign_report_has_sections_and_statistics(campaign_dir, tmp_path):
     text, _ = pdf_text(write_report(campaign_dir, tmp_path / "campaign.pdf"))
-    for heading in ("Monte Carlo campaign report: demo", "Statistics across runs", "Attitude error envelopes",
+    for heading in ("Monte Carlo campaign report: paper000_high_dynamic", "Statistics across runs", "Attitude error envelopes",
                     "Filter consistency over runs", "Final errors", "Identification success per mode",
                     "Aggregate summary", "Failed runs", "Scenario parameters"):
         assert heading in text
