@@ -1,4 +1,4 @@
-"""``navsim`` command line (contract in DESIGN.md).
+"""``navsim`` command line (contract in docs/design.md).
 
     navsim run SCENARIO.toml --out DIR [--seed N] [--set key=value ...] [--report [FILE.pdf]]
     navsim report DIR -o FILE.pdf

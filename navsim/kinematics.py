@@ -16,7 +16,7 @@ def omega_matrix(omega):
     """The 4x4 matrix Ω(ω) of eq. 9 of 000: ``q̇ = ½ Ω(ω) q`` for scalar-last q.
 
     Ω(ω) = [[-[ω×], ω], [-ωᵀ, 0]]; with ω in body axes this equals the right
-    product ``q ⊗ [ω, 0]`` of DESIGN.md.
+    product ``q ⊗ [ω, 0]`` of docs/design.md.
     """
     omega = np.asarray(omega, dtype=float)
     shape = omega.shape[:-1]

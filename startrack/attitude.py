@@ -13,7 +13,7 @@ Every solver is a strategy object with the same call::
 Convention: ``q_IS`` (scalar-last, scipy's Hamilton convention) rotates S vectors into I, so
 ``obs_S = R_IS^T ref_I``; the documents' attitude matrix A (I -> S) is ``R_IS^T``.  The attitude
 error ``dtheta`` is in S axes: ``R_true = R_est exp([dtheta x])``, i.e. ``q_true = q_est (x) dq``, the
-filter's multiplicative error convention (DESIGN.md).  Components x, y of ``dtheta`` are the
+filter's multiplicative error convention (docs/design.md).  Components x, y of ``dtheta`` are the
 cross-boresight errors, z the roll about the boresight.
 
 Each solution carries the first-order covariance of *that* estimator:

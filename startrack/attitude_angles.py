@@ -1,6 +1,6 @@
 """Attitude angles of the star sensor: RA, Dec and roll (003 §1.1) and the 3-1-3 angles of 004 eq. 19.
 
-Conventions (DESIGN.md): ``q_IS`` is a scalar-last Hamilton quaternion [x, y, z, w] exactly as
+Conventions (docs/design.md): ``q_IS`` is a scalar-last Hamilton quaternion [x, y, z, w] exactly as
 ``scipy.spatial.transform.Rotation``; it rotates star-sensor (S) vectors into the inertial frame
 (I): ``v_I = R_IS v_S`` with ``R_IS = Rotation.from_quat(q_IS).as_matrix()``.  The documents'
 attitude ("transfer") matrix from I to S is ``M_st = R_IS^T``; its rows are the S axes written in I.

@@ -9,9 +9,9 @@ inertial frame I ("^0w" of 001).  Inputs, for stars already identified:
   the angle between the star and the boresight (eq. 2-1);
 * vector image data (001 ch. 3): ``xy_px`` (n, 2) the image coordinates (X_i, Y_i) [px] relative to the
   principal point, X = u - cx, Y = v - cy; c_i = (X_i, Y_i, f)/|.| is the star direction in the sensor
-  frame S of DESIGN.md (+z boresight, +x along u, +y along v), so the sensor attitude follows too.
+  frame S of docs/design.md (+z boresight, +x along u, +y along v), so the sensor attitude follows too.
 
-001's rotation R maps I into S (R = R_IS^T); ``BoresightSolution.q_IS`` is DESIGN.md's quaternion.
+001's rotation R maps I into S (R = R_IS^T); ``BoresightSolution.q_IS`` is docs/design.md's quaternion.
 Matrices below are written with stars as columns: Pc = [p_1 .. p_n], Cc = [c_1 .. c_n] and
 R Pc = Cc (001 eq. 3-1); the row matrix ^0P of eq. 2-2 is Pc^T.
 

@@ -1,6 +1,6 @@
 """Pinhole camera of the star sensor with radial distortion (k1, k2).
 
-Frame convention (DESIGN.md, binding):
+Frame convention (docs/design.md, binding):
 
 * Sensor frame S: +z along the boresight (out of the lens, towards the sky),
   +x along the image columns u (to the right), +y along the image rows v

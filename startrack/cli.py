@@ -1,4 +1,4 @@
-"""``startrack`` command line (contract in DESIGN.md).
+"""``startrack`` command line (contract in docs/design.md).
 
 Bad input of any kind ends with one line ``startrack: error: ...`` and exit
 status 2; no traceback reaches the user.

@@ -14,7 +14,7 @@ Pipeline (one pass, vectorised):
    image or window border, so the centroid is biased).
 
 Centroiders (strategy objects, all over the component's pixels, u = column,
-v = row, image convention of DESIGN.md):
+v = row, image convention of docs/design.md):
 
 * :class:`GreyCentroid`: grey-level centre of gravity, w = I - b;
 * :class:`ThresholdedCentroid`: thresholded centre of gravity of 004

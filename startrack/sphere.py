@@ -1,6 +1,6 @@
 """Directions on the celestial sphere: RA/Dec <-> unit vectors, angular distance.
 
-Conventions (DESIGN.md): inertial frame I = ICRS; RA = atan2(y, x) in [0, 2 pi),
+Conventions (docs/design.md): inertial frame I = ICRS; RA = atan2(y, x) in [0, 2 pi),
 Dec = asin(z); radians everywhere.
 """
 

@@ -270,7 +270,7 @@ def rendered_frame(run):
     ax = fig.subplots()
     low, high = np.percentile(img, [50, 99.95])
     stretched = np.arcsinh(np.clip(img - low, 0, None) / max(high - low, 1e-12) * 20.0)
-    # Pixel centres at integer (u, v), origin at the top-left pixel (DESIGN.md image coordinates).
+    # Pixel centres at integer (u, v), origin at the top-left pixel (docs/design.md image coordinates).
     ax.imshow(stretched, cmap="gray", origin="upper", extent=(-0.5, w - 0.5, h - 0.5, -0.5),
               interpolation="nearest")
     ax.grid(False)

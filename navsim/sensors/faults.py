@@ -55,7 +55,13 @@ class SensorFaults:
 
     def available(self, t_frames):
         """False for the frames (times t_frames [s]) that :meth:`status` takes away."""
-        return np.array([self.status(t) is None for t in t_frames], dtype=bool)
+        t_frames = np.asarray(t_frames, dtype=float)
+        available = np.ones(t_frames.shape, dtype=bool)
+        for start, end, _ in self.outages:
+            available &= ~((t_frames >= start) & (t_frames < end))
+        for t in self.dropped_s:
+            available &= np.abs(t_frames - t) >= 0.5 * self.frame_interval
+        return available
 
     def storm_count(self, t):
         """False-star tracks per frame at t [s] (0 outside a storm)."""

@@ -1,4 +1,5 @@
-"""What every static study shares: its result type, the paper-difference helper and the progress bar."""
+"""What the studies share: the static studies' result type, the observers' findings, the
+paper-difference helper and the progress bar."""
 
 import sys
 from dataclasses import dataclass, field
@@ -14,6 +15,18 @@ class StudyResult:
     scenario: dict
     summary: dict
     arrays: dict = field(default_factory=dict)
+
+
+class Findings:
+    """A per-frame observer's findings for a run or a campaign: ``stats`` (the summary's entry under
+    ``key``), ``series`` (extra per-frame arrays of a run) and, from the subclass, ``rows`` (the
+    comparison table) and ``notes`` (sentences explaining it)."""
+
+    key = ""
+
+    def __init__(self, stats, series=None):
+        self.stats = stats
+        self.series = series or {}
 
 
 def percent(ours, paper):

@@ -15,6 +15,7 @@ import copy
 import numpy as np
 
 from navsim.sensors.star_image import STACKED_SIGMA_PX
+from navsim.studies import common
 from startrack import rotation as rot
 from startrack.attitude import SvdWahba, ThreeStarOptimal, Triad, cramer_rao_covariance
 from startrack.attitude_angles import radec_roll_from_quaternion
@@ -140,10 +141,8 @@ class DimStarRun:
             shadow_error = rot.attitude_error(self._shadow_q, series["q_true"])
         if shadow_error is None and not any(self._logs.values()):
             return None
-        findings = Findings(_statistics(self._logs, series["attitude_error"], shadow_error, steady))
-        if shadow_error is not None:
-            findings.series = {"attitude_error_without_stacking": shadow_error}
-        return findings
+        extra = {} if shadow_error is None else {"attitude_error_without_stacking": shadow_error}
+        return Findings(_statistics(self._logs, series["attitude_error"], shadow_error, steady), extra)
 
 
 def _rms_arcsec(values, axis=0):
@@ -183,14 +182,10 @@ def _rms_change(stats, with_star, without):
                     np.array(stats[without]["rms_cross_roll_arcsec"]) - 1.0)
 
 
-class Findings:
+class Findings(common.Findings):
     """The comparison's statistics with their comparison rows and notes (run or campaign)."""
 
     key = KEY
-
-    def __init__(self, stats):
-        self.stats = stats
-        self.series = {}
 
     @property
     def rows(self):

@@ -9,6 +9,7 @@ figures (Fig. 5: 14.2 ms against 74.1 ms, both 100 %); a campaign pools them by 
 
 import numpy as np
 
+from navsim.studies import common
 from startrack import rotation as rot
 from startrack.identify.identifier import Prior, StarIdentifier
 
@@ -109,14 +110,10 @@ class ProbeRun:
         return Findings(stats)
 
 
-class Findings:
+class Findings(common.Findings):
     """The probes' statistics with their comparison rows and notes (run or campaign)."""
 
     key = KEY
-
-    def __init__(self, stats):
-        self.stats = stats
-        self.series = {}
 
     @property
     def rows(self):

@@ -3,7 +3,7 @@
 Every profile is an immutable strategy object with one method,
 ``simulate(t, q0) -> (q_IB (N, 4), omega_B (N, 3))`` on a uniform time grid
 ``t`` [s] starting at 0, with body rates [rad/s] in body axes
-(``q̇_IB = ½ q_IB ⊗ [ω_B, 0]``, DESIGN.md).
+(``q̇_IB = ½ q_IB ⊗ [ω_B, 0]``, docs/design.md).
 """
 
 from dataclasses import dataclass

@@ -335,7 +335,7 @@ def main():
     OUT.mkdir(parents=True, exist_ok=True)
     notes = [
         "004 Table 2 is not reproduced by q(t) = q0 exp(w t) with w = (1, 2, 10) deg/s over 120 ms frames for any of the "
-        "7 sign and axis assignments tried; ours follows the body-rate kinematics (DESIGN.md) and both are listed.",
+        "7 sign and axis assignments tried; ours follows the body-rate kinematics (docs/design.md) and both are listed.",
         "Table 3 prints Dec -1 31' 05\" for SAO 138917 (gamma Vir); Hipparcos HIP 61941 is at -1 26' 58\" (4.1'), "
         "yet projecting HIP 61941 reproduces 004's Table 4 centroid of A to ~1 px, so Table 3's Dec is a misprint.",
         "004's image axes are ours turned by 180 deg about the centre: its (x, y) = (W - 1 - u, H - 1 - v).",

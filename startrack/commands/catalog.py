@@ -1,6 +1,6 @@
 """``startrack catalog``: build (or load from cache) the navigation catalog and print its statistics.
 
-``--json`` prints one JSON object (DESIGN.md contract); without it a readable
+``--json`` prints one JSON object (docs/design.md contract); without it a readable
 table, including a memory table like Table 1 of document 000. ``--plot DIR``
 writes ``DIR/catalog_homogenisation.png`` (Fig. 3 of 000: candidates and guide
 stars per 6 x 6 deg RA/Dec window) and ``DIR/catalog_subcatalogs.png``

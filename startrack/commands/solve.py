@@ -1,4 +1,4 @@
-"""``startrack solve``: identify the stars of frames and print their attitude (DESIGN.md contract).
+"""``startrack solve``: identify the stars of frames and print their attitude (docs/design.md contract).
 
 INPUT is a centroid CSV (``u,v[,flux]`` per line, pixels, header line optional; with flux the
 brighter centroids are tried first), an image (.png/.tif/.tiff/.npy: detected and centroided first

@@ -1,4 +1,4 @@
-"""`navsim run`: the command-line contract of DESIGN.md, reproducibility and bad input."""
+"""`navsim run`: the command-line contract of docs/design.md, reproducibility and bad input."""
 
 import json
 import subprocess

@@ -22,7 +22,7 @@ def random_quats(n):
 
 
 def test_omega_matrix_of_eq9_equals_the_right_product():
-    """eq. 9 of 000: q̇ = ½ Ω(ω) q is DESIGN.md's q̇ = ½ q ⊗ [ω, 0] for scalar-last q."""
+    """eq. 9 of 000: q̇ = ½ Ω(ω) q is docs/design.md's q̇ = ½ q ⊗ [ω, 0] for scalar-last q."""
     q = random_quats(20)
     w = RNG.standard_normal((20, 3))
     via_omega = 0.5 * np.einsum("nij,nj->ni", kinematics.omega_matrix(w), q)

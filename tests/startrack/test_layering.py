@@ -1,4 +1,4 @@
-"""DESIGN.md's layering: startrack (the star sensor) never imports navsim (the system)."""
+"""docs/design.md's layering: startrack (the star sensor) never imports navsim (the system)."""
 
 import ast
 from pathlib import Path
