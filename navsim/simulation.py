@@ -17,7 +17,7 @@ from navsim.closed_loop import FrameGrid, mode_statistics, run_loop
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.records import RunSummary
 from navsim.scenario import build, resolve_scenario
-from navsim.sensors.faults import AttitudeJumps, apply_bias_steps
+from navsim.sensors import faults
 from navsim.sensors.star_sensor import MODES
 from navsim.studies import STUDIES, StudyResult
 from navsim.truth.profiles import sample_truth
@@ -55,6 +55,8 @@ class Prepared:
     gyro: object
     sensor: object
     observers: tuple
+    bias_steps: tuple
+    attitude_jumps: tuple
     R_BS: np.ndarray
 
 
@@ -84,7 +86,8 @@ def prepare(scenario, overrides=(), star_catalog=None):
     sensor = build.star_sensor(scenario, star_catalog, ratio * grid.dt)
     q_BS, _ = build.mounting(scenario)
     return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario), sensor=sensor,
-                    observers=build.observers(scenario, sensor), R_BS=rot.to_matrix(q_BS))
+                    observers=build.observers(scenario, sensor), bias_steps=faults.bias_steps(scenario["faults"]),
+                    attitude_jumps=faults.attitude_jumps(scenario["faults"]), R_BS=rot.to_matrix(q_BS))
 
 
 def simulate(prepared, seed, compiled=True):
@@ -94,7 +97,7 @@ def simulate(prepared, seed, compiled=True):
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
     gyro_ss, sensor_ss, init_ss = np.random.SeedSequence(seed).spawn(3)
     record = p.gyro.measure(p.truth.omega_mean, gyro_ss)
-    omega, bias_true = apply_bias_steps(record.omega, record.bias, p.truth.t[1:], scenario["faults"]["gyro_bias_steps"])
+    omega, bias_true = faults.apply_bias_steps(record.omega, record.bias, p.truth.t[1:], p.bias_steps)
     P0 = build.initial_covariance(scenario, p.gyro)
     dtheta0 = np.sqrt(np.diag(P0)[0:3]) * np.random.default_rng(init_ss).standard_normal(3)
     filt = build.attitude_filter(scenario, p.gyro, rot.multiply(p.truth.q_IB[0], rot.from_rotation_vector(dtheta0)), P0)
@@ -106,7 +109,7 @@ def simulate(prepared, seed, compiled=True):
         full_frames = set().union(*(o.full_frames for o in observers))
         sensor_run = p.sensor.start(np.random.default_rng(storm_ss), np.random.default_rng(render_ss), grid.n_frames,
                                     full_frames)
-        jumps = AttitudeJumps(scenario["faults"]["attitude_jumps"], np.random.default_rng(jump_ss))
+        jumps = faults.AttitudeJumps(p.attitude_jumps, np.random.default_rng(jump_ss))
     else:
         observers, jumps = [], None
         sensor_run = p.sensor.start(sensor_ss, p.truth.q_IB[frame_k], p.truth.t[frame_k])

@@ -12,16 +12,20 @@ import numpy as np
 from startrack import units
 
 
+def bias_steps(faults):
+    """The gyro bias steps of ``scenario['faults']`` in SI: ((time [s], step (3,) [rad/s]), ...)."""
+    return tuple((s["time_s"], units.deg_per_h_to_rad_per_s(s["step_deg_per_h"])) for s in faults["gyro_bias_steps"])
+
+
 def apply_bias_steps(omega, bias, t_samples, steps):
-    """Gyro output and true bias with each step (deg/h, at ``time_s``) added from its time on.
+    """Gyro output and true bias with each of :func:`bias_steps` added from its time on.
 
     ``t_samples`` (M,) are the sample times [s] (end of each gyro interval)."""
     if not steps:
         return omega, bias
     omega, bias = omega.copy(), bias.copy()
-    for step in steps:
-        after = t_samples > step["time_s"]
-        delta = units.deg_per_h_to_rad_per_s(step["step_deg_per_h"])
+    for time_s, delta in steps:
+        after = t_samples > time_s
         omega[after] += delta
         bias[after] += delta
     return omega, bias
@@ -68,13 +72,19 @@ class SensorFaults:
         return next((count for start, end, count in self.storms if start <= t < end), 0)
 
 
+def attitude_jumps(faults):
+    """The attitude jumps of ``scenario['faults']`` in time order: ((time [s], angle [rad]), ...)."""
+    ordered = sorted(faults["attitude_jumps"], key=lambda j: j["time_s"])
+    return tuple((j["time_s"], float(units.deg_to_rad(j["angle_deg"]))) for j in ordered)
+
+
 class AttitudeJumps:
-    """The attitude-jump fault: at each ``time_s`` the filter's estimate is knocked off by
-    ``angle_deg`` about a random axis drawn from ``rng`` (a tracking loss the sensor must recover)."""
+    """The attitude-jump fault of one run: at each time of ``jumps`` (:func:`attitude_jumps`) the
+    filter's estimate is knocked off by its angle about a random axis drawn from ``rng`` (a tracking
+    loss the sensor must recover)."""
 
     def __init__(self, jumps, rng):
-        ordered = sorted(jumps, key=lambda j: j["time_s"])
-        self._pending = [(j["time_s"], units.deg_to_rad(j["angle_deg"])) for j in ordered]
+        self._pending = list(jumps)
         self._rng = rng
 
     def due(self, t):

@@ -211,7 +211,7 @@ def test_the_loop_needs_nothing_but_the_filter_interface():
     filt, sensor = _RecordingFilter(), _ScriptedSensor()
     grid = FrameGrid(dt=0.1, ratio=5, n_frames=4)
     truth = SimpleNamespace(q_IB=np.tile([0.0, 0.0, 0.0, 1.0], (21, 1)), omega_mean=np.zeros((20, 3)))
-    jumps = AttitudeJumps([{"time_s": 1.0, "angle_deg": 2.0}], np.random.default_rng(0))
+    jumps = AttitudeJumps([(1.0, np.radians(2.0))], np.random.default_rng(0))
     log = run_loop(filt, sensor, np.zeros((20, 3)), truth, grid, jumps)
     names = [c[0] for c in filt.calls]
     assert names[:4] == ["predict", "sensor_prediction", "update_stars", "reinitialise"]
