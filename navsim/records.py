@@ -87,6 +87,8 @@ class RunSummary(Record):
 
     ``nees``: {dof, runs, band_95, mean, fraction_in_band} of the attitude and gyro-bias errors;
     ``nis``: {mean_per_dof}; ``updates``: {frames_with_measurements, measurements, accepted, rejected};
+    ``gyro_calibration``: per calibration group the filter carries (scale factors [ppm], misalignment
+    [arcsec]) the truth, the final estimate, its σ and the normalised error;
     ``identification``/``modes``: the image-fidelity sensor's modes, counts and transitions;
     ``paper_comparison``: rows {quantity, ours, paper, source}; ``notes``: sentences explaining them.
     """
@@ -111,6 +113,7 @@ class RunSummary(Record):
     nis: dict
     updates: dict
     wall_seconds: float = 0.0
+    gyro_calibration: dict | None = None
     identification: dict | None = None
     modes: list | None = None
     paper_comparison: list | None = None
@@ -125,7 +128,9 @@ class CampaignSummary(Record):
 
     Errors pool every steady frame of every run; ``nees`` is the run-averaged NEES against its band
     for ``runs`` runs; ``divergent_runs`` lists runs with an error beyond 5σ or a NEES mean above
-    5 dof; findings, ``paper_comparison`` and ``notes`` pool the observers' per-run figures."""
+    5 dof; ``gyro_calibration`` pools the final normalised errors of the calibration states (RMS per
+    state, expected 1, and the share within 3σ, expected 99.7 %); findings, ``paper_comparison`` and
+    ``notes`` pool the observers' per-run figures."""
 
     FORMAT = CAMPAIGN_FORMAT
 
@@ -143,6 +148,7 @@ class CampaignSummary(Record):
     nees: dict | None = None
     updates: dict | None = None
     divergent_runs: list | None = None
+    gyro_calibration: dict | None = None
     identification: dict | None = None
     paper_comparison: list | None = None
     notes: list | None = None

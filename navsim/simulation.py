@@ -118,7 +118,7 @@ def simulate(prepared, seed, compiled=True):
     series["attitude_error"] = rot.attitude_error(series["q_est"], series["q_true"])
     series["nees"] = nees(series["P"][:, :NEES_DOF, :NEES_DOF],
                           np.concatenate([series["attitude_error"], series["bias_true"] - series["bias_est"]], axis=1))
-    summary = summarize(scenario, seed, series, p.R_BS)
+    summary = summarize(scenario, seed, series, p.R_BS).replace(gyro_calibration=calibration_summary(filt, record.matrix))
     if log.logs_modes:
         summary = summary.replace(identification=mode_statistics(series, log.transitions), modes=list(MODES))
     summary = _with_findings(summary, series, observers, series["t"] >= scenario["settle_s"])
@@ -181,6 +181,28 @@ def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
         return [simulate(prepared, int(seed)) for seed in seeds]
     with ThreadPoolExecutor(max_workers=threads) as pool:
         return list(pool.map(lambda seed: simulate(prepared, int(seed)), seeds))
+
+
+#: Calibration groups of the gyro error matrix K: (name in the summary, flat indices in K, unit).
+CALIBRATION_GROUPS = {"scale_factor": ("scale_factor_ppm", [0, 4, 8], units.PPM),
+                      "gyro_misalignment": ("misalignment_arcsec", [1, 2, 3, 5, 6, 7], units.ARCSEC)}
+
+
+def calibration_summary(filt, matrix_true):
+    """The gyro calibration states the filter carries at the end of the run: truth (from the gyro's
+    (I + S)(I + M) − I), estimate and σ, in ppm / arcsec, and the errors normalised by σ; None
+    without calibration states."""
+    K_true, K_est, P = (np.asarray(matrix_true) - np.eye(3)).ravel(), filt.K.ravel(), filt.P
+    out = {}
+    for group, span in filt.calibration_slices().items():
+        if group not in CALIBRATION_GROUPS:
+            continue
+        name, flat, unit = CALIBRATION_GROUPS[group]
+        sigma = np.sqrt(np.diag(P)[span])
+        out[name] = {"true": [float(v) for v in K_true[flat] / unit], "estimate": [float(v) for v in K_est[flat] / unit],
+                     "sigma": [float(v) for v in sigma / unit],
+                     "normalised_error": [float(v) for v in (K_est[flat] - K_true[flat]) / sigma]}
+    return out or None
 
 
 def summarize(scenario, seed, series, R_BS):

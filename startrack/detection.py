@@ -76,8 +76,9 @@ class Detections:
     """Detected star images, brightest (largest flux) first.
 
     u, v [px]; flux = sum(I - b) [DN]; peak [DN]; npix; snr (eq. 1 of 004);
-    saturated, edge (bool); and the background b, noise sigma_n and
-    threshold [DN] used.
+    saturated, edge (bool); the background b, noise sigma_n and threshold [DN]
+    used; sigma_u, sigma_v [px]: the centroid's σ from the pixel noise
+    (:func:`_centroid_sigma`).
     """
 
     u: np.ndarray
@@ -91,6 +92,8 @@ class Detections:
     background: float
     sigma_n: float
     threshold: float
+    sigma_u: np.ndarray
+    sigma_v: np.ndarray
 
     def __len__(self):
         return len(self.u)
@@ -103,7 +106,8 @@ class Detections:
     def select(self, mask):
         """The detections where ``mask`` (bool or indices) holds, same order."""
         fields = ("u", "v", "flux", "peak", "npix", "snr", "saturated", "edge")
-        return Detections(*(getattr(self, f)[mask] for f in fields), self.background, self.sigma_n, self.threshold)
+        return Detections(*(getattr(self, f)[mask] for f in fields), self.background, self.sigma_n, self.threshold,
+                          self.sigma_u[mask], self.sigma_v[mask])
 
     def to_dict(self):
         """Plain dict (lists) for JSON output."""
@@ -116,6 +120,7 @@ class Detections:
                     "u": float(self.u[i]), "v": float(self.v[i]), "flux_dn": float(self.flux[i]),
                     "peak_dn": float(self.peak[i]), "npix": int(self.npix[i]), "snr": float(self.snr[i]),
                     "saturated": bool(self.saturated[i]), "edge": bool(self.edge[i]),
+                    "sigma_u": float(self.sigma_u[i]), "sigma_v": float(self.sigma_v[i]),
                 }
                 for i in range(len(self))
             ],
@@ -125,7 +130,7 @@ class Detections:
 def _empty(background, sigma_n, threshold):
     f = np.zeros(0)
     b = np.zeros(0, dtype=bool)
-    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold)
+    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f)
 
 
 def _validate(image, name="image"):
@@ -199,6 +204,8 @@ def _measure(values, rows, cols, labels, n, on_border, background, sigma_n, thre
     wsum = np.bincount(index, weights=weights, minlength=n)
     u = np.bincount(index, weights=weights * u_coord, minlength=n) / wsum
     v = np.bincount(index, weights=weights * v_coord, minlength=n) / wsum
+    sigma_u = _centroid_sigma(index, n, u_coord, u, npix, wsum, sigma_n)
+    sigma_v = _centroid_sigma(index, n, v_coord, v, npix, wsum, sigma_n)
     flux = np.bincount(index, weights=values - background, minlength=n)
     peak = np.full(n, -np.inf)
     np.maximum.at(peak, index, values)
@@ -208,7 +215,16 @@ def _measure(values, rows, cols, labels, n, on_border, background, sigma_n, thre
     keep = np.flatnonzero(npix >= min_pixels)
     keep = keep[np.argsort(-flux[keep], kind="stable")]
     return Detections(u[keep], v[keep], flux[keep], peak[keep], npix[keep], snr[keep], saturated[keep],
-                      edge[keep], float(background), float(sigma_n), float(threshold))
+                      edge[keep], float(background), float(sigma_n), float(threshold), sigma_u[keep], sigma_v[keep])
+
+
+def _centroid_sigma(index, n, coord, centre, npix, wsum, sigma_n):
+    """σ [px] of a weighted centroid c = Σ wᵢ xᵢ / Σ wᵢ over a component of N pixels: the pixel noise
+    σ_n propagated (∂c/∂Iᵢ = (xᵢ − c)/W, so σ_n² Σ (xᵢ − c)² / W²) plus the sampling of the image on the
+    pixel grid, 1/(12 N) px² (the rounding of each coordinate to its pixel; 1/12 px² for one pixel)."""
+    spread = np.bincount(index, weights=coord * coord, minlength=n) - 2.0 * centre * np.bincount(
+        index, weights=coord, minlength=n) + npix * centre * centre
+    return np.sqrt(sigma_n**2 * np.maximum(spread, 0.0) / wsum**2 + 1.0 / (12.0 * npix * npix))
 
 
 def _levels(array, background, sigma_n, a, threshold):

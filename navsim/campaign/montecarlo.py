@@ -225,7 +225,8 @@ def aggregate(directory):
     summaries = [summary for _, summary, _ in finished]
     return CampaignSummary(**base, **_error_statistics(finished, request["scenario_data"]["settle_s"]),
                            updates={key: int(sum(s["updates"][key] for s in summaries)) for key in ("accepted", "rejected")},
-                           identification=_identification(summaries), **_pooled_findings(summaries))
+                           gyro_calibration=_calibration(summaries), identification=_identification(summaries),
+                           **_pooled_findings(summaries))
 
 
 def _error_statistics(finished, settle):
@@ -261,6 +262,20 @@ def _error_statistics(finished, settle):
 def _spread(values):
     return {"mean": float(np.mean(values)), "p50": float(np.percentile(values, 50)),
             "p95": float(np.percentile(values, 95)), "max": float(np.max(values))}
+
+
+def _calibration(summaries):
+    """Final normalised errors of the gyro calibration states over the runs: RMS per state (1 for a
+    consistent filter) and the share within 3σ."""
+    runs = [s.gyro_calibration for s in summaries if s.gyro_calibration]
+    if not runs:
+        return None
+    out = {"runs": len(runs)}
+    for name in runs[0]:
+        errors = np.array([r[name]["normalised_error"] for r in runs])
+        out[name] = {"normalised_error_rms": [float(v) for v in np.sqrt(np.mean(errors**2, axis=0))],
+                     "within_3_sigma": float(np.mean(np.abs(errors) <= 3.0))}
+    return out
 
 
 def _identification(summaries):

@@ -1,21 +1,28 @@
-"""Multiplicative error-state Kalman filter (MEKF) for attitude and gyro bias.
+"""Multiplicative error-state Kalman filter (MEKF) for attitude and gyro bias, with optional gyro
+calibration and star-sensor mounting states.
 
-Nominal state: attitude q_IB (scalar-last), gyro bias b [rad/s], optionally gyro scale-factor
-errors s [-] and the star-sensor mounting q_BS. Error state x (zero between updates):
+Nominal state: attitude q_IB (scalar-last), the total gyro bias b [rad/s] and its Gauss-Markov part
+g (the bias instability, σ_g and τ from the gyro's datasheet), the gyro error matrix K of
+ω̃ = (I + K) ω + b + noise (scale factors on the diagonal, the six misalignment/non-orthogonality
+terms off it, as in the alignment-calibration filter of Pittelkau 2001) and the star-sensor mounting
+q_BS. Error state x (zero between updates):
 
-    x = [δθ (3), δb (3), δs (3) if scale factors, δm (3) if mounting]
+    x = [δθ (3), δb (3), δg (3), δs (3) scale factors, δk (6) off-diagonal terms, δm (3) mounting]
 
-with q_true = q ⊗ δq(δθ) (δθ in body axes), δb = b_true − b, δs = s_true − s, and
-q_BS,true = q_BS ⊗ δq(δm) (δm in sensor axes), as docs/design.md fixes.
+each of the last four groups present when asked for, with q_true = q ⊗ δq(δθ) (δθ in body axes),
+δb = b_true − b (the total bias, so the attitude/bias NEES is over the first six states whatever the
+groups), δg = g_true − g, δK = K_true − K and q_BS,true = q_BS ⊗ δq(δm) (δm in sensor axes), as
+docs/design.md fixes. Without δg the bias instability is folded into an equivalent random walk. A group is estimated, or kept as consider states (Schmidt-Kalman: in P and Φ,
+never corrected, so the filter accounts for an error it does not estimate), or ignored.
 
-Propagation at the gyro rate: q by RK4 (eq. 9 of 000) with ω = (1 − s)(ω̃ − b) held over the
+Propagation at the gyro rate: q by RK4 (eq. 9 of 000) with ω = (I + K)⁻¹(ω̃ − b) held over the
 interval; P ← Φ P Φᵀ + Q with the closed-form Φ and Farrenkopf's discrete Q
 (:func:`navsim.estimation.kernels.transition`, :func:`~navsim.estimation.kernels.process_noise`).
 Updates: an attitude fix (3-dim) or one 2-dim tangent-plane residual per identified star; each is
 gated by its chi-square NIS against the prior, the accepted ones update together in Joseph form,
 and the error estimate is reset into the nominal state.
 
-The filter owns its state: q, b, s, q_BS and P are read-only views; only its methods change them
+The filter owns its state: q, b, K, q_BS and P are read-only views; only its methods change them
 (predict, the updates, :meth:`AttitudeFilter.reinitialise` after a lost track and
 :meth:`AttitudeFilter.disturb` for the attitude-jump fault). :meth:`AttitudeFilter.process_record`
 is the compiled fast path over a whole record, tested equal to the step-by-step path.
@@ -31,6 +38,11 @@ from navsim.estimation import kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
 from startrack import rotation as rot
+
+#: How a group of extra states is treated.
+TREATMENTS = ("estimate", "consider", "ignore")
+#: The groups of extra states in error-state order, with their sizes.
+GROUPS = (("bias_instability", 3), ("scale_factor", 3), ("gyro_misalignment", 6), ("mounting", 3))
 
 
 @dataclass(frozen=True)
@@ -71,40 +83,65 @@ class AttitudeFilter:
     """MEKF with textbook names: error state x, covariance P; Φ, Q, H, R, K inside each step.
 
     Parameters: ``q`` (q_IB estimate), ``b`` (bias estimate, rad/s), ``P`` (initial covariance,
-    n x n), ``arw``/``rrw`` (gyro noise the filter assumes, SI), ``q_BS`` (nominal sensor mounting,
-    rotating S vectors into B; identity by default), ``estimate_scale_factor``/``estimate_misalignment``
-    (extra states; their initial σ are in P), ``scale_factor_rw`` (σ of a scale-factor random walk,
-    1/√s), ``process_noise_scale`` (multiplies Q) and ``measurement_noise_scale`` (multiplies the
-    sensor's σ) for tuning studies, and ``gate_probability`` (chi-square gate).
+    n x n, in the state order of the module docstring), ``arw``/``rrw`` (gyro noise the filter
+    assumes, SI), ``q_BS`` (nominal sensor mounting, rotating S vectors into B; identity by default),
+    ``bias_instability``, ``scale_factor``, ``gyro_misalignment``, ``mounting`` (each "estimate",
+    "consider" or "ignore"), ``bias_instability_sigma`` σ_g [rad/s] and ``bias_correlation_time`` τ [s]
+    of the Gauss-Markov bias, ``calibration_rw`` (σ of a random walk of the calibration terms, 1/√s),
+    ``process_noise_scale``
+    (multiplies Q) and ``measurement_noise_scale`` (multiplies the sensor's σ) for tuning studies,
+    and ``gate_probability`` (chi-square gate).
     """
 
-    def __init__(self, q, b, P, arw, rrw, q_BS=None, estimate_scale_factor=False, estimate_misalignment=False,
-                 scale_factor_rw=0.0, process_noise_scale=1.0, measurement_noise_scale=1.0, gate_probability=0.9999):
-        self.model = FilterModel(arw=float(arw), rrw=float(rrw), sf_rw=float(scale_factor_rw),
-                                 q_scale=float(process_noise_scale), n_cal=3 * int(estimate_scale_factor),
-                                 mounting=bool(estimate_misalignment))
-        self.n = 6 + self.model.n_cal + 3 * int(self.model.mounting)
+    def __init__(self, q, b, P, arw, rrw, q_BS=None, bias_instability="ignore", scale_factor="ignore",
+                 gyro_misalignment="ignore", mounting="ignore", bias_instability_sigma=0.0, bias_correlation_time=np.inf,
+                 calibration_rw=0.0, process_noise_scale=1.0, measurement_noise_scale=1.0, gate_probability=0.9999):
+        treatment = {"bias_instability": bias_instability, "scale_factor": scale_factor,
+                     "gyro_misalignment": gyro_misalignment, "mounting": mounting}
+        for group, value in treatment.items():
+            if value not in TREATMENTS:
+                raise ValueError(f"{group} must be one of {', '.join(TREATMENTS)}, got {value!r}")
+        used = [(group, size) for group, size in GROUPS if treatment[group] != "ignore"]
+        self.model = FilterModel(arw=float(arw), rrw=float(rrw), gm_sigma=float(bias_instability_sigma),
+                                 gm_tau=float(bias_correlation_time), cal_rw=float(calibration_rw),
+                                 q_scale=float(process_noise_scale), n_bi=3 * int(bias_instability != "ignore"),
+                                 n_sf=3 * int(scale_factor != "ignore"), n_gm=6 * int(gyro_misalignment != "ignore"),
+                                 mounting=mounting != "ignore")
+        self.estimated = np.array([True] * 6 + [treatment[g] == "estimate" for g, size in used for _ in range(size)])
+        self.n = self.estimated.size
         P = np.array(P, dtype=float)
         if P.shape != (self.n, self.n):
             raise ValueError(f"P must be {self.n}x{self.n} for the chosen states, got {P.shape}")
         q = np.asarray(q, dtype=float)
         q_BS = np.array([0.0, 0.0, 0.0, 1.0] if q_BS is None else q_BS, dtype=float)
-        self._x = np.concatenate([q / np.linalg.norm(q), np.asarray(b, dtype=float), np.zeros(3), q_BS])
+        self._x = np.concatenate([q / np.linalg.norm(q), np.asarray(b, dtype=float), np.zeros(9), q_BS, np.zeros(3)])
         self._P = P
         self._P0_attitude = P[0:3, 0:3].copy()
         self.variance_scale = float(measurement_noise_scale) ** 2
         self.gate = {dof: float(chi2_quantile(gate_probability, dof)) for dof in (2, 3)}
 
     q = property(lambda self: _read_only(self._x[0:4]), doc="q_IB estimate (4,)")
-    b = property(lambda self: _read_only(self._x[4:7]), doc="gyro bias estimate (3,) [rad/s]")
-    s = property(lambda self: _read_only(self._x[7:10]), doc="gyro scale-factor error estimate (3,)")
-    q_BS = property(lambda self: _read_only(self._x[10:14]), doc="mounting estimate q_BS (4,)")
+    b = property(lambda self: _read_only(self._x[4:7]), doc="total gyro bias estimate (3,) [rad/s]")
+    g = property(lambda self: _read_only(self._x[20:23]), doc="Gauss-Markov part of the bias estimate (3,) [rad/s]")
+    K = property(lambda self: _read_only(self._x[7:16].reshape(3, 3)), doc="gyro error matrix estimate (3, 3)")
+    q_BS = property(lambda self: _read_only(self._x[16:20]), doc="mounting estimate q_BS (4,)")
     P = property(lambda self: _read_only(self._P), doc="error covariance (n, n)")
 
     @property
     def R_BS(self):
         """Mounting estimate as a matrix (S -> B)."""
-        return rot.to_matrix(self._x[10:14])
+        return rot.to_matrix(self._x[16:20])
+
+    def calibration_slices(self):
+        """{group: slice of the error state} of the extra states the filter carries."""
+        out, start = {}, 6
+        sizes = {"bias_instability": self.model.n_bi, "scale_factor": self.model.n_sf, "gyro_misalignment": self.model.n_gm,
+                 "mounting": 3 * self.model.mounting}
+        for group, _ in GROUPS:
+            if sizes[group]:
+                out[group] = slice(start, start + sizes[group])
+                start += sizes[group]
+        return out
 
     def predict(self, omega_measured, dt):
         """Propagate q (RK4) and P (Φ P Φᵀ + Q) over one gyro sample (3,) or several
@@ -116,8 +153,8 @@ class AttitudeFilter:
     def sensor_prediction(self, omega_measured):
         """(q_IS, ω_S): the predicted sensor attitude q_IB ⊗ q_BS and the body rate the filter
         believes from the gyro sample ``omega_measured`` (3,), in sensor axes [rad/s]."""
-        omega, _ = kernels.corrected_rate(self._x, np.asarray(omega_measured, dtype=float))
-        return rot.multiply(self._x[0:4], self._x[10:14]), self.R_BS.T @ omega
+        omega = kernels.corrected_rate(self._x, np.asarray(omega_measured, dtype=float), self.model)
+        return rot.multiply(self._x[0:4], self._x[16:20]), self.R_BS.T @ omega
 
     def update_attitude(self, q_IS, R_S):
         """Update with a star-sensor attitude fix q_IS and its 3x3 covariance R_S in sensor axes
@@ -125,7 +162,7 @@ class AttitudeFilter:
         H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ), gated at 3 dof."""
         R = self.variance_scale * np.asarray(R_S, dtype=float)
         self._x, self._P, z, nis, accepted = kernels.attitude_update(
-            self._x, self._P, np.asarray(q_IS, dtype=float), R, self.gate[3], self.model)
+            self._x, self._P, np.asarray(q_IS, dtype=float), R, self.gate[3], self.model, self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
     def update_stars(self, ref_I, obs_S, sigma):
@@ -141,7 +178,7 @@ class AttitudeFilter:
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
         variance = self._variance(sigma, ref_I.shape[0])
         self._x, self._P, z, nis, accepted = kernels.stars_update(
-            self._x, self._P, ref_I, obs_S, variance, self.gate[2], self.model)
+            self._x, self._P, ref_I, obs_S, variance, self.gate[2], self.model, self.estimated)
         return UpdateResult(z=z, nis=nis, accepted=accepted)
 
     def _variance(self, sigma, count):
@@ -150,7 +187,7 @@ class AttitudeFilter:
     def reinitialise(self, q_IS):
         """Restart the attitude from a sensor fix q_IS after a lost track: q_IB = q_IS ⊗ q_BS⁻¹, the
         attitude block of P back to its initial value and its correlations cleared."""
-        self._x[0:4] = rot.normalize(rot.multiply(q_IS, rot.conjugate(self._x[10:14])))
+        self._x[0:4] = rot.normalize(rot.multiply(q_IS, rot.conjugate(self._x[16:20])))
         self._P[0:3, :] = 0.0
         self._P[:, 0:3] = 0.0
         self._P[0:3, 0:3] = self._P0_attitude
@@ -161,8 +198,10 @@ class AttitudeFilter:
         self._x[0:4] = rot.normalize(rot.multiply(self._x[0:4], rot.from_rotation_vector(rotation_vector)))
 
     def snapshot(self):
-        """What the run log keeps of the filter at a frame: q_est, bias_est and P."""
-        return {"q_est": self._x[0:4].copy(), "bias_est": self._x[4:7].copy(), "P": self._P.copy()}
+        """What the run log keeps of the filter at a frame: q_est, bias_est, the gyro error matrix
+        (flat, K_est) and P."""
+        return {"q_est": self._x[0:4].copy(), "bias_est": self._x[4:7].copy(), "K_est": self._x[7:16].copy(),
+                "P": self._P.copy()}
 
     def process_record(self, omega, ratio, dt, record):
         """The compiled fast path: run the whole record at once (:func:`kernels.run_fixes` or
@@ -175,14 +214,16 @@ class AttitudeFilter:
         omega = np.ascontiguousarray(omega)
         available = np.asarray(record.available, dtype=np.bool_)
         if record.fixes is not None:
-            out = kernels.run_fixes(self._x, self._P, omega, ratio, dt, self.model, np.ascontiguousarray(record.fixes),
+            out = kernels.run_fixes(self._x, self._P, omega, ratio, dt, self.model, self.estimated,
+                                    np.ascontiguousarray(record.fixes),
                                     self.variance_scale * record.R_S, self.gate[3], available)
         else:
             stars = record.stars
-            out = kernels.run_stars(self._x, self._P, omega, ratio, dt, self.model, stars.offsets.astype(np.int64),
+            out = kernels.run_stars(self._x, self._P, omega, ratio, dt, self.model, self.estimated,
+                                    stars.offsets.astype(np.int64),
                                     np.ascontiguousarray(stars.ref_I), np.ascontiguousarray(stars.obs_S),
                                     self._variance(record.sigma, len(stars.ref_I)), self.gate[2], available)
         x_log, P_log = out[0], out[1]
         self._x, self._P = x_log[-1].copy(), P_log[-1].copy()
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[2:]))
-        return {"q_est": x_log[:, 0:4], "bias_est": x_log[:, 4:7], "P": P_log, **log}
+        return {"q_est": x_log[:, 0:4], "bias_est": x_log[:, 4:7], "K_est": x_log[:, 7:16], "P": P_log, **log}

@@ -6,9 +6,15 @@ filter step runs tens of thousands of times per simulated minute; each is tested
 numpy / filterpy counterpart. Conventions are those of docs/design.md (scalar-last Hamilton
 quaternions, error state δθ in body axes).
 
-Nominal state ``x`` (14,): q_IB [0:4], gyro bias b [4:7] (rad/s), gyro scale-factor errors s [7:10],
-star-sensor mounting q_BS [10:14]. Error state (n,): δθ [0:3], δb [3:6], then δs [6:6+n_cal] and, with
-``model.mounting``, δm [n-3:n]. ``model`` is a :class:`FilterModel`.
+Nominal state ``x`` (23,): q_IB [0:4], total gyro bias b [4:7] (rad/s), the gyro error matrix K
+[7:16] (row-major 3x3, ω̃ = (I + K) ω + b + noise: scale factors on the diagonal, misalignment and
+non-orthogonality off it), star-sensor mounting q_BS [16:20], the Gauss-Markov part g of the bias
+[20:23] (rad/s). Error state (n,): δθ [0:3], δb [3:6] (the total bias), then optional groups in this
+order: δg [6:9] (``model.n_bi`` = 3: the bias instability as a first-order Gauss-Markov process of
+σ_g and τ, inside the total bias), the calibration states δk — the 3 scale factors (``model.n_sf`` = 3)
+followed by the 6 off-diagonal terms k_xy, k_xz, k_yx, k_yz, k_zx, k_zy (``model.n_gm`` = 6) — and,
+with ``model.mounting``, δm [n-3:n]. ``estimated`` (n,) marks the states the updates correct;
+the others are consider states (Schmidt): they stay in P and in Φ, their gain is zero.
 """
 
 from collections import namedtuple
@@ -20,9 +26,12 @@ from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, rotation_vector, skew
 
 #: What the filter assumes of the gyro and which states it carries: ARW σ_v [rad/√s], RRW σ_u
-#: [rad/s^(3/2)], scale-factor random walk σ_s [1/√s], the factor on Q, the number of gyro
-#: calibration states (0 or 3) and whether the mounting error δm is a state.
-FilterModel = namedtuple("FilterModel", "arw rrw sf_rw q_scale n_cal mounting")
+#: [rad/s^(3/2)], the bias instability's σ_g [rad/s] and correlation time τ [s], random walk of the
+#: calibration terms σ_k [1/√s], the factor on Q, the number of Gauss-Markov states (0 or 3), of
+#: scale-factor states (0 or 3) and of misalignment states (0 or 6), whether δm is a state.
+FilterModel = namedtuple("FilterModel", "arw rrw gm_sigma gm_tau cal_rw q_scale n_bi n_sf n_gm mounting")
+#: Flat index in K of each calibration state: the scale factors, then the off-diagonal terms.
+K_FLAT = np.array([0, 4, 8, 1, 2, 3, 5, 6, 7])
 
 @njit
 def mm(A, B):
@@ -88,20 +97,45 @@ def inverse_small(S):
 
 
 @njit
-def corrected_rate(x, omega_measured):
-    """(ω, d): the body rate the filter believes, ω = (1 − s)(ω̃ − b), and d = ω̃ − b [rad/s]."""
-    d = omega_measured - x[4:7]
-    return (1.0 - x[7:10]) * d, d
+def calibration_flat(model):
+    """Flat index in K of each calibration state, in state order."""
+    first = 0 if model.n_sf else 3
+    return K_FLAT[first : first + model.n_sf + model.n_gm]
 
 
 @njit
-def transition(omega, d, dt, n, n_cal):
+def solve3(A, d):
+    """A⁻¹ d for a general 3x3 A (Cramer's rule)."""
+    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
+    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
+    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
+    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
+    out = np.empty(3)
+    out[0] = (c00 * d[0] + (A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]) * d[1] + (A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]) * d[2]) / det
+    out[1] = (c01 * d[0] + (A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]) * d[1] + (A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]) * d[2]) / det
+    out[2] = (c02 * d[0] + (A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]) * d[1] + (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * d[2]) / det
+    return out
+
+
+@njit
+def corrected_rate(x, omega_measured, model):
+    """The body rate the filter believes, ω = (I + K)⁻¹ (ω̃ − b) [rad/s] (ω̃ − b without calibration states)."""
+    d = omega_measured - x[4:7]
+    if model.n_sf + model.n_gm == 0:
+        return d
+    A = np.eye(3) + x[7:16].reshape(3, 3)
+    return solve3(A, d)
+
+
+@njit
+def transition(omega, dt, n, model):
     """Closed-form transition matrix Φ (n x n) of the error state over dt (Crassidis & Junkins,
     *Optimal Estimation of Dynamic Systems*, 2nd ed., §7.2.1), w = |ω|:
 
     Φ11 = I − [ω×] sin(wΔt)/w + [ω×]² (1 − cos wΔt)/w²,
     Φ12 = −IΔt + [ω×](1 − cos wΔt)/w² − [ω×]²(wΔt − sin wΔt)/w³,
-    Φ_θs = Φ12 diag(d), d = ω̃ − b (δs enters like δb), all other blocks identity/zero.
+    Φ_θk = Φ12 D(ω), D(ω) δk = δK ω (a gyro-matrix error enters like a bias: ω̃ = (I + K) ω + b,
+    Pittelkau 2001), all other blocks identity/zero.
     """
     w = np.sqrt(omega[0] ** 2 + omega[1] ** 2 + omega[2] ** 2)
     wt = w * dt
@@ -121,60 +155,90 @@ def transition(omega, d, dt, n, n_cal):
             F[i, j] += -a * W[i, j] + b * W2[i, j]
             F[i, 3 + j] = b * W[i, j] - c * W2[i, j]
         F[i, 3 + i] -= dt
-    if n_cal > 0:
+    if model.n_bi:
+        # θ integrates the bias decay −g(1 − e^(−s/τ)): Φ_θg = ∫ Φ11(Δt − s)(1 − e^(−s/τ)) ds, to O(Δt⁴)
+        tau = model.gm_tau
+        decay = np.exp(-dt / tau)
         for i in range(3):
             for j in range(3):
-                F[i, 6 + j] = F[i, 3 + j] * d[j]
+                F[i, 6 + j] = -W[i, j] * dt**3 / (6.0 * tau)
+            F[i, 6 + i] += 0.5 * dt * dt / tau - dt**3 / (6.0 * tau * tau)
+            F[3 + i, 6 + i] = decay - 1.0  # b(t + Δt) = b − (1 − e^(−Δt/τ)) g
+            F[6 + i, 6 + i] = decay
+    flat = calibration_flat(model)
+    start = 6 + model.n_bi
+    for c in range(flat.shape[0]):
+        row, col = flat[c] // 3, flat[c] % 3  # δK[row, col] ω adds ω[col] to the rate error's row
+        for i in range(3):
+            F[i, start + c] = F[i, 3 + row] * omega[col]
     return F
 
 
 @njit
 def process_noise(model, dt, n):
     """Discrete Q (n x n), before ``model.q_scale``: Farrenkopf's attitude/bias blocks for ARW σ_v and
-    RRW σ_u — Q11 = (σ_v²Δt + σ_u²Δt³/3) I, Q12 = −σ_u²Δt²/2 I, Q22 = σ_u²Δt I — and a scale-factor
-    random walk σ_s²Δt I."""
+    RRW σ_u — Q11 = (σ_v²Δt + σ_u²Δt³/3) I, Q12 = −σ_u²Δt²/2 I, Q22 = σ_u²Δt I —, the Gauss-Markov
+    drive of the bias instability, q_g = 2σ_g²/τ, which enters the total bias like a rate random
+    walk and the g state with its exact variance σ_g²(1 − e^(−2Δt/τ)), and a random walk σ_k²Δt of
+    each calibration state."""
     arw, rrw = model.arw, model.rrw
     Q = np.zeros((n, n))
     for i in range(3):
         Q[i, i] = arw * arw * dt + rrw * rrw * dt**3 / 3.0
         Q[i, 3 + i] = Q[3 + i, i] = -0.5 * rrw * rrw * dt * dt
         Q[3 + i, 3 + i] = rrw * rrw * dt
-        if model.n_cal > 0:
-            Q[6 + i, 6 + i] = model.sf_rw * model.sf_rw * dt
+    if model.n_bi:
+        q_g = 2.0 * model.gm_sigma**2 / model.gm_tau
+        drive = model.gm_sigma**2 * (1.0 - np.exp(-2.0 * dt / model.gm_tau))
+        for i in range(3):
+            Q[i, i] += q_g * dt**3 / 3.0
+            Q[i, 3 + i] -= 0.5 * q_g * dt * dt
+            Q[3 + i, i] = Q[i, 3 + i]
+            Q[i, 6 + i] = Q[6 + i, i] = -0.5 * q_g * dt * dt
+            Q[3 + i, 3 + i] += drive
+            Q[3 + i, 6 + i] = Q[6 + i, 3 + i] = drive
+            Q[6 + i, 6 + i] = drive
+    start = 6 + model.n_bi
+    for c in range(model.n_sf + model.n_gm):
+        Q[start + c, start + c] = model.cal_rw * model.cal_rw * dt
     return Q
 
 
 @njit
 def predict(x, P, omega_measured, dt, model):
     """Propagation over consecutive gyro samples ``omega_measured`` (m, 3), each held for dt:
-    q by RK4 (eq. 9 of 000) with the corrected rate, P ← Φ P Φᵀ + q_scale Q. Returns (x, P).
+    q by RK4 (eq. 9 of 000) with the corrected rate (:func:`corrected_rate`), P ← Φ P Φᵀ + q_scale Q.
+    Returns (x, P).
 
-    Φ = I + E with E non-zero only in the three attitude rows, so Φ P Φᵀ = P + E P + (E P)ᵀ
-    + E P Eᵀ is formed from the 3 x n product E P alone.
+    Φ = I + E with E non-zero only in the r leading rows (the attitude's, and the bias and
+    Gauss-Markov rows when g is a state), so Φ P Φᵀ = P + E P + (E P)ᵀ + E P Eᵀ is formed from the
+    r x n product E P alone. The nominal bias decays with ĝ: b ← b − (1 − e^(−Δt/τ)) ĝ, ĝ ← e^(−Δt/τ) ĝ.
     """
     n = P.shape[0]
+    r = 3 + 2 * model.n_bi
     Q = model.q_scale * process_noise(model, dt, n)
+    decay = np.exp(-dt / model.gm_tau) if model.n_bi else 1.0
     P = P.copy()
     x = x.copy()
-    EP = np.empty((3, n))
+    EP = np.empty((r, n))
     for k in range(omega_measured.shape[0]):
-        omega, d = corrected_rate(x, omega_measured[k])
-        F = transition(omega, d, dt, n, model.n_cal)
-        for i in range(3):
+        omega = corrected_rate(x, omega_measured[k], model)
+        F = transition(omega, dt, n, model)
+        for i in range(r):
             F[i, i] -= 1.0  # E = Φ − I
-        for i in range(3):
+        for i in range(r):
             for j in range(n):
                 acc = 0.0
                 for p in range(n):
                     acc += F[i, p] * P[p, j]
                 EP[i, j] = acc
-        for i in range(3):
-            for j in range(3):
+        for i in range(r):
+            for j in range(r):
                 acc = 0.0
                 for p in range(n):
                     acc += EP[i, p] * F[j, p]
                 P[i, j] += EP[i, j] + EP[j, i] + acc
-            for j in range(3, n):
+            for j in range(r, n):
                 P[i, j] += EP[i, j]
                 P[j, i] = P[i, j]
         for i in range(n):
@@ -183,19 +247,26 @@ def predict(x, P, omega_measured, dt, model):
                 P[i, j] = value
                 P[j, i] = value
         x[0:4] = rk4_hold(x[0:4], omega, dt)
+        if model.n_bi:
+            x[4:7] -= (1.0 - decay) * x[20:23]
+            x[20:23] *= decay
     return x, P
 
 
 @njit
-def joseph_update(P, H, R, z):
+def joseph_update(P, H, R, z, estimated):
     """Kalman update of a zero error state: returns (dx, P⁺) with the Joseph form
-    P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ, K = P Hᵀ S⁻¹, S = H P Hᵀ + R, symmetrised.
+    P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ, K = P Hᵀ S⁻¹, S = H P Hᵀ + R, symmetrised; the rows of K of
+    consider states (not ``estimated``) are zero (Schmidt), for which the Joseph form stays exact.
 
     Formed as M = P − K (H P), P⁺ = M − (M Hᵀ) Kᵀ + K R Kᵀ: O(n² m) for m measurements.
     """
     HP = mm(H, P)
     S = mm_t(HP, H) + R
     K = mm(HP.T.copy(), inverse_small(S))
+    for i in range(K.shape[0]):
+        if not estimated[i]:
+            K[i, :] = 0.0
     dx = np.zeros(K.shape[0])
     for i in range(K.shape[0]):
         for j in range(z.shape[0]):
@@ -206,9 +277,10 @@ def joseph_update(P, H, R, z):
 
 
 @njit
-def joseph_update_attitude(P, R, z):
+def joseph_update_attitude(P, R, z, estimated):
     """:func:`joseph_update` for H = [I₃ 0] (an attitude fix, no mounting state), in O(n²):
-    S = P₁₁ + R, K = P[:, :3] S⁻¹, M = P − K P[:3, :], P⁺ = M − M[:, :3] Kᵀ + K R Kᵀ."""
+    S = P₁₁ + R, K = P[:, :3] S⁻¹ (zero rows for consider states), M = P − K P[:3, :],
+    P⁺ = M − M[:, :3] Kᵀ + K R Kᵀ."""
     n = P.shape[0]
     S = np.empty((3, 3))
     for i in range(3):
@@ -217,9 +289,10 @@ def joseph_update_attitude(P, R, z):
     S_inv = inverse_small(S)
     K = np.zeros((n, 3))
     for i in range(n):
-        for j in range(3):
-            for m in range(3):
-                K[i, j] += P[i, m] * S_inv[m, j]
+        if estimated[i]:
+            for j in range(3):
+                for m in range(3):
+                    K[i, j] += P[i, m] * S_inv[m, j]
     dx = np.zeros(n)
     for i in range(n):
         dx[i] = K[i, 0] * z[0] + K[i, 1] * z[1] + K[i, 2] * z[2]
@@ -257,7 +330,7 @@ def star_residuals(x, ref_I, obs_S, n, mounting):
     """
     m = ref_I.shape[0]
     R_IB = quat_to_matrix(x[0:4])
-    R_SB = quat_to_matrix(x[10:14]).T
+    R_SB = quat_to_matrix(x[16:20]).T
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     for k in range(m):
@@ -305,7 +378,7 @@ def block_nis(H, P, z, variance):
 
 
 @njit
-def attitude_update(x, P, q_IS, R_S, gate, model):
+def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
     """Gated update with an attitude fix q_IS (covariance R_S in sensor axes), then the reset.
 
     z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes, H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ.
@@ -313,7 +386,7 @@ def attitude_update(x, P, q_IS, R_S, gate, model):
     """
     n = P.shape[0]
     conj = np.array([-1.0, -1.0, -1.0, 1.0])
-    q_BS = x[10:14]
+    q_BS = x[16:20]
     q_IB_measured = quat_multiply(q_IS, q_BS * conj)
     z = rotation_vector(quat_multiply(x[0:4] * conj, q_IB_measured))
     R_BS = quat_to_matrix(q_BS)
@@ -333,14 +406,14 @@ def attitude_update(x, P, q_IS, R_S, gate, model):
     if nis > gate:
         return x, P, z, nis, False
     if model.mounting:
-        dx, P_next = joseph_update(P, H, R, z)
+        dx, P_next = joseph_update(P, H, R, z, estimated)
     else:
-        dx, P_next = joseph_update_attitude(P, R, z)
+        dx, P_next = joseph_update_attitude(P, R, z, estimated)
     return reset(x, dx, model), P_next, z, nis, True
 
 
 @njit
-def stars_update(x, P, ref_I, obs_S, variance, gate, model):
+def stars_update(x, P, ref_I, obs_S, variance, gate, model, estimated):
     """Gated update with identified stars (see :func:`star_residuals`): each star's 2-dof NIS
     against the prior is compared with ``gate``; the accepted stars update together, then the
     reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
@@ -362,24 +435,27 @@ def stars_update(x, P, ref_I, obs_S, variance, gate, model):
                 za[row] = z[k, r]
                 Ra[row, row] = variance[k]
                 row += 1
-    dx, P_next = joseph_update(P, Ha, Ra, za)
+    dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
     return reset(x, dx, model), P_next, z, nis, accepted
 
 
 @njit
 def reset(x, dx, model):
     """Move the error estimate dx into the nominal state (first-order reset):
-    q ← q ⊗ δq(δθ), b ← b + δb, s ← s + δs, q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
+    q ← q ⊗ δq(δθ), b ← b + δb, g ← g + δg, K ← K + δK, q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
     n = dx.shape[0]
     out = x.copy()
     q_next = quat_multiply(x[0:4], quat_from_rotation_vector(dx[0:3]))
     out[0:4] = q_next / np.sqrt(np.sum(q_next * q_next))
     out[4:7] = x[4:7] + dx[3:6]
-    if model.n_cal > 0:
-        out[7:10] = x[7:10] + dx[6:9]
+    if model.n_bi:
+        out[20:23] = x[20:23] + dx[6:9]
+    flat = calibration_flat(model)
+    for c in range(flat.shape[0]):
+        out[7 + flat[c]] = x[7 + flat[c]] + dx[6 + model.n_bi + c]
     if model.mounting:
-        q_BS_next = quat_multiply(x[10:14], quat_from_rotation_vector(dx[n - 3 : n]))
-        out[10:14] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
+        q_BS_next = quat_multiply(x[16:20], quat_from_rotation_vector(dx[n - 3 : n]))
+        out[16:20] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
     return out
 
 
@@ -401,24 +477,24 @@ def star_statistics(z, nis, accepted):
 
 @njit
 def _allocate_logs(n_frames, n):
-    return (np.empty((n_frames, 14)), np.empty((n_frames, n, n)), np.zeros(n_frames, dtype=np.int32),
+    return (np.empty((n_frames, 23)), np.empty((n_frames, n, n)), np.zeros(n_frames, dtype=np.int32),
             np.zeros(n_frames, dtype=np.int32), np.full(n_frames, np.nan), np.zeros(n_frames, dtype=np.int32),
             np.full(n_frames, np.nan))
 
 
 @njit
-def run_fixes(x, P, omega, ratio, dt, model, q_meas, R_S, gate, available):
+def run_fixes(x, P, omega, ratio, dt, model, estimated, q_meas, R_S, gate, available):
     """The whole-record loop of the fast path with attitude fixes: for each frame f, ``ratio`` gyro
     samples of ``omega`` (F*ratio, 3) propagate the filter (:func:`predict`), then the fix
     ``q_meas[f]`` (covariance R_S) updates it (:func:`attitude_update`); frames not ``available``
-    only propagate. Returns per frame: x (F, 14), P (F, n, n), measurements, accepted, NIS of the
+    only propagate. Returns per frame: x (F, 23), P (F, n, n), measurements, accepted, NIS of the
     accepted, its dof and the RMS of the accepted innovations [rad]."""
     n_frames = available.shape[0]
     x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
     for f in range(n_frames):
         x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
         if available[f]:
-            x, P, z, nis, ok = attitude_update(x, P, q_meas[f], R_S, gate, model)
+            x, P, z, nis, ok = attitude_update(x, P, q_meas[f], R_S, gate, model, estimated)
             n_meas[f] = 1
             if ok:
                 n_acc[f] = 1
@@ -431,7 +507,7 @@ def run_fixes(x, P, omega, ratio, dt, model, q_meas, R_S, gate, available):
 
 
 @njit
-def run_stars(x, P, omega, ratio, dt, model, offsets, ref_I, obs_S, variance, gate, available):
+def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, ref_I, obs_S, variance, gate, available):
     """:func:`run_fixes` with star vectors: frame f updates with the stars offsets[f]:offsets[f+1]
     of ``ref_I``/``obs_S``/``variance`` (:func:`stars_update`)."""
     n_frames = available.shape[0]
@@ -440,7 +516,8 @@ def run_stars(x, P, omega, ratio, dt, model, offsets, ref_I, obs_S, variance, ga
         x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
         lo, hi = offsets[f], offsets[f + 1]
         if available[f] and hi > lo:
-            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], variance[lo:hi], gate, model)
+            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], variance[lo:hi], gate, model,
+                                                  estimated)
             n_meas[f] = hi - lo
             n_acc[f], nis_log[f], dof_log[f], innov_log[f] = star_statistics(z, nis, accepted)
         x_log[f] = x

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from navsim.estimation.attitude_filter import TREATMENTS
 from navsim.scenario.schema import ListOfTables, Table, Value
 from navsim.studies import STUDIES
 from startrack.errors import InputError
@@ -123,7 +124,7 @@ SCHEMA = Table(
                         "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0,
                                                   doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
                         "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0,
-                                                   doc="centroid error assumed by identification and filter"),
+                                                   doc="centroid error the identification assumes (its gates); the filter takes each star's σ from its detection"),
                         "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
                                             doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
                         "catalog_max_pointing_error_deg": Value("float", default=2.0, exclusive_minimum=0.0,
@@ -179,12 +180,25 @@ SCHEMA = Table(
                 "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0,
                                             doc="ARW the filter assumes (default: the gyro's)"),
                 "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0,
-                                                  doc="RRW the filter assumes (default: the gyro's "
-                                                      "RRW plus its Gauss-Markov drive)"),
-                "estimate_scale_factor": Value("bool", default=False),
-                "initial_scale_factor_sigma_ppm": Value("float", default=None, exclusive_minimum=0.0),
-                "estimate_misalignment": Value("bool", default=False),
-                "initial_misalignment_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0),
+                                                  doc="RRW the filter assumes (default: the gyro's; plus the "
+                                                      "Gauss-Markov drive when bias_instability is ignored)"),
+                "bias_instability": Value("str", default=None, choices=TREATMENTS,
+                                          doc="the gyro's Gauss-Markov bias (σ_g, τ of the gyro) as three states: "
+                                              "estimate, consider or ignore (an equivalent random walk); default: "
+                                              "estimate when the gyro has one"),
+                "scale_factor": Value("str", default=None, choices=TREATMENTS,
+                                      doc="the gyro's three scale-factor errors: estimate, consider (kept in P, "
+                                          "not estimated: Schmidt) or ignore; default: estimate when the gyro has one"),
+                "gyro_misalignment": Value("str", default=None, choices=TREATMENTS,
+                                           doc="the gyro's six misalignment (non-orthogonality) terms; default: "
+                                               "estimate when the gyro has them"),
+                "mounting": Value("str", default="ignore", choices=TREATMENTS,
+                                  doc="the star-sensor mounting error δm (star_sensor.misalignment_arcsec is its truth)"),
+                "initial_scale_factor_sigma_ppm": Value("float", default=None, exclusive_minimum=0.0,
+                                                        doc="default: the gyro's scale-factor σ"),
+                "initial_gyro_misalignment_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0,
+                                                                doc="default: the gyro's misalignment σ"),
+                "initial_mounting_sigma_arcsec": Value("float", default=60.0, exclusive_minimum=0.0),
                 "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
                 "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
                 "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
@@ -277,10 +291,22 @@ def apply_overrides(data, overrides, source):
     return data
 
 
+#: Keys of earlier versions -> what replaced them.
+RENAMED = {
+    ("filter", "estimate_scale_factor"): 'filter.scale_factor = "estimate" (or "consider", "ignore")',
+    ("filter", "estimate_misalignment"): 'filter.mounting = "estimate" (the star-sensor mounting; the gyro\'s own axis '
+                                         'misalignment is filter.gyro_misalignment)',
+    ("filter", "initial_misalignment_sigma_arcsec"): "filter.initial_mounting_sigma_arcsec",
+}
+
+
 def validate(data, source="<scenario>"):
     """Check a raw dictionary against the schema and the cross-key rules."""
     if isinstance(data, dict) and "study" in data:
         return _validate_study(data, source)
+    for (table, key), replacement in RENAMED.items():
+        if isinstance(data, dict) and isinstance(data.get(table), dict) and key in data[table]:
+            raise InputError(f"{source}: {table}.{key}: renamed; use {replacement}")
     checked = _checked(SCHEMA, data, source)
     truth = checked["truth"]
     profile = truth["profile"]

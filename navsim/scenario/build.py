@@ -1,6 +1,7 @@
 """From a validated scenario (units in key names) to model objects in SI units."""
 
 import numpy as np
+import scipy.linalg
 
 from navsim.estimation.attitude_filter import AttitudeFilter
 from navsim.sensors.faults import SensorFaults
@@ -123,8 +124,7 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults):
     return ImageStarSensor(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
                            stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
-                           stacking=image["dim_star_stacking"], centroid_sigma=image["centroid_sigma_px"] / camera.focal_px,
-                           start_tracking=image["start_tracking"], q_BS_true=q_BS_true, faults=sensor_faults)
+                           stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true, faults=sensor_faults)
 
 
 def _rendered_stars(star_catalog, image):
@@ -155,22 +155,42 @@ def initial_covariance(scenario, gyro):
     else:
         sigma_bias = float(np.hypot(gyro.bias_turn_on_sigma, gyro.bias_instability_sigma))
         sigma_bias = max(sigma_bias, float(units.deg_per_h_to_rad_per_s(0.001)))
-    diag = [sigma_att**2] * 3 + [sigma_bias**2] * 3
-    if f["estimate_scale_factor"]:
-        ppm = f["initial_scale_factor_sigma_ppm"] or max(gyro.scale_factor_sigma * 1e6, 1.0)
-        diag += [(ppm * 1e-6) ** 2] * 3
-    if f["estimate_misalignment"]:
-        arcsec = f["initial_misalignment_sigma_arcsec"] or 60.0
-        diag += [float(units.arcsec_to_rad(arcsec)) ** 2] * 3
-    return np.diag(diag)
+    treatment = filter_states(scenario, gyro)
+    blocks = [np.eye(3) * sigma_att**2, np.eye(3) * sigma_bias**2]
+    if treatment["bias_instability"] != "ignore":  # b = b_turn-on + g: the total and its Gauss-Markov part
+        g2 = min(gyro.bias_instability_sigma**2, sigma_bias**2)
+        blocks[1] = np.block([[np.eye(3) * sigma_bias**2, np.eye(3) * g2], [np.eye(3) * g2, np.eye(3) * g2]])
+    diag = []
+    if treatment["scale_factor"] != "ignore":
+        ppm = f["initial_scale_factor_sigma_ppm"] or max(gyro.scale_factor_sigma / units.PPM, 1.0)
+        diag += [(ppm * units.PPM) ** 2] * 3
+    if treatment["gyro_misalignment"] != "ignore":
+        arcsec = f["initial_gyro_misalignment_sigma_arcsec"] or max(gyro.misalignment_sigma / units.ARCSEC, 1.0)
+        diag += [(arcsec * units.ARCSEC) ** 2] * 6
+    if treatment["mounting"] != "ignore":
+        diag += [(f["initial_mounting_sigma_arcsec"] * units.ARCSEC) ** 2] * 3
+    return scipy.linalg.block_diag(*blocks, np.diag(diag)) if diag else scipy.linalg.block_diag(*blocks)
+
+
+def filter_states(scenario, gyro):
+    """How the filter treats each group of extra states: the scenario's choice, else (the gyro's
+    datasheet in, the filter model out) "estimate" for a gyro error the gyro has and "ignore" otherwise."""
+    f = scenario["filter"]
+    return {"bias_instability": f["bias_instability"] or ("estimate" if gyro.bias_instability_sigma > 0.0 else "ignore"),
+            "scale_factor": f["scale_factor"] or ("estimate" if gyro.scale_factor_sigma > 0.0 else "ignore"),
+            "gyro_misalignment": f["gyro_misalignment"] or ("estimate" if gyro.misalignment_sigma > 0.0 else "ignore"),
+            "mounting": f["mounting"]}
 
 
 def attitude_filter(scenario, gyro, q0, P0):
     """The MEKF of ``scenario['filter']`` starting from attitude q0, zero bias and P0."""
     f = scenario["filter"]
     q_BS, _ = mounting(scenario)
+    states = filter_states(scenario, gyro)
     arw = gyro.arw if f["arw_deg_per_sqrt_h"] is None else float(units.arw_to_si(f["arw_deg_per_sqrt_h"]))
-    rrw = gyro.filter_rrw if f["rrw_deg_per_h_per_sqrt_h"] is None else float(units.rrw_to_si(f["rrw_deg_per_h_per_sqrt_h"]))
+    rrw = gyro.rrw if states["bias_instability"] != "ignore" else gyro.filter_rrw
+    if f["rrw_deg_per_h_per_sqrt_h"] is not None:
+        rrw = float(units.rrw_to_si(f["rrw_deg_per_h_per_sqrt_h"]))
     return AttitudeFilter(
         q=q0,
         b=np.zeros(3),
@@ -178,8 +198,9 @@ def attitude_filter(scenario, gyro, q0, P0):
         arw=arw,
         rrw=rrw,
         q_BS=q_BS,
-        estimate_scale_factor=f["estimate_scale_factor"],
-        estimate_misalignment=f["estimate_misalignment"],
+        **states,
+        bias_instability_sigma=gyro.bias_instability_sigma,
+        bias_correlation_time=gyro.bias_correlation_time,
         process_noise_scale=f["process_noise_scale"],
         measurement_noise_scale=f["measurement_noise_scale"],
         gate_probability=f["gate_probability"],

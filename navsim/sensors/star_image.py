@@ -14,8 +14,10 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    stacked over the last 4 frames (shifted-window superposition, eq. 13-18 of 004), its centroid
    corrected by the sub-pixel phases the predictions give (an extension of 004: integer shifts alone
    leave ~0.25 px per axis);
-5. one unit vector per identified star (the stacked dim star last, with its own larger σ), the
-   identification's attitude for a re-initialisation when it came from the sub-catalog or full sky.
+5. one unit vector per identified star with the σ its detection gives (pixel noise propagated through
+   the centroid, and the pixel grid: it grows with the smear), the stacked dim star last with its own
+   measured σ; the identification's attitude for a re-initialisation when it came from the sub-catalog
+   or full sky.
 
 Faults acting on the sensor (outages, dropped frames, false-star storms) are applied here; the
 tracking state follows the filter's verdict (:meth:`ImageRun.after_update`).
@@ -52,8 +54,9 @@ class ImageStarSensor:
     """The seed-free image-fidelity sensor, built once per scenario (:func:`navsim.scenario.build.star_sensor`):
     camera and detector model, the identifier over the navigation catalog, the stars drawn into the
     frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n,
-    tracking window half-width [px], dim-star stacking on/off, the centroid σ [rad] the filter is
-    told, whether the first frame is already tracked (004's set-up), the true mounting and the faults."""
+    tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
+    tracked (004's set-up), the true mounting and the faults. Each star's direction σ comes from its
+    detection (the centroid σ of :class:`startrack.detection.Detections`)."""
 
     camera: object
     model: object
@@ -64,7 +67,6 @@ class ImageStarSensor:
     detection_sigmas: float
     window_half_px: int
     stacking: bool
-    centroid_sigma: float
     start_tracking: bool
     q_BS_true: np.ndarray
     faults: object
@@ -120,11 +122,11 @@ class ImageRun:
                 or request.index in self._full_frames)
         image, windows, found = self._read(request, q_IS_true, uv_pred[predicted], full)
         result = s.identifier.solve(found.uv, found.flux, prior=Prior(q_IS=request.q_IS_pred))
-        ref_I, obs_S, mode, reason = self._identified(result, found, uv_pred, predicted)
+        ref_I, obs_S, detected, mode, reason = self._identified(result, found, uv_pred, predicted)
         info |= {"n_detected": len(found), "n_identified": len(ref_I), "id_ms": result.solve_ms}
         diagnostics = {"q_IS_true": q_IS_true, "detections": found}
         stacked = self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I)) if self._stacks(predicted) else None
-        sigma = np.full(len(ref_I), s.centroid_sigma)
+        sigma = np.sqrt(0.5 * (found.sigma_u[detected] ** 2 + found.sigma_v[detected] ** 2)) / s.camera.focal_px
         if stacked is not None:
             stacked["uv_true"] = s.camera.project(q_IS_true, s.stars_I[stacked["index"]][None])[0][0]
             diagnostics["stacked"] = stacked
@@ -181,17 +183,18 @@ class ImageRun:
         return tuple(cosmic_ray(a, b, a + c, b + d, 4.0e4) for a, b, c, d in zip(u0, v0, du, dv))
 
     def _identified(self, result, found, uv_pred, predicted):
-        """(ref_I, obs_S, mode, reason) of the identification; while tracking, stars it did not
-        identify are matched to their predicted positions instead (mode None: nothing found)."""
+        """(ref_I, obs_S, detection index of each, mode, reason) of the identification; while tracking,
+        stars it did not identify are matched to their predicted positions instead (mode None: nothing)."""
         s = self.sensor
         if result.ok:
-            return result.ref_I, result.obs_S, result.method, f"{len(result.ref_I)} stars identified"
+            return (result.ref_I, result.obs_S, result.matches[:, 0], result.method,
+                    f"{len(result.ref_I)} stars identified")
         if self._tracking:
             det, pred = _match_predicted(found.uv, uv_pred[predicted], 3.0 * s.window_half_px / 2)
             if det.size:
-                return (s.stars_I[predicted[pred]], s.camera.unproject(found.uv[det]), "tracking",
+                return (s.stars_I[predicted[pred]], s.camera.unproject(found.uv[det]), det, "tracking",
                         f"{det.size} stars matched to their predictions")
-        return np.zeros((0, 3)), np.zeros((0, 3)), None, result.reason
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=np.int64), None, result.reason
 
     def _stacks(self, predicted):
         return self.sensor.stacking and self._tracking and len(predicted) > 0

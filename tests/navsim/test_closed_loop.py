@@ -226,7 +226,8 @@ def test_the_loop_needs_nothing_but_the_filter_interface():
 @pytest.mark.parametrize("overrides", [
     {},
     {"star_sensor.measurement": "stars", "star_sensor.mag_limit": 5.0},
-    {"star_sensor.measurement": "stars", "filter.estimate_scale_factor": True, "filter.estimate_misalignment": True,
+    {"star_sensor.measurement": "stars", "gyro.preset": "tactical", "filter.gyro_misalignment": "consider",
+     "filter.mounting": "estimate",
      "star_sensor.misalignment_arcsec": [20.0, -10.0, 30.0], "faults.outages": [{"start_s": 5.0, "end_s": 9.0}],
      "filter.measurement_noise_scale": 1.5},
 ])

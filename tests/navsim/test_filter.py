@@ -24,21 +24,59 @@ def random_spd(n):
     return A @ A.T * 1e-6 + np.eye(n) * 1e-8
 
 
-def test_transition_is_the_exponential_of_the_error_dynamics():
-    """Φ = expm(F Δt) for δθ̇ = −[ω×]δθ − δb − diag(ω̃ − b) δs."""
+def _rate_jacobian(omega):
+    """D(ω) (3 x 9): δK ω for δk = (scale factors x, y, z; k_xy, k_xz, k_yx, k_yz, k_zx, k_zy)."""
+    D = np.zeros((3, 9))
+    D[[0, 1, 2], [0, 1, 2]] = omega
+    for c, (i, j) in enumerate([(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)]):
+        D[i, 3 + c] = omega[j]
+    return D
+
+
+@pytest.mark.parametrize("n_sf, n_gm", [(3, 0), (3, 6), (0, 6)])
+def test_transition_is_the_exponential_of_the_error_dynamics(n_sf, n_gm):
+    """Φ = expm(F Δt) for δθ̇ = −[ω×]δθ − δb − D(ω) δk (δK ω = D(ω) δk; Pittelkau 2001)."""
     omega = np.array([0.3, -0.5, 0.2])
-    d = np.array([0.31, -0.49, 0.21])
     dt = 0.1
-    F = np.zeros((9, 9))
+    columns = list(range(3)) * (n_sf > 0) + list(range(3, 9)) * (n_gm > 0)
+    n = 6 + len(columns)
+    F = np.zeros((n, n))
     F[0:3, 0:3] = -rot.skew(omega)
     F[0:3, 3:6] = -np.eye(3)
-    F[0:3, 6:9] = -np.diag(d)
-    np.testing.assert_allclose(kernels.transition(omega, d, dt, 9, 3), expm(F * dt), atol=1e-14)
-    np.testing.assert_allclose(kernels.transition(omega * 1e-6, d, dt, 6, 0), expm(F[:6, :6] * 1e-6 * 0 + _f6(omega * 1e-6) * dt), atol=1e-14)
+    F[0:3, 6:] = -_rate_jacobian(omega)[:, columns]
+    model = _model(1e-4, 1e-6, n_sf=n_sf, n_gm=n_gm)
+    np.testing.assert_allclose(kernels.transition(omega, dt, n, model), expm(F * dt), atol=1e-14)
+    np.testing.assert_allclose(kernels.transition(omega * 1e-6, dt, 6, _model(1e-4, 1e-6)), expm(_f6(omega * 1e-6) * dt),
+                               atol=1e-14)
 
 
-def _model(arw, rrw, sf_rw=0.0, n_cal=0):
-    return kernels.FilterModel(arw=arw, rrw=rrw, sf_rw=sf_rw, q_scale=1.0, n_cal=n_cal, mounting=False)
+def _model(arw, rrw, cal_rw=0.0, n_sf=0, n_gm=0, gm_sigma=0.0, gm_tau=np.inf):
+    return kernels.FilterModel(arw=arw, rrw=rrw, gm_sigma=gm_sigma, gm_tau=gm_tau, cal_rw=cal_rw, q_scale=1.0,
+                               n_bi=3 * int(gm_sigma > 0), n_sf=n_sf, n_gm=n_gm, mounting=False)
+
+
+def test_gauss_markov_bias_states_against_expm_and_van_loan():
+    """Total bias b and its Gauss-Markov part g: ḃ = w_u − g/τ + w_g, ġ = −g/τ + w_g, E[w_g²] = 2σ_g²/τ.
+    Φ against expm and Q against the Van Loan integral at the gyro step, to first order in Δt/τ."""
+    omega, dt, tau = np.array([0.3, -0.5, 0.2]), 0.01, 100.0
+    arw, rrw, sigma_g = 1e-4, 1e-6, 5e-6
+    F = np.zeros((9, 9))
+    F[0:3, 0:3], F[0:3, 3:6] = -rot.skew(omega), -np.eye(3)
+    F[3:6, 6:9] = F[6:9, 6:9] = -np.eye(3) / tau
+    model = _model(arw, rrw, gm_sigma=sigma_g, gm_tau=tau)
+    np.testing.assert_allclose(kernels.transition(omega, dt, 9, model), expm(F * dt), atol=1e-11)  # O(ω²Δt⁴/τ)
+    q_g = 2 * sigma_g**2 / tau
+    W = np.zeros((9, 9))
+    W[0:3, 0:3] = np.eye(3) * arw**2
+    W[3:6, 3:6] = np.eye(3) * (rrw**2 + q_g)
+    W[3:6, 6:9] = W[6:9, 3:6] = W[6:9, 6:9] = np.eye(3) * q_g
+    F0 = F.copy()
+    F0[0:3, 0:3] = 0.0  # Farrenkopf's Q is the zero-rate integral
+    B = expm(np.block([[-F0, W], [np.zeros((9, 9)), F0.T]]) * dt)
+    Q_van_loan = B[9:, 9:].T @ B[:9, 9:]
+    Q = kernels.process_noise(model, dt, 9)
+    scale = np.sqrt(np.outer(np.diag(Q_van_loan), np.diag(Q_van_loan)))
+    np.testing.assert_allclose(Q / scale, Q_van_loan / scale, atol=1e-6)
 
 
 def _f6(omega):
@@ -62,25 +100,25 @@ def test_process_noise_is_the_van_loan_integral():
 
 def test_predict_and_update_equal_filterpy():
     """One step through our kernels equals filterpy's KalmanFilter.predict/update (Joseph form)."""
-    n = 9
+    n = 15
     P = random_spd(n)
     omega_measured = np.array([[0.1, 0.2, -0.05]])
     b = np.array([1e-4, -2e-4, 5e-5])
-    s = np.array([1e-4, 0.0, -1e-4])
-    dt, arw, rrw, sf_rw = 0.1, 1e-4, 1e-6, 1e-5
+    K = np.array([[1e-4, 2e-4, -1e-4], [3e-4, 0.0, 1e-4], [-2e-4, 5e-5, -1e-4]])
+    dt, arw, rrw, cal_rw = 0.1, 1e-4, 1e-6, 1e-5
     q0 = rot.from_rotation_vector([0.1, 0.2, 0.3])
-    model = _model(arw, rrw, sf_rw, n_cal=3)
-    x0 = np.concatenate([q0, b, s, [0.0, 0.0, 0.0, 1.0]])
+    model = _model(arw, rrw, cal_rw, n_sf=3, n_gm=6)
+    x0 = np.concatenate([q0, b, K.ravel(), [0.0, 0.0, 0.0, 1.0]])
     _, P_pred = kernels.predict(x0, P, omega_measured, dt, model)
-    d = omega_measured[0] - b
+    omega = np.linalg.solve(np.eye(3) + K, omega_measured[0] - b)  # the corrected rate
     kf = KalmanFilter(dim_x=n, dim_z=4)
     kf.P = P.copy()
-    kf.predict(F=kernels.transition((1 - s) * d, d, dt, n, 3), Q=kernels.process_noise(model, dt, n))
+    kf.predict(F=kernels.transition(omega, dt, n, model), Q=kernels.process_noise(model, dt, n))
     np.testing.assert_allclose(P_pred, kf.P, rtol=1e-12, atol=1e-24)
     H = RNG.standard_normal((4, n))
     R = np.diag([1e-9, 2e-9, 1e-9, 3e-9])
     z = RNG.standard_normal(4) * 1e-4
-    dx, P_post = kernels.joseph_update(P_pred, H, R, z)
+    dx, P_post = kernels.joseph_update(P_pred, H, R, z, np.ones(n, bool))
     kf.update(z.reshape(-1, 1), R=R, H=H)
     np.testing.assert_allclose(dx, kf.x[:, 0], rtol=1e-10, atol=1e-20)
     np.testing.assert_allclose(P_post, kf.P, rtol=1e-10, atol=1e-24)
@@ -106,7 +144,7 @@ def test_steady_state_matches_riccati_and_farrenkopf(omega_deg_per_s):
     sigma_n, dt = units.arcsec_to_rad(10.0), 0.1
     omega = np.radians([omega_deg_per_s, -0.5 * omega_deg_per_s, 0.3 * omega_deg_per_s])
     P_pre, P_post = _steady_state_filter(omega, dt, 1, arw, rrw, sigma_n)
-    F = kernels.transition(omega, omega, dt, 6, 0)
+    F = kernels.transition(omega, dt, 6, _model(arw, rrw))
     Q = kernels.process_noise(_model(arw, rrw), dt, 6)
     H = np.hstack([np.eye(3), np.zeros((3, 3))])
     P_dare = solve_discrete_are(F.T, H.T, Q, np.eye(3) * sigma_n**2)
@@ -165,7 +203,7 @@ def test_consistent_on_the_30_deg_per_s_profile_of_000(base_scenario):
                                              "amplitude_deg": 30.0, "angular_frequency_rad_per_s": 1.0}}
     scenario["gyro"] = {"preset": "tactical", "rate_hz": 100.0, "misalignment_arcsec": 0.0}
     scenario["star_sensor"] = {"measurement": "stars", "rate_hz": 10.0, "fov_deg": 16.0, "star_sigma_arcsec": 5.0}
-    scenario["filter"] = {"initial_attitude_sigma_deg": 0.2, "estimate_scale_factor": True}
+    scenario["filter"] = {"initial_attitude_sigma_deg": 0.2, "scale_factor": "estimate"}
     results, nees, t = _monte_carlo(scenario, 20)
     _assert_nees_consistent(nees, t, settle_s=3.0)
     for r in results:
@@ -246,7 +284,7 @@ def test_misalignment_state_is_estimated_under_rotation(base_scenario):
     segments = [{"duration_s": 60.0, "rate_deg_per_s": rate} for rate in ([3.0, 0, 0], [0, 3.0, 0], [0, 0, 3.0])]
     scenario["truth"] = {"profile": "rate_segments", "rate_hz": 40.0, "rate_segments": {"segments": segments}}
     scenario["star_sensor"].update(misalignment_arcsec=[60.0, -40.0, 90.0], attitude_sigma_roll_arcsec=10.0)
-    scenario["filter"].update(estimate_misalignment=True, initial_misalignment_sigma_arcsec=120.0)
+    scenario["filter"].update(mounting="estimate", initial_mounting_sigma_arcsec=120.0)
     result = navsim.run(scenario, seed=1)
     sigma_m = units.rad_to_arcsec(np.sqrt(result.series["P_diag"][-1, 6:9]))
     assert np.all(sigma_m < 20.0)  # from 120 arcsec
@@ -259,8 +297,8 @@ def test_attitude_fix_joseph_shortcut_equals_the_general_form():
     R = np.diag([1e-9, 2e-9, 4e-9])
     z = RNG.standard_normal(3) * 1e-4
     H = np.hstack([np.eye(3), np.zeros((3, 6))])
-    dx, P_general = kernels.joseph_update(P, H, R, z)
-    dx_short, P_short = kernels.joseph_update_attitude(P, R, z)
+    dx, P_general = kernels.joseph_update(P, H, R, z, np.ones(9, bool))
+    dx_short, P_short = kernels.joseph_update_attitude(P, R, z, np.ones(9, bool))
     np.testing.assert_allclose(dx_short, dx, rtol=1e-10, atol=1e-20)
     np.testing.assert_allclose(P_short, P_general, rtol=1e-9, atol=1e-24)
 

@@ -31,7 +31,7 @@ def check(data, overrides=()):
         (lambda d: d["truth"].update(profile="sinusoidal_axis"), "truth.sinusoidal_axis: missing table"),
         (lambda d: d.update(settle_s=100.0), "settle_s: must be shorter than duration_s"),
         (lambda d: d["filter"].update(gate_probability=1.5), "filter.gate_probability: must be <="),
-        (lambda d: d["filter"].update(estimate_scale_factor="yes"), "must be true or false"),
+        (lambda d: d["filter"].update(scale_factor="yes"), "must be one of estimate, consider, ignore"),
         (lambda d: d["truth"].update(initial_q_IB=[0, 0, 0, 0]), "quaternion must have a non-zero norm"),
     ],
 )

@@ -162,3 +162,19 @@ def test_adjacent_components_are_separated_and_merged_by_8_connectivity():
     image[7, 7] = 10.0
     found = detect(image, background=0.0, sigma_n=1.0)
     assert sorted(found.npix.tolist()) == [1, 2]
+
+
+@pytest.mark.parametrize("electrons", [800.0, 3000.0])
+def test_reported_centroid_sigma_bounds_the_scatter_of_static_stars(electrons):
+    """The σ a detection reports (pixel noise through the thresholded centroid, plus the pixel grid
+    1/(12 N²)) against the actual centroid errors of 196 static stars at random sub-pixel phases: it
+    bounds them without being loose by more than ~3x (normalised RMS 0.3-1). For smeared stars, where
+    the noise term dominates, it matches the scatter (normalised RMS 1.03 / 1.12 in the demo's frames)."""
+    rng = np.random.default_rng(13)
+    stars = _grid_stars(14, 17, rng, electrons)
+    found = detect(render(GAUSS, 256, 256, [stars], rng))
+    _, nearest = cKDTree(stars.centroids).query(found.uv)
+    error = found.uv - stars.centroids[nearest]
+    normalised = error / np.column_stack([found.sigma_u, found.sigma_v])
+    assert 0.3 < np.sqrt(np.mean(normalised**2)) <= 1.0
+    assert np.all(np.abs(normalised) < 4.0)
