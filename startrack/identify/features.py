@@ -18,6 +18,10 @@ so, with every centroid coordinate wrong by at most delta [px],
 here, gives the tight bound of the same linearisation (001's is 2-3 times wider for the pairs of a
 16 deg field).  For a Gaussian centroid error of standard deviation sigma per axis, delta = 3 sigma
 makes e_ij at least a 3-sigma gate on beta_ij (the 1-norm bounds the 2-norm).
+
+:func:`centroid_directions` turns a frame's centroids into these directions in one compiled call:
+checks, brightest first, the camera model of :class:`startrack.camera.Camera` (pinhole, Brown radial
+distortion inverted by Newton's method on the radius, as ``Camera.unproject``).
 """
 
 from __future__ import annotations
@@ -58,6 +62,72 @@ def pair_features(obs, focal_px, delta_px):  # pragma: no cover  (compiled)
             gate[i, j] = e
             gate[j, i] = e
     return beta, gate
+
+
+#: Status codes of :func:`centroid_directions`.
+DIRECTIONS_OK, BAD_COORDINATE, BAD_FLUX, ALL_OUTSIDE = 0, 1, 2, 3
+
+_NEWTON_ITERATIONS = 12
+
+
+@njit
+def brightest_first(flux, count, max_stars):  # pragma: no cover  (compiled)
+    """Indices of the first ``count`` entries ordered by decreasing ``flux`` (stable; given order when
+    ``flux`` is empty), at most ``max_stars`` (< 0: all)."""
+    order = np.arange(count) if flux.size == 0 else np.argsort(-flux[:count], kind="mergesort")
+    return order if max_stars < 0 else order[:max_stars]
+
+
+@njit
+def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
+    """Unit vector in S of the image point (u, v) [px]: pinhole, radial distortion removed by Newton's
+    method on the radius (r_d = r (1 + k1 r^2 + k2 r^4)), as :meth:`startrack.camera.Camera.unproject`."""
+    focal, cx, cy, _, _, k1, k2, _ = camera_params
+    x, y = (u - cx) / focal, (v - cy) / focal
+    if k1 != 0.0 or k2 != 0.0:
+        rd = np.sqrt(x * x + y * y)
+        r = rd
+        for _ in range(_NEWTON_ITERATIONS):
+            r2 = r * r
+            step = (r * (1.0 + k1 * r2 + k2 * r2 * r2) - rd) / (1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2)
+            r -= step
+            if abs(step) <= 1e-16 * max(r, 1.0):
+                break
+        if rd > 0.0:
+            x, y = x * r / rd, y * r / rd
+    norm = np.sqrt(x * x + y * y + 1.0)
+    return x / norm, y / norm, 1.0 / norm
+
+
+@njit
+def centroid_directions(uv, flux, camera_params, max_stars):  # pragma: no cover  (compiled)
+    """(status, obs_S (m, 3), index (m,)): the unit vectors in S of the centroids ``uv`` (n, 2) [px] that
+    lie on the sensor (pixel edges included), brightest first by ``flux`` (n,) (empty: given order),
+    at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``.  status: DIRECTIONS_OK,
+    BAD_COORDINATE (NaN or infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
+    n = uv.shape[0]
+    width, height = camera_params[3], camera_params[4]
+    inside = np.empty(n, np.int64)
+    count = 0
+    for i in range(n):
+        u, v = uv[i, 0], uv[i, 1]
+        if not (np.isfinite(u) and np.isfinite(v)):
+            return BAD_COORDINATE, np.empty((0, 3)), inside[:0]
+        if -0.5 <= u <= width - 0.5 and -0.5 <= v <= height - 0.5:
+            inside[count] = i
+            count += 1
+    for i in range(flux.size):
+        if not np.isfinite(flux[i]):
+            return BAD_FLUX, np.empty((0, 3)), inside[:0]
+    if count == 0 and n > 0:
+        return ALL_OUTSIDE, np.empty((0, 3)), inside[:0]
+    index = inside[:count]
+    kept = flux.copy() if flux.size == 0 else flux[index]
+    index = index[brightest_first(kept, count, max_stars)]
+    obs = np.empty((index.size, 3))
+    for m in range(index.size):
+        obs[m, 0], obs[m, 1], obs[m, 2] = _unproject(uv[index[m], 0], uv[index[m], 1], camera_params)
+    return DIRECTIONS_OK, obs, index
 
 
 @dataclass(frozen=True, eq=False)
