@@ -44,24 +44,27 @@ def pair_features(obs, focal_px, delta_px):  # pragma: no cover  (compiled)
     n = obs.shape[0]
     beta = np.zeros((n, n))
     gate = np.full((n, n), np.inf)
-    # t[i, j, 0..1] = v_j^T dv_i/dX_i, v_j^T dv_i/dY_i
-    for i in range(n):
-        scale = obs[i, 2] / focal_px
-        for j in range(i + 1, n):
+    fill_features(obs, n, focal_px, delta_px, beta, gate, np.zeros(1, np.int64))
+    return beta, gate
+
+
+@njit(_nrt=False)
+def fill_features(obs, n, focal_px, delta_px, beta, gate, filled):  # pragma: no cover  (compiled)
+    """:func:`pair_features` in place, for the pairs of the first n stars not yet filled: ``filled[0]``
+    is the number of leading stars whose pairs are (updated to n)."""
+    for j in range(filled[0], n):
+        for i in range(j):
             c = obs[i, 0] * obs[j, 0] + obs[i, 1] * obs[j, 1] + obs[i, 2] * obs[j, 2]
             c = min(1.0, max(-1.0, c))
             s_ij = abs(obs[j, 0] - c * obs[i, 0]) + abs(obs[j, 1] - c * obs[i, 1])
             s_ji = abs(obs[i, 0] - c * obs[j, 0]) + abs(obs[i, 1] - c * obs[j, 1])
             sine = np.sqrt(max(1.0 - c * c, 0.0))
-            b = np.arccos(c)
             e = np.inf
             if sine > 0.0:
-                e = delta_px * (s_ij * scale + s_ji * obs[j, 2] / focal_px) / sine
-            beta[i, j] = b
-            beta[j, i] = b
-            gate[i, j] = e
-            gate[j, i] = e
-    return beta, gate
+                e = delta_px * (s_ij * obs[i, 2] + s_ji * obs[j, 2]) / (focal_px * sine)
+            beta[i, j] = beta[j, i] = np.arccos(c)
+            gate[i, j] = gate[j, i] = e
+    filled[0] = max(filled[0], n)
 
 
 #: Status codes of :func:`centroid_directions`.
@@ -136,20 +139,37 @@ class FrameFeatures:
 
     ``obs_S`` (n, 3) centroid directions in the sensor frame, brightest first; ``index`` (n,) their
     positions in the caller's list; ``beta`` and ``gate`` (m, m) the angular distances and bounds
-    e_ij [rad] of the first m (brightest) stars; ``verify_gate`` the verification match radius [rad].
+    e_ij [rad] of the first m (brightest) stars, filled for the pairs of the first ``filled[0]`` of them
+    (the search fills more as it widens, :func:`fill_features`); ``focal_px``, ``delta_px`` their
+    camera and error bound; ``verify_gate`` the verification match radius [rad].
     """
 
     obs_S: np.ndarray
     index: np.ndarray
     beta: np.ndarray
     gate: np.ndarray
+    filled: np.ndarray
+    focal_px: float
+    delta_px: float
     verify_gate: float
 
     @classmethod
-    def build(cls, obs_S, index, focal_px: float, delta_px: float, verify_gate: float, n_pattern: int):
-        """Features of ``obs_S`` (already brightest first) for at most ``n_pattern`` pattern stars."""
-        beta, gate = pair_features(np.ascontiguousarray(obs_S[:n_pattern]), float(focal_px), float(delta_px))
-        return cls(obs_S, index, beta, gate, verify_gate)
+    def build(cls, obs_S, index, focal_px: float, delta_px: float, verify_gate: float, n_pattern: int,
+              n_filled: int | None = None):
+        """Features of ``obs_S`` (already brightest first) for at most ``n_pattern`` pattern stars, the
+        pairs of the first ``n_filled`` (default: all of them) computed now."""
+        obs_S = np.ascontiguousarray(obs_S, dtype=float)
+        m = min(len(obs_S), n_pattern)
+        beta, gate = np.zeros((m, m)), np.full((m, m), np.inf)
+        filled = np.zeros(1, np.int64)
+        fill_features(obs_S, m if n_filled is None else min(n_filled, m), float(focal_px), float(delta_px), beta, gate,
+                      filled)
+        return cls(obs_S, index, beta, gate, filled, float(focal_px), float(delta_px), verify_gate)
+
+    @property
+    def arrays(self):
+        """The tuple the search kernels take: (obs_S, beta, gate, filled, focal_px, delta_px)."""
+        return self.obs_S, self.beta, self.gate, self.filled, self.focal_px, self.delta_px
 
     def __len__(self):
         return int(self.obs_S.shape[0])

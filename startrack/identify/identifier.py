@@ -21,13 +21,14 @@ reason); a wrong configuration raises :class:`startrack.errors.InputError` at co
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.attitude_angles import quaternion_from_matrix, radec_roll_from_matrix
+from startrack.attitude_angles import quaternion_from_matrix
 from startrack.errors import InputError
 from startrack.identify.context import SearchContext
 from startrack.identify.features import (ALL_OUTSIDE, BAD_COORDINATE, BAD_FLUX, DIRECTIONS_OK, FrameFeatures,
@@ -77,11 +78,18 @@ class Prior:
                                            or abs(self.boresight[1]) > math.pi / 2):
             raise InputError(f"prior boresight must be (ra, dec) in rad with |dec| <= pi/2; got {self.boresight!r}.")
 
+    @functools.cached_property
+    def predicted_R_IS(self):
+        """R_IS (3, 3) predicted at the frame (the prior propagated by ``rate_S`` over ``dt``), or None."""
+        if self.q_IS is None:
+            return None
+        return propagate(self.q_IS, _NO_RATE if self.rate_S is None else self.rate_S, float(self.dt))
+
     def boresight_radec(self):
         """(ra, dec) [rad] of the predicted boresight, or None."""
         if self.q_IS is not None:
-            ra, dec, _ = radec_roll_from_matrix(propagate(self.q_IS, self.rate_S, self.dt))
-            return float(ra), float(dec)
+            x, y, z = self.predicted_R_IS[:, 2].tolist()
+            return math.atan2(y, x) % (2.0 * math.pi), math.asin(max(-1.0, min(1.0, z)))
         if self.boresight is not None:
             return float(self.boresight[0]), float(self.boresight[1])
         return None
@@ -144,7 +152,7 @@ class StarIdentifier:
         context = SearchContext(catalog, self.field, self.pattern_stars, self.verify_gate, self.false_match_threshold,
                                 dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
         available = {
-            "tracking": lambda: Tracking(self.field, window_px, self.false_match_threshold),
+            "tracking": lambda: Tracking(context, window_px),
             "subcatalog": lambda: SubCatalog(context, neighbours),
             "lost_in_space": lambda: LostInSpace(context, context.dense),
         }
@@ -209,7 +217,7 @@ class StarIdentifier:
         """The frame's features for the search: ``obs_S`` (n, 3) directions brightest first, ``index`` their
         positions in the caller's list."""
         return FrameFeatures.build(obs_S, index, self.camera.focal_px, self.delta_px, self.verify_gate,
-                                   2 * self.pattern_stars)
+                                   2 * self.pattern_stars, n_filled=0)
 
     def _solve(self, obs_S, index, prior, start):
         if len(obs_S) < 3:
@@ -251,6 +259,7 @@ def matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma:
 
 _NO_STARS = np.zeros(0, np.int64)
 _NO_FLUX = np.zeros(0)
+_NO_RATE = np.zeros(3)
 
 
 def _float_array(value):

@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from startrack.identify.features import fill_features
 from startrack.identify.pyramid import TRIANGLE_BUFFER, gate_cosines, no_result, search, verify_triangles
 from startrack.jit import njit
 
@@ -26,10 +27,12 @@ SKY = (np.zeros(3), -2.0)
 
 
 @njit
-def search_tables(obs, beta, gate, widths, tables, stars, region, field):  # pragma: no cover  (compiled)
+def search_tables(frame, widths, tables, stars, region, field):  # pragma: no cover  (compiled)
     """For each width n of ``widths`` (ascending), each table in turn (:func:`startrack.identify.pyramid.search`,
-    then its unextended triangles); the first verified hypothesis (verify_near's tuple).  ``stars``: per
-    table, (vectors (N, 3) of the stars it indexes, work array (N,) int32 of -1)."""
+    then its unextended triangles); the first verified hypothesis (verify_near's tuple).  ``frame``:
+    :attr:`~startrack.identify.features.FrameFeatures.arrays` (features filled here as needed);
+    ``stars``: per table, (vectors (N, 3) of the stars it indexes, work array (N,) int32 of -1)."""
+    obs, beta, gate, filled, focal_px, delta_px = frame
     cos_low, cos_high = gate_cosines(beta)
     triangles = np.empty((TRIANGLE_BUFFER, 6), np.int64)
     done = 0
@@ -38,6 +41,7 @@ def search_tables(obs, beta, gate, widths, tables, stars, region, field):  # pra
         if n <= done:
             continue
         done = n
+        fill_features(obs, n, focal_px, delta_px, beta, gate, filled)
         for t in range(len(tables)):
             vectors, head = stars[t]
             result, n_h, kept = search(obs, n, beta, gate, cos_low, cos_high, tables[t], vectors, region, field, head,
@@ -67,7 +71,7 @@ class LostInSpace:
     def identify(self, frame, prior):
         """Verified hypothesis or None; ``prior`` is not used."""
         ctx = self.context
-        return ctx.verified(search_tables(frame.obs_S, frame.beta, frame.gate, ctx.widths, self.tables, self.stars,
+        return ctx.verified(search_tables(frame.arrays, ctx.widths, self.tables, self.stars,
                                           SKY, ctx.field_arrays))
 
 

@@ -62,13 +62,13 @@ class SubCatalog:
             return None
         ctx = self.context
         for b in self.cells(*boresight):
-            result = search_tables(frame.obs_S, frame.beta, frame.gate, ctx.widths, (ctx.sub_catalogs.arrays(b),),
+            result = search_tables(frame.arrays, ctx.widths, (ctx.sub_catalogs.arrays(b),),
                                    (ctx.stars["guide"],), SKY, ctx.field_arrays)
             if result[0]:
                 return ctx.verified(result)
         if self._dense is not None:
             tables, stars = self._dense
             region = cap(radec_to_vector(*boresight), 2.0 * self.catalog.rho_sub)
-            return ctx.verified(search_tables(frame.obs_S, frame.beta, frame.gate, ctx.widths, tables, stars, region,
+            return ctx.verified(search_tables(frame.arrays, ctx.widths, tables, stars, region,
                                               ctx.field_arrays))
         return None

@@ -387,26 +387,3 @@ class Verified:
     star_index: np.ndarray
     false_match_probability: float
     n_predicted: int
-
-
-def verify(obs_S, R_IS, field: FieldStars, gate: float, n_hypotheses: int, threshold: float,
-           n_seed: int = 2, first_gate: float | None = None):
-    """Verify the attitude hypothesis R_IS for the centroid directions obs_S (n, 3); a :class:`Verified` or None.
-
-    Matches in passes with the gates ``first_gate`` (if given, e.g. a tracking window), 3 r and r
-    [rad], refitting by SVD after each (:func:`match_and_refit`), and accepts when P_false <=
-    ``threshold`` (module model; ``n_seed`` stars seeded the hypothesis; ``n_hypotheses`` N_h).
-    """
-    cell = field.cell(R_IS[:, 2])
-    gates = np.array([3.0 * gate, gate] if first_gate is None else [first_gate, 3.0 * gate, gate])
-    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
-        obs_S, field.vectors[cell], np.ascontiguousarray(R_IS), field.camera_params, gates, field.camera.focal_px)
-    if not ok:
-        return None
-    probability = false_match_probability(
-        n_other=max(len(obs_S) - n_seed, 0), n_matched_other=max(int(obs_index.size) - n_seed, 0), gate=gate,
-        density=max(n_predicted, 1) / field.solid_angle, n_hypotheses=n_hypotheses)
-    if not probability <= threshold:
-        return None
-    return Verified(R_IS=R_IS, obs_index=obs_index, star_index=cell[star_index],
-                    false_match_probability=probability, n_predicted=int(n_predicted))
