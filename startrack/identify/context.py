@@ -27,11 +27,12 @@ class SearchContext:
 
     catalog: the navigation catalog; field: :class:`~startrack.identify.verify.FieldStars`;
     pattern_stars: the brightest centroids searched first (then twice as many); verify_gate: match
-    radius r [rad] (passes at 3 r then r); threshold: largest accepted false-match probability;
-    dense: also build the field stars' pair table (~0.2 s).
+    radius r [rad] (passes at 3 r then r); threshold: largest accepted false-match probability; sigma:
+    centroid noise [rad]; dense: also build the field stars' pair table (~0.2 s).
     """
 
-    def __init__(self, catalog, field, pattern_stars: int, verify_gate: float, threshold: float, dense: bool):
+    def __init__(self, catalog, field, pattern_stars: int, verify_gate: float, threshold: float, sigma: float,
+                 dense: bool):
         self.catalog = catalog
         self.field = field
         self.widths = np.array([pattern_stars, 2 * pattern_stars], np.int64)
@@ -43,9 +44,10 @@ class SearchContext:
             self.tables["dense"] = PairTable.of_stars(field.vectors, catalog.params.theta_min, catalog.params.theta_max)
             self.stars["dense"] = _stars(field.vectors)
         pass_gates = np.array([3.0 * verify_gate, verify_gate])
-        #: (vectors, cos field radius, camera parameters, pass gates, f [px], field solid angle [sr], threshold)
+        #: (vectors, cos field radius, camera parameters, pass gates, f [px], field solid angle [sr], threshold,
+        #: centroid noise [rad])
         self.field_arrays = (field.vectors, field.cos_field_radius, field.camera_params, pass_gates,
-                             float(field.camera.focal_px), float(field.solid_angle), float(threshold))
+                             float(field.camera.focal_px), float(field.solid_angle), float(threshold), float(sigma))
 
     @property
     def dense(self) -> bool:

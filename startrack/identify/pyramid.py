@@ -215,9 +215,9 @@ def _verify(obs, observed, stars, vectors, field, n_h):  # pragma: no cover  (co
     for m in range(stars.size):
         ref[m] = vectors[stars[m]]
         seen[m] = obs[observed[m]]
-    field_vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold = field
+    field_vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = field
     return verify_near(obs, field_vectors, wahba_svd(ref, seen), cos_field_radius, camera_params, pass_gates,
-                       focal_px, solid_angle, n_h, threshold, 2)
+                       focal_px, solid_angle, n_h, threshold, 2, sigma)
 
 
 @njit

@@ -53,9 +53,10 @@ class Tracking:
         """Verified solution or None; needs ``prior.q_IS``."""
         if prior is None or prior.q_IS is None:
             return None
-        vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold = self._field
+        vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = self._field
         return self.context.verified(verify_near(frame.obs_S, vectors, prior.predicted_R_IS, cos_field_radius,
-                                                 camera_params, pass_gates, focal_px, solid_angle, 1, threshold, 0))
+                                                 camera_params, pass_gates, focal_px, solid_angle, 1, threshold, 0,
+                                                 sigma))
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""

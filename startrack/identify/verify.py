@@ -26,7 +26,12 @@ gate, both orientations) can be fooled by any of them, hence (Bonferroni)
 
     P_false = min(1, N_h * P[Binomial(n_other, p) >= K]).
 
-A hypothesis is accepted when P_false <= threshold (default 1e-6).
+The radius is the one the matches reached: d_K, the largest angle between a matched centroid and its
+star after the final refit (never below the centroid noise sigma, never above the gate r).  P[Binomial
+(n_other, p(d)) >= K] is the probability that the K-th closest chance match lies within d, i.e. the
+exact tail of the observed order statistic, so it is as valid as the fixed gate and far sharper for
+frames with few stars (4 true stars among false ones: p(2 sigma) is 6x smaller than p(5 sigma) per
+star).  A hypothesis is accepted when P_false <= threshold (default 1e-6).
 """
 
 from __future__ import annotations
@@ -162,10 +167,11 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
 
 @njit
 def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
-                n_hypotheses, threshold, n_seed):  # pragma: no cover  (compiled)
-    """:func:`verify` in one compiled call, the field stars taken by brute force (all within the field
-    radius of the boresight, ``cos_field_radius`` its cosine); returns (ok, R_IS, obs indices, star
-    indices into ``field_vectors``, P_false, stars predicted in the field)."""
+                n_hypotheses, threshold, n_seed, sigma):  # pragma: no cover  (compiled)
+    """Verification (module text) in one compiled call, the field stars taken by brute force (all within
+    the field radius of the boresight, ``cos_field_radius`` its cosine); ``sigma`` the centroid noise
+    [rad]; returns (ok, R_IS, obs indices, star indices into ``field_vectors``, P_false, stars
+    predicted in the field)."""
     boresight = R_IS[:, 2].copy()
     near = np.empty(field_vectors.shape[0], np.int64)
     count = 0
@@ -179,8 +185,17 @@ def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pas
         obs_S, field_vectors[near], R_IS, camera_params, pass_gates, focal_px)
     if not ok:
         return False, R_IS, obs_index, star_index, 1.0, n_predicted
+    stars = field_vectors[near]
+    reached = 1.0
+    for m in range(obs_index.size):  # cosine of the largest residual
+        star = stars[star_index[m]]
+        cosine = 0.0
+        for c in range(3):
+            cosine += (star[0] * R_IS[0, c] + star[1] * R_IS[1, c] + star[2] * R_IS[2, c]) * obs_S[obs_index[m], c]
+        reached = min(reached, cosine)
+    radius = min(max(np.arccos(min(reached, 1.0)), sigma), pass_gates[-1])
     probability = false_match_probability(max(obs_S.shape[0] - n_seed, 0), max(obs_index.size - n_seed, 0),
-                                          pass_gates[-1], max(n_predicted, 1) / solid_angle, n_hypotheses)
+                                          radius, max(n_predicted, 1) / solid_angle, n_hypotheses)
     return probability <= threshold, R_IS, obs_index, near[star_index], probability, n_predicted
 
 
