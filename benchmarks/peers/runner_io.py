@@ -104,6 +104,13 @@ def run_frames(frames, solve, out_path, progress_label):
                 print(f"  {progress_label}: {n + 1}/{len(frames)} frames", flush=True)
 
 
+def write_meta(out_path, **fields):
+    """Write ``fields`` (e.g. ``setup_ms``: database or kernel loading, timed apart from the solves) to
+    ``<out_path>.meta.json`` beside the results."""
+    with open(str(out_path) + ".meta.json", "w") as stream:
+        json.dump(fields, stream)
+
+
 def nearest_indices(points, targets):
     """Index into ``points`` (N, 2) of the nearest point to each of ``targets`` (M, 2)."""
     points = np.asarray(points, dtype=float).reshape(-1, 2)
