@@ -44,10 +44,15 @@ class SearchContext:
             self.tables["dense"] = PairTable.of_stars(field.vectors, catalog.params.theta_min, catalog.params.theta_max)
             self.stars["dense"] = _stars(field.vectors)
         pass_gates = np.array([3.0 * verify_gate, verify_gate])
-        #: (vectors, cos field radius, camera parameters, pass gates, f [px], field solid angle [sr], threshold,
-        #: centroid noise [rad])
-        self.field_arrays = (field.vectors, field.cos_field_radius, field.camera_params, pass_gates,
+        #: verify_near's ``field``: (vectors, zones, search radius [rad], camera parameters, pass gates [rad],
+        #: f [px], field solid angle [sr], threshold, centroid noise [rad])
+        self.field_arrays = (field.vectors, field.zones, float(field.search_radius), field.camera_params, pass_gates,
                              float(field.camera.focal_px), float(field.solid_angle), float(threshold), float(sigma))
+
+    def with_first_gate(self, gate: float):
+        """:attr:`field_arrays` with a first matching pass at ``gate`` [rad] before 3 r and r (tracking)."""
+        field = self.field_arrays
+        return (*field[:4], np.concatenate([[gate], field[4]]), *field[5:])
 
     @property
     def dense(self) -> bool:

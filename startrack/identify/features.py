@@ -51,7 +51,8 @@ def pair_features(obs, focal_px, delta_px):  # pragma: no cover  (compiled)
 @njit(_nrt=False)
 def fill_features(obs, n, focal_px, delta_px, beta, gate, filled):  # pragma: no cover  (compiled)
     """:func:`pair_features` in place, for the pairs of the first n stars not yet filled: ``filled[0]``
-    is the number of leading stars whose pairs are (updated to n)."""
+    is the number of leading stars whose pairs are (updated to n, at most the size of ``beta``)."""
+    n = min(n, beta.shape[0], obs.shape[0])
     for j in range(filled[0], n):
         for i in range(j):
             c = obs[i, 0] * obs[j, 0] + obs[i, 1] * obs[j, 1] + obs[i, 2] * obs[j, 2]
@@ -103,34 +104,45 @@ def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
 
 
 @njit
-def centroid_directions(uv, flux, camera_params, max_stars):  # pragma: no cover  (compiled)
-    """(status, obs_S (m, 3), index (m,)): the unit vectors in S of the centroids ``uv`` (n, 2) [px] that
-    lie on the sensor (pixel edges included), brightest first by ``flux`` (n,) (empty: given order),
-    at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``.  status: DIRECTIONS_OK,
-    BAD_COORDINATE (NaN or infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
+def feature_arrays(n_stars, n_pattern):  # pragma: no cover  (compiled)
+    """Empty features of a frame: (beta (m, m) zeros, gate (m, m) +inf, filled (1,) zero), m = min(n_stars,
+    n_pattern)."""
+    m = min(n_stars, n_pattern)
+    return np.zeros((m, m)), np.full((m, m), np.inf), np.zeros(1, np.int64)
+
+
+@njit
+def centroid_directions(uv, flux, camera_params, max_stars, n_pattern):  # pragma: no cover  (compiled)
+    """(status, obs_S (m, 3), index (m,), beta, gate, filled): the unit vectors in S of the centroids ``uv``
+    (n, 2) [px] that lie on the sensor (pixel edges included), brightest first by ``flux`` (n,) (empty:
+    given order), at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``; empty features
+    for ``n_pattern`` stars (:func:`feature_arrays`).  status: DIRECTIONS_OK, BAD_COORDINATE (NaN or
+    infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
     n = uv.shape[0]
+    beta, gate, filled = feature_arrays(0, n_pattern)
     width, height = camera_params[3], camera_params[4]
     inside = np.empty(n, np.int64)
     count = 0
     for i in range(n):
         u, v = uv[i, 0], uv[i, 1]
         if not (np.isfinite(u) and np.isfinite(v)):
-            return BAD_COORDINATE, np.empty((0, 3)), inside[:0]
+            return BAD_COORDINATE, np.empty((0, 3)), inside[:0], beta, gate, filled
         if -0.5 <= u <= width - 0.5 and -0.5 <= v <= height - 0.5:
             inside[count] = i
             count += 1
     for i in range(flux.size):
         if not np.isfinite(flux[i]):
-            return BAD_FLUX, np.empty((0, 3)), inside[:0]
+            return BAD_FLUX, np.empty((0, 3)), inside[:0], beta, gate, filled
     if count == 0 and n > 0:
-        return ALL_OUTSIDE, np.empty((0, 3)), inside[:0]
+        return ALL_OUTSIDE, np.empty((0, 3)), inside[:0], beta, gate, filled
     index = inside[:count]
     kept = flux.copy() if flux.size == 0 else flux[index]
     index = index[brightest_first(kept, count, max_stars)]
     obs = np.empty((index.size, 3))
     for m in range(index.size):
         obs[m, 0], obs[m, 1], obs[m, 2] = _unproject(uv[index[m], 0], uv[index[m], 1], camera_params)
-    return DIRECTIONS_OK, obs, index
+    beta, gate, filled = feature_arrays(index.size, n_pattern)
+    return DIRECTIONS_OK, obs, index, beta, gate, filled
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,10 +171,8 @@ class FrameFeatures:
         """Features of ``obs_S`` (already brightest first) for at most ``n_pattern`` pattern stars, the
         pairs of the first ``n_filled`` (default: all of them) computed now."""
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
-        m = min(len(obs_S), n_pattern)
-        beta, gate = np.zeros((m, m)), np.full((m, m), np.inf)
-        filled = np.zeros(1, np.int64)
-        fill_features(obs_S, m if n_filled is None else min(n_filled, m), float(focal_px), float(delta_px), beta, gate,
+        beta, gate, filled = feature_arrays(len(obs_S), n_pattern)
+        fill_features(obs_S, n_pattern if n_filled is None else n_filled, float(focal_px), float(delta_px), beta, gate,
                       filled)
         return cls(obs_S, index, beta, gate, filled, float(focal_px), float(delta_px), verify_gate)
 

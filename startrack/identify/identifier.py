@@ -173,11 +173,14 @@ class StarIdentifier:
         flux = self._checked_flux(flux, uv.shape[0])
         if isinstance(flux, str):
             return _failed("error", flux, start)
-        status, obs_S, index = centroid_directions(np.ascontiguousarray(uv), flux, self.field.camera_params,
-                                                   self._max_stars)
+        status, obs_S, index, beta, gate, filled = centroid_directions(
+            np.ascontiguousarray(uv), flux, self.field.camera_params, self._max_stars, 2 * self.pattern_stars)
         if status != DIRECTIONS_OK:
             return _failed("error", self._direction_errors[status].format(n=uv.shape[0]), start)
-        return self._solve(obs_S, index, prior, start)
+        if len(obs_S) < 3:
+            return _too_few(len(obs_S), start)
+        return self._solve(FrameFeatures(obs_S, index, beta, gate, filled, self.camera.focal_px, self.delta_px,
+                                         self.verify_gate), prior, start)
 
     def solve_vectors(self, obs_S, flux=None, prior: Prior | None = None) -> IdentificationResult:
         """Identify directions ``obs_S`` (n, 3) in the sensor frame (normalised here), brightest first unless ``flux``."""
@@ -194,7 +197,9 @@ class StarIdentifier:
         if not np.all(np.isfinite(flux)):
             return _failed("error", "a flux value is NaN or infinite", start)
         index = brightest_first(flux, obs.shape[0], self._max_stars)
-        return self._solve(np.ascontiguousarray(obs[index] / norms[index, None]), index, prior, start)
+        if len(index) < 3:
+            return _too_few(len(index), start)
+        return self._solve(self.features(obs[index] / norms[index, None], index), prior, start)
 
     # ------------------------------------------------------------------ internals
     @staticmethod
@@ -219,10 +224,7 @@ class StarIdentifier:
         return FrameFeatures.build(obs_S, index, self.camera.focal_px, self.delta_px, self.verify_gate,
                                    2 * self.pattern_stars, n_filled=0)
 
-    def _solve(self, obs_S, index, prior, start):
-        if len(obs_S) < 3:
-            return _failed("too_few", f"{len(obs_S)} usable centroids; at least 3 are needed", start)
-        frame = self.features(obs_S, index)
+    def _solve(self, frame, prior, start):
         for strategy in self.strategies:
             verified = strategy.identify(frame, prior)
             if verified is not None:
@@ -273,6 +275,10 @@ def _float_array(value):
     except (ValueError, TypeError):
         return None
     return array.astype(float) if array.dtype.kind in "biuf" else None
+
+
+def _too_few(n, start):
+    return _failed("too_few", f"{n} usable centroids; at least 3 are needed", start)
 
 
 def _failed(status, reason, start):

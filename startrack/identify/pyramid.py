@@ -12,11 +12,11 @@ k-vector of 000 eq. 3-5, or a sub-catalog's pairs; :func:`startrack.identify.pai
    partner), the second is scanned for a marked star; each hit gives a catalog triangle, kept when
    its third distance lies within the third gate and its handedness is the observed one (a mirror
    image is not a rotation).  Only contiguous runs of the pair table are read.
-2. Pyramid (001 §4.4.3, the fourth star): each catalog triangle is extended by the other centroids r
-   in brightness order: a catalog pair of the gate of (x, r) (x the triangle star whose gate holds the
-   fewest pairs) with an end on x's catalog star gives D, kept when its distances to the other two
-   lie within their gates.  The four-star group's SVD attitude is verified at once
-   (:func:`startrack.identify.verify.verify_near`); the first accepted group ends the search.
+2. Pyramid (001 §4.4.3, the fourth star): the catalog triangle's SVD attitude puts each other
+   centroid r (brightness order) on the sky; the first that falls within the first verification gate
+   (3 r) of a field star (a look-up in the zone index, :mod:`startrack.identify.zones`) makes the
+   four-star group, whose hypothesis is verified at once (:func:`startrack.identify.verify.verify_near`,
+   which refits with every match); the first accepted hypothesis ends the search.
 3. Triangles that no fourth star extends are kept (up to the buffer) and verified after every group
    of the n stars has failed: such a hypothesis needs further matches in the verification.
 
@@ -32,6 +32,7 @@ import numpy as np
 
 from startrack.identify.pairs import pair_count, pair_range
 from startrack.identify.verify import verify_near, wahba_svd
+from startrack.identify.zones import stars_near
 from startrack.jit import njit
 
 #: Catalog triangles kept per observed triangle, and unextended triangles kept per search.
@@ -166,37 +167,18 @@ def catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, r
 
 
 @njit(_nrt=False)
-def fourth_star(tri, stars, r, beta, gate, cos_low, cos_high, table, region, lo, hi, counts, vectors):  # pragma: no cover
-    """Catalog star D of centroid r within the gates of its distances to the three stars of a catalog
-    triangle (``tri`` observed, ``stars`` catalog), or -1 (module text, step 2)."""
-    theta, first, second = table[0], table[1], table[2]
-    theta_max = theta[-1] if theta.size else 0.0
-    x, fewest = -1, np.inf
-    for y in range(3):
-        if beta[tri[y], r] - gate[tri[y], r] <= theta_max:
-            count = _expected(tri[y], r, beta, gate, table, counts)
-            if count < fewest:
-                x, fewest = y, count
-    if x < 0:
-        return -1
-    start, stop = _slots(tri[x], r, beta, gate, table, lo, hi)
-    for y in range(3):
-        _gate_ends(tri[y], r, beta, gate, cos_low, cos_high)
-    for q in range(start, stop):
-        if first[q] == stars[x]:
-            D = second[q]
-        elif second[q] == stars[x]:
-            D = first[q]
-        else:
+def fourth_star(R_IS, obs, tri, n, field, near, direction):  # pragma: no cover  (compiled)
+    """The first centroid r < n outside the triangle ``tri`` that the triangle's attitude R_IS puts within
+    the first verification gate (3 r) of a field star, or -1 (module text, step 2; ``near`` a work
+    array of at least one entry per field star, ``direction`` one of 3)."""
+    vectors, zones, gate = field[0], field[1], field[4][0]
+    for r in range(n):
+        if r == tri[0] or r == tri[1] or r == tri[2]:
             continue
-        if D == stars[0] or D == stars[1] or D == stars[2] or not _in_region(region, vectors, D):
-            continue
-        good = True
-        for y in range(3):
-            if y != x and not _inside(vectors, stars[y], D, cos_low[tri[y], r], cos_high[tri[y], r]):
-                good = False
-        if good:
-            return D
+        for c in range(3):
+            direction[c] = R_IS[c, 0] * obs[r, 0] + R_IS[c, 1] * obs[r, 1] + R_IS[c, 2] * obs[r, 2]
+        if stars_near(zones, vectors, direction, gate, near) > 0:
+            return r
     return -1
 
 
@@ -208,16 +190,14 @@ def no_result():  # pragma: no cover  (compiled)
 
 
 @njit
-def _verify(obs, observed, stars, vectors, field, n_h):  # pragma: no cover  (compiled)
-    """verify_near of the SVD attitude of the centroids ``observed`` matched to the catalog ``stars``."""
+def _attitude(obs, observed, stars, vectors):  # pragma: no cover  (compiled)
+    """SVD attitude R_IS of the centroids ``observed`` matched to the catalog ``stars``."""
     ref = np.empty((stars.size, 3))
     seen = np.empty((stars.size, 3))
     for m in range(stars.size):
         ref[m] = vectors[stars[m]]
         seen[m] = obs[observed[m]]
-    field_vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = field
-    return verify_near(obs, field_vectors, wahba_svd(ref, seen), cos_field_radius, camera_params, pass_gates,
-                       focal_px, solid_angle, n_h, threshold, 2, sigma)
+    return wahba_svd(ref, seen)
 
 
 @njit
@@ -235,12 +215,12 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
     n_h = hypothesis_count(n, beta, gate, table, counts)
     found = np.empty((TRIANGLE_BUFFER, 3), np.int64)
     tri = np.empty(3, np.int64)
-    group = np.empty(4, np.int64)
-    stars = np.empty(4, np.int64)
     x_slots = np.empty(2, np.int64)
     y_slots = np.empty(2, np.int64)
     partner = np.empty(0, np.int64)
     chain = np.empty(0, np.int64)
+    near = np.empty(field[0].shape[0], np.int64)
+    direction = np.empty(3)
     theta_max = table[0][-1] if table[0].size else 0.0
     kept = 0
     for k in range(2, n):
@@ -255,23 +235,14 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
                 if partner.size < 2 * (x_slots[1] - x_slots[0]):
                     partner = np.empty(4 * (x_slots[1] - x_slots[0]), np.int64)
                     chain = np.empty(partner.size, np.int64)
-                for t in range(catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots, y_slots,
-                                                 vectors, head, partner, chain, found)):
-                    extended = False
-                    for r in range(n):
-                        if r == i or r == j or r == k:
-                            continue
-                        D = fourth_star(tri, found[t], r, beta, gate, cos_low, cos_high, table, region, lo, hi,
-                                        counts, vectors)
-                        if D < 0:
-                            continue
-                        extended = True
-                        group[0], group[1], group[2], group[3] = i, j, k, r
-                        stars[0], stars[1], stars[2], stars[3] = found[t, 0], found[t, 1], found[t, 2], D
-                        result = _verify(obs, group, stars, vectors, field, n_h)
+                for t in range(catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots,
+                                                 y_slots, vectors, head, partner, chain, found)):
+                    R_IS = _attitude(obs, tri, found[t], vectors)
+                    if fourth_star(R_IS, obs, tri, n, field, near, direction) >= 0:
+                        result = verify_near(obs, R_IS, field, n_h, 2)
                         if result[0]:
                             return result, n_h, kept
-                    if not extended and kept < triangles.shape[0]:
+                    elif kept < triangles.shape[0]:
                         triangles[kept, :3] = tri
                         triangles[kept, 3:] = found[t]
                         kept += 1
@@ -282,7 +253,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
 def verify_triangles(obs, triangles, kept, vectors, field, n_h):  # pragma: no cover  (compiled)
     """The first of the ``kept`` triangles (rows of ``triangles``) whose SVD attitude verifies."""
     for t in range(kept):
-        result = _verify(obs, triangles[t, :3], triangles[t, 3:], vectors, field, n_h)
+        result = verify_near(obs, _attitude(obs, triangles[t, :3], triangles[t, 3:], vectors), field, n_h, 2)
         if result[0]:
             return result
     return no_result()

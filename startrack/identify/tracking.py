@@ -45,18 +45,13 @@ class Tracking:
         self.context = context
         self.field = context.field
         self.window_px = float(window_px)
-        field = context.field_arrays
-        # pass gates: the tracking window, then those of every verification (3 r, r)
-        self._field = (*field[:3], np.concatenate([[self.window_px / self.field.camera.focal_px], field[3]]), *field[4:])
+        self._field = context.with_first_gate(self.window_px / self.field.camera.focal_px)
 
     def identify(self, frame, prior):
         """Verified solution or None; needs ``prior.q_IS``."""
         if prior is None or prior.q_IS is None:
             return None
-        vectors, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = self._field
-        return self.context.verified(verify_near(frame.obs_S, vectors, prior.predicted_R_IS, cos_field_radius,
-                                                 camera_params, pass_gates, focal_px, solid_angle, 1, threshold, 0,
-                                                 sigma))
+        return self.context.verified(verify_near(frame.obs_S, prior.predicted_R_IS, self._field, 1, 0))
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
 
@@ -166,26 +167,21 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
 
 
 @njit
-def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
-                n_hypotheses, threshold, n_seed, sigma):  # pragma: no cover  (compiled)
-    """Verification (module text) in one compiled call, the field stars taken by brute force (all within
-    the field radius of the boresight, ``cos_field_radius`` its cosine); ``sigma`` the centroid noise
-    [rad]; returns (ok, R_IS, obs indices, star indices into ``field_vectors``, P_false, stars
-    predicted in the field)."""
-    boresight = R_IS[:, 2].copy()
-    near = np.empty(field_vectors.shape[0], np.int64)
-    count = 0
-    for s in range(field_vectors.shape[0]):
-        if (field_vectors[s, 0] * boresight[0] + field_vectors[s, 1] * boresight[1]
-                + field_vectors[s, 2] * boresight[2]) >= cos_field_radius:
-            near[count] = s
-            count += 1
-    near = near[:count]
-    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
-        obs_S, field_vectors[near], R_IS, camera_params, pass_gates, focal_px)
+def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  (compiled)
+    """Verification (module text) of the attitude hypothesis R_IS for the centroid directions ``obs_S``
+    (n, 3) in one compiled call.  ``field`` = (vectors, zone index (:mod:`startrack.identify.zones`),
+    radius [rad] around the boresight holding every star the image can show, camera parameters, pass
+    gates [rad], f [px], field solid angle [sr], threshold, centroid noise sigma [rad]); ``n_seed`` stars
+    seeded the hypothesis, ``n_hypotheses`` N_h.  Returns (ok, R_IS, obs indices, star indices into
+    the vectors, P_false, stars predicted in the field)."""
+    vectors, zones, radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = field
+    near = np.empty(vectors.shape[0], np.int64)
+    near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), radius, near)]
+    stars = vectors[near]
+    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(obs_S, stars, R_IS, camera_params, pass_gates,
+                                                                   focal_px)
     if not ok:
         return False, R_IS, obs_index, star_index, 1.0, n_predicted
-    stars = field_vectors[near]
     reached = 1.0
     for m in range(obs_index.size):  # cosine of the largest residual
         star = stars[star_index[m]]
@@ -193,9 +189,9 @@ def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pas
         for c in range(3):
             cosine += (star[0] * R_IS[0, c] + star[1] * R_IS[1, c] + star[2] * R_IS[2, c]) * obs_S[obs_index[m], c]
         reached = min(reached, cosine)
-    radius = min(max(np.arccos(min(reached, 1.0)), sigma), pass_gates[-1])
+    gate = min(max(np.arccos(min(reached, 1.0)), sigma), pass_gates[-1])
     probability = false_match_probability(max(obs_S.shape[0] - n_seed, 0), max(obs_index.size - n_seed, 0),
-                                          radius, max(n_predicted, 1) / solid_angle, n_hypotheses)
+                                          gate, max(n_predicted, 1) / solid_angle, n_hypotheses)
     return probability <= threshold, R_IS, obs_index, near[star_index], probability, n_predicted
 
 
@@ -350,7 +346,8 @@ class FieldStars:
         self.hip = np.asarray(hip, dtype=np.int64)
         self.v_mag = np.asarray(v_mag, dtype=float)
         self.field_radius = _field_radius(camera)
-        self.cos_field_radius = math.cos(self.field_radius + _FIELD_MARGIN)  # brute-force neighbourhood of verify_near
+        self.search_radius = self.field_radius + _FIELD_MARGIN  # the stars verify_near projects
+        self.zones = zone_index(self.vectors)
         self.solid_angle = _field_solid_angle(camera)
         radius = self.field_radius + catalog.s_max
         pairs = cKDTree(catalog.base_vectors).sparse_distance_matrix(
