@@ -84,34 +84,42 @@ def _slots(s, t, beta, gate, table, lo, hi):  # pragma: no cover  (compiled)
 
 
 @njit(_nrt=False)
-def _expected(s, t, beta, gate, table, counts):  # pragma: no cover  (compiled)
-    """Cached expected number of catalog pairs inside the gate of (s, t) (pair_count)."""
+def _expected(s, t, beta, gate, table, counts, lo, hi):  # pragma: no cover  (compiled)
+    """Cached expected number of catalog pairs inside the gate of (s, t) (pair_count); exact, with its
+    range cached too, for a table without cumulative counts."""
     if counts[s, t] < 0.0:
-        counts[s, t] = pair_count(table, beta[s, t] - gate[s, t], beta[s, t] + gate[s, t])
+        if table[6].size:
+            counts[s, t] = pair_count(table, beta[s, t] - gate[s, t], beta[s, t] + gate[s, t])
+        else:
+            a, b = _slots(s, t, beta, gate, table, lo, hi)
+            counts[s, t] = b - a
         counts[t, s] = counts[s, t]
     return counts[s, t]
 
 
 @njit(_nrt=False)
-def hypothesis_count(n, beta, gate, table, counts):  # pragma: no cover  (compiled)
+def hypothesis_count(n, beta, gate, table, counts, lo, hi):  # pragma: no cover  (compiled)
     """N_h: oriented catalog pairs inside the gates of every pair of the first n centroids."""
     total = 0.0
     for s in range(n):
         for t in range(s + 1, n):
-            total += 2.0 * _expected(s, t, beta, gate, table, counts)
+            total += 2.0 * _expected(s, t, beta, gate, table, counts, lo, hi)
     return int(np.ceil(total))
 
 
 @njit(_nrt=False)
-def _two_smallest(tri, beta, gate, table, counts, theta_max):  # pragma: no cover  (compiled)
+def _two_smallest(tri, beta, gate, table, counts, lo, hi, theta_max):  # pragma: no cover  (compiled)
     """(s, x, y): the triangle's star s shared by its two pairs (s, x), (s, y) with the fewest expected
-    candidates among the pairs within the table's reach; s = -1 if fewer than two are."""
+    candidates among the pairs within the table's reach; s = -1 if fewer than two are, or if a pair
+    has no candidate at all (no catalog triangle can match)."""
     best_e, best_count, second_e, second_count = -1, np.inf, -1, np.inf
     for e in range(3):  # pair e joins tri[e] and tri[(e + 1) % 3]
         a, b = tri[e], tri[(e + 1) % 3]
         if beta[a, b] - gate[a, b] > theta_max:
             continue
-        count = _expected(a, b, beta, gate, table, counts)
+        count = _expected(a, b, beta, gate, table, counts, lo, hi)
+        if count == 0.0:
+            return -1, -1, -1
         if count < best_count:
             second_e, second_count, best_e, best_count = best_e, best_count, e, count
         elif count < second_count:
@@ -212,7 +220,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
     lo = np.full((size, size), -1, np.int64)
     hi = np.full((size, size), -1, np.int64)
     counts = np.full((size, size), -1.0)
-    n_h = hypothesis_count(n, beta, gate, table, counts)
+    n_h = hypothesis_count(n, beta, gate, table, counts, lo, hi)
     found = np.empty((TRIANGLE_BUFFER, 3), np.int64)
     tri = np.empty(3, np.int64)
     x_slots = np.empty(2, np.int64)
@@ -227,7 +235,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
         for j in range(1, k):
             for i in range(j):
                 tri[0], tri[1], tri[2] = i, j, k
-                s, x, y = _two_smallest(tri, beta, gate, table, counts, theta_max)
+                s, x, y = _two_smallest(tri, beta, gate, table, counts, lo, hi, theta_max)
                 if s < 0:
                     continue
                 x_slots[0], x_slots[1] = _slots(s, x, beta, gate, table, lo, hi)
