@@ -1,9 +1,11 @@
 """Compiled star-pattern search: triangles extended to pyramids, each verified as soon as it is found.
 
-For the brightest n centroids (brightest first) the observed triangles (i, j, k) are taken in the
-order k = 2, 3, ..., n - 1, then j, then i: every triangle of the brightest m stars before the
-(m+1)-th star is used (the pyramid order), so a false or uncatalogued bright star costs only the few
-triangles it is part of.  Every observed pair (s, t) has the gate [beta - e, beta + e] (e the bound
+For the brightest n centroids (brightest first) the observed triangles (i, j, k) = (i, i + dj,
+i + dj + dk) are taken for dj = 1, 2, ..., then dk = 1, 2, ..., then i = 0, 1, ... (the order of
+Mortari's pyramid algorithm): the first triangles are those of neighbouring brightness ranks,
+(0, 1, 2), (1, 2, 3), (2, 3, 4), ..., so a false or uncatalogued bright star is left behind after
+the few triangles it is part of (with star 0 false the second triangle is all true; with the
+triangles of the brightest m stars first it would be the fourth, with two false stars the tenth).  Every observed pair (s, t) has the gate [beta - e, beta + e] (e the bound
 of 001 §4.3.1, :mod:`startrack.identify.features`) and the catalog pairs inside it (the pair table:
 k-vector of 000 eq. 3-5, or a sub-catalog's pairs; :func:`startrack.identify.pairs.pair_range`).
 
@@ -216,10 +218,9 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
     ``triangles`` (TRIANGLE_BUFFER, 6) int64 receives the unextended triangles (3 centroids, 3 catalog
     stars).  Returns (verify_near's tuple, N_h, triangles kept).
     """
-    size = beta.shape[0]
-    lo = np.full((size, size), -1, np.int64)
-    hi = np.full((size, size), -1, np.int64)
-    counts = np.full((size, size), -1.0)
+    lo = np.full((n, n), -1, np.int64)
+    hi = np.full((n, n), -1, np.int64)
+    counts = np.full((n, n), -1.0)
     n_h = hypothesis_count(n, beta, gate, table, counts, lo, hi)
     found = np.empty((TRIANGLE_BUFFER, 3), np.int64)
     tri = np.empty(3, np.int64)
@@ -231,10 +232,10 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
     direction = np.empty(3)
     theta_max = table[0][-1] if table[0].size else 0.0
     kept = 0
-    for k in range(2, n):
-        for j in range(1, k):
-            for i in range(j):
-                tri[0], tri[1], tri[2] = i, j, k
+    for dj in range(1, n - 1):
+        for dk in range(1, n - dj):
+            for i in range(n - dj - dk):
+                tri[0], tri[1], tri[2] = i, i + dj, i + dj + dk
                 s, x, y = _two_smallest(tri, beta, gate, table, counts, lo, hi, theta_max)
                 if s < 0:
                     continue
