@@ -35,8 +35,12 @@ def _frozen(array, dtype):
     return array
 
 
-_NO_INDEX = _frozen(np.zeros(0), np.int64)
-_NO_COUNTS = _NO_INDEX
+#: Angular distances of a table [rad] in single precision (2e-8 rad at 0.3 rad, far inside any gate):
+#: half the memory a search reads.
+THETA = np.float32
+
+_NO_INDEX = _frozen(np.zeros(0), np.int32)
+_NO_COUNTS = _frozen(np.zeros(0), np.int64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,7 +59,7 @@ class PairTable:
     intercept: float = 0.0
 
     def __post_init__(self):
-        for name, dtype in (("theta", float), ("first", np.int32), ("second", np.int32), ("k", np.int64)):
+        for name, dtype in (("theta", THETA), ("first", np.int32), ("second", np.int32), ("k", np.int32)):
             object.__setattr__(self, name, _frozen(getattr(self, name), dtype))
 
     @classmethod
@@ -91,7 +95,7 @@ class SubCatalogPairs:
     def __init__(self, catalog):
         index = catalog.sub_pair_index
         self.offsets = np.asarray(catalog.sub_pair_offsets, dtype=np.int64)
-        self.theta = _frozen(catalog.pair_theta[index], float)
+        self.theta = _frozen(catalog.pair_theta[index], THETA)
         self.first = _frozen(catalog.pair_i[index], np.int32)
         self.second = _frozen(catalog.pair_j[index], np.int32)
 

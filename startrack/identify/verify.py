@@ -197,15 +197,25 @@ def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  
 
 @njit
 def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
-    """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [rad]."""
+    """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [rad].
+
+    Only pairs whose x components differ by at most the chord of the gate, 2 sin(gate / 2), can lie
+    within it; the predictions are sorted by x and each centroid compares those in its window.  A
+    nearest neighbour outside the window lies outside the gate, so the matches are those of the
+    comparison of every pair.
+    """
     n, m = obs_S.shape[0], pred_S.shape[0]
     cos_gate = np.cos(gate)
+    width = 2.0 * np.sin(0.5 * min(gate, np.pi)) * (1.0 + 1e-12)
+    order = np.argsort(pred_S[:, 0])
+    x = pred_S[order, 0]
     best_pred = np.full(n, -1, np.int64)
     best_pred_cos = np.full(n, -2.0)
     best_obs = np.full(m, -1, np.int64)
     best_obs_cos = np.full(m, -2.0)
     for i in range(n):
-        for j in range(m):
+        for e in range(np.searchsorted(x, obs_S[i, 0] - width), np.searchsorted(x, obs_S[i, 0] + width, side="right")):
+            j = order[e]
             c = obs_S[i, 0] * pred_S[j, 0] + obs_S[i, 1] * pred_S[j, 1] + obs_S[i, 2] * pred_S[j, 2]
             if c > best_pred_cos[i]:
                 best_pred_cos[i] = c
