@@ -26,8 +26,6 @@ distortion inverted by Newton's method on the radius, as ``Camera.unproject``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from startrack.jit import njit
@@ -145,7 +143,6 @@ def centroid_directions(uv, flux, camera_params, max_stars, n_pattern):  # pragm
     return DIRECTIONS_OK, obs, index, beta, gate, filled
 
 
-@dataclass(frozen=True, eq=False)
 class FrameFeatures:
     """A frame prepared for identification.
 
@@ -153,17 +150,15 @@ class FrameFeatures:
     positions in the caller's list; ``beta`` and ``gate`` (m, m) the angular distances and bounds
     e_ij [rad] of the first m (brightest) stars, filled for the pairs of the first ``filled[0]`` of them
     (the search fills more as it widens, :func:`fill_features`); ``focal_px``, ``delta_px`` their
-    camera and error bound; ``verify_gate`` the verification match radius [rad].
+    camera and error bound; ``verify_gate`` the verification match radius [rad].  (A plain class with
+    slots: one is made per frame, and a frozen dataclass takes three times as long to build.)
     """
 
-    obs_S: np.ndarray
-    index: np.ndarray
-    beta: np.ndarray
-    gate: np.ndarray
-    filled: np.ndarray
-    focal_px: float
-    delta_px: float
-    verify_gate: float
+    __slots__ = ("obs_S", "index", "beta", "gate", "filled", "focal_px", "delta_px", "verify_gate")
+
+    def __init__(self, obs_S, index, beta, gate, filled, focal_px: float, delta_px: float, verify_gate: float):
+        self.obs_S, self.index, self.beta, self.gate, self.filled = obs_S, index, beta, gate, filled
+        self.focal_px, self.delta_px, self.verify_gate = focal_px, delta_px, verify_gate
 
     @classmethod
     def build(cls, obs_S, index, focal_px: float, delta_px: float, verify_gate: float, n_pattern: int,
