@@ -278,8 +278,8 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
 
     Each pass predicts with the field grown by its gate, matches, and refits with every match; the
     final gate is repeated (up to ``_EXTRA_PASSES`` times) while it adds stars, since a first fit from
-    a few stars may leave distant ones outside the gate; a last check drops matches outside the final
-    gate and refits.  Returns (ok, R_IS, obs indices, star
+    a few stars may leave distant ones outside the gate; once every centroid is matched no further
+    pass is made; a last check drops matches outside the final gate and refits.  Returns (ok, R_IS, obs indices, star
     indices, number of stars predicted in the field); ok is False below 3 matches.
     """
     empty = np.zeros(0, np.int64)
@@ -297,8 +297,9 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
             return False, R_IS, empty, empty, n_predicted
         star_index = index[pred_index]
         R_IS = wahba_svd(stars_I[star_index], obs_S[obs_index])
-        if p >= pass_gates.size - 1 and obs_index.size <= previous:
-            break  # the final gate no longer adds stars
+        if obs_index.size == obs_S.shape[0] or (p >= pass_gates.size - 1 and obs_index.size <= previous):
+            break  # every centroid matched (later passes could only drop some, as the last check does), or
+            # the final gate no longer adds stars
     cos_gate = np.cos(pass_gates[-1])
     keep = np.empty(obs_index.size, np.bool_)
     for m in range(obs_index.size):
