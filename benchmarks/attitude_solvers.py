@@ -22,8 +22,8 @@ from scipy.spatial.transform import Rotation
 
 from startrack import boresight as bs
 from startrack.attitude import SOLVERS
+from startrack.units import ARCSEC
 
-ARCSEC = np.pi / 180.0 / 3600.0
 FOCAL = 256.0 / np.tan(np.radians(8.0))
 SIGMA = 1.0 * ARCSEC
 

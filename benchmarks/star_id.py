@@ -32,8 +32,12 @@ Metrics per solver and frame set:
 Reference row "truth-SVD": the SVD attitude from every true star centroid with its true HIP (told
 the answer; checks the Cramer-Rao column, RMS/CRB ~ 1).
 
-Tracking: success and false rate per prior error (cedar-solve has no tracking mode).  Goals of
-issue 6 are evaluated for startrack (met or by how much not).  Measures, never asserts.
+Tracking: success and false rate per prior error (cedar-solve has no tracking mode).  Sub-catalog
+(startrack only, 000 §4): the same prior frames identified by the predicted sub-catalog with its 4
+redundant neighbours alone (no tracking, no full-sky fall-back), its median time beside our full-sky
+median on the main set of the same run.  Each solver's set-up (database or compiled kernels loaded)
+is timed apart from the solves and reported as ``setup_ms``.  Goals of issues 6 and 17 are evaluated
+for startrack (met or by how much not).  Measures, never asserts.
 
 Run:  python benchmarks/star_id.py [--frames 500] [--tracking-frames 500] [--seed 0]
 Writes benchmarks/results/star_id.json; frames, catalogs, databases and raw results go under
@@ -62,8 +66,8 @@ sys.path.insert(0, str(HERE))
 
 import star_id_frames as sif  # noqa: E402
 from startrack.star_catalog import load_star_catalog  # noqa: E402
+from startrack.units import ARCSEC  # noqa: E402
 
-ARCSEC = np.pi / (180.0 * 3600.0)
 FALSE_MATCH_ANGLE = 60.0 * ARCSEC  # 1 arcmin
 CRB_DRAWS_PER_FRAME = 200
 SET_NAMES = ("main", "clean", "stress")
@@ -76,7 +80,8 @@ def _solver_table():
     peers = HERE / "peers"
     return {
         "startrack": {"python": Path(sys.executable), "runner": peers / "startrack_runner.py", "catalog": None,
-                      "tracking": True, "setup": "the startrack identification layer (startrack.identify)"},
+                      "tracking": True, "subcatalog": True,
+                      "setup": "the startrack identification layer (startrack.identify)"},
         "cedar-solve": {"python": HERE / ".venv-cedar" / "bin" / "python", "runner": peers / "cedar_runner.py",
                         "catalog": "hip_main.dat", "tracking": False, "distribution": "cedar-solve",
                         "setup": "sh benchmarks/peers/setup_venvs.sh"},
@@ -281,8 +286,13 @@ def _goal(name, target, measured, met, shortfall):
     return {"goal": name, "target": target, "measured": measured, "met": bool(met), "shortfall": shortfall}
 
 
-def evaluate_goals(results, tracking):
-    """Issue 6 goals for startrack against the peers measured in this run (met, or by how much not)."""
+#: Issue 17: largest solve time [ms] of any frame, and the sub-catalog/full-sky median ratio.
+MAX_MS_GOAL = 5.0
+SUBCATALOG_RATIO_GOAL = 0.25
+
+
+def evaluate_goals(results, tracking, subcatalog=None):
+    """Issue 6 and 17 goals for startrack against the peers measured in this run (met, or by how much not)."""
     ours = results.get("startrack")
     if not ours:
         return []
@@ -308,6 +318,9 @@ def evaluate_goals(results, tracking):
         if p95_limit is not None and mine["solve_ms"]["p95"] is not None:
             goals.append(_goal(f"{set_name}: p95 ms <= {p95_limit:g}", p95_limit, mine["solve_ms"]["p95"],
                                mine["solve_ms"]["p95"] <= p95_limit, max(0.0, mine["solve_ms"]["p95"] - p95_limit)))
+        if mine["solve_ms"]["max"] is not None:
+            goals.append(_goal(f"{set_name}: max ms <= {MAX_MS_GOAL:g}", MAX_MS_GOAL, mine["solve_ms"]["max"],
+                               mine["solve_ms"]["max"] <= MAX_MS_GOAL, max(0.0, mine["solve_ms"]["max"] - MAX_MS_GOAL)))
         for axis in ("cross_boresight", "roll"):
             ratio = mine.get(f"rms_over_crb_{axis}")
             if ratio is not None:
@@ -316,6 +329,16 @@ def evaluate_goals(results, tracking):
     for prior, metrics in (tracking.get("startrack") or {}).items():
         goals.append(_goal(f"tracking, prior error {prior} deg: success 100 %", 1.0, metrics["success_rate"],
                            metrics["success_rate"] >= 1.0, 1.0 - metrics["success_rate"]))
+    full_sky = (ours.get("main") or {}).get("solve_ms", {}).get("median")
+    for prior, metrics in (subcatalog or {}).items():
+        goals.append(_goal(f"sub-catalog, prior error {prior} deg: success 100 %", 1.0, metrics["success_rate"],
+                           metrics["success_rate"] >= 1.0, 1.0 - metrics["success_rate"]))
+        median = metrics["solve_ms"]["median"]
+        if full_sky and median is not None:
+            ratio = median / full_sky
+            goals.append(_goal(f"sub-catalog, prior error {prior} deg: median <= {SUBCATALOG_RATIO_GOAL:g} x full-sky median",
+                               SUBCATALOG_RATIO_GOAL, ratio, ratio <= SUBCATALOG_RATIO_GOAL,
+                               max(0.0, ratio - SUBCATALOG_RATIO_GOAL)))
     return goals
 
 
@@ -324,10 +347,23 @@ def _fmt(value, spec, missing="-"):
     return missing if value is None else format(value, spec)
 
 
+def print_subcatalog(subcatalog, full_sky_ms):
+    """The sub-catalog sweep of startrack beside its full-sky median on the main set."""
+    print(f"\nstartrack predicted sub-catalog alone (000 §4): success (false), median / p95 / max ms, median / "
+          f"full-sky median ({_fmt(full_sky_ms, '.3f')} ms, main set)")
+    for prior, m in subcatalog.items():
+        ms = m["solve_ms"]
+        ratio = None if not full_sky_ms or ms["median"] is None else ms["median"] / full_sky_ms
+        print(f"  prior {prior:>4} deg: {m['success_rate']:6.1%} ({m['false_rate']:4.1%})  {_fmt(ms['median'], '.3f')} / "
+              f"{_fmt(ms['p95'], '.3f')} / {_fmt(ms['max'], '.2f')} ms  ratio {_fmt(ratio, '.2f')}")
+
+
 def print_tables(results, tracking, solvers, set_names):
     for name, info in solvers.items():
         if not info["available"]:
             print(f"{name}: MISSING ({info['reason']})")
+        elif info.get("setup_ms") is not None:
+            print(f"{name}: set-up {info['setup_ms']:.0f} ms (database or kernels loaded; not part of any solve)")
     columns = [("solver", "<12"), ("set", "<7"), ("success", ">8"), ("false", ">6"), ("att,HIP", ">7"), ("cross med/p95 [as]", ">18"),
                ("CRB med/p95", ">12"), ("roll med/p95 [as]", ">17"), ("CRB med/p95", ">12"),
                ("RMS/CRB x, roll", ">16"), ("ms med", ">7"), ("p95", ">7"), ("max", ">8")]
@@ -372,7 +408,7 @@ def print_tables(results, tracking, solvers, set_names):
 
 
 # ----------------------------------------------------------------------------------- main
-def _run_solver(name, info, frames_path, out_path, args, catalog_folder):
+def _run_solver(name, info, frames_path, out_path, args, catalog_folder, extra=()):
     command = [str(info["python"]), str(info["runner"]), "--frames", str(frames_path), "--out", str(out_path),
                "--fov-deg", str(sif.FOV_DEG), "--fov-max-error-deg", str(args.fov_max_error_deg),
                "--width", str(sif.WIDTH_PX), "--height", str(sif.HEIGHT_PX), "--work", str(args.work)]
@@ -381,6 +417,7 @@ def _run_solver(name, info, frames_path, out_path, args, catalog_folder):
     else:
         command += ["--mag", str(sif.V_MAX), "--epoch", str(sif.CATALOG_EPOCH),
                     "--centroid-sigma-px", str(sif.CENTROID_SIGMA_PX)]
+    command += list(extra)
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True)
     for line in done.stdout.splitlines():
@@ -399,27 +436,38 @@ def _crb_rng(seed, solver, set_name):
     return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(f"{solver}/{set_name}".encode())]))
 
 
+#: Passes over the prior frames: the solver's tracking mode, and (startrack) the sub-catalog alone.
+PRIOR_PASSES = {"tracking": (), "subcatalog": ("--methods", "subcatalog")}
+
+
 def run_and_score(name, info, frame_sets, frame_paths, args, catalog_folder, stars, camera):
-    """({set: metrics, "tracking": {prior: metrics}}, None) of one solver, or (None, why it could not run)."""
+    """({set: metrics, "tracking"/"subcatalog": {prior: metrics}, "setup_ms"}, None) of one solver, or (None,
+    why it could not run)."""
     scored = {}
-    for set_name in list(SET_NAMES) + (["tracking"] if info["tracking"] else []):
-        frames_path = frame_paths[set_name]
+    passes = list(SET_NAMES) + [p for p in PRIOR_PASSES if info.get(p)]
+    for set_name in passes:
+        frames_name = "tracking" if set_name in PRIOR_PASSES else set_name
+        frames_path = frame_paths[frames_name]
         out_path = args.work / f"results-{name}-{set_name}-seed{args.seed}.jsonl"
         if args.reuse and out_path.is_file() and out_path.stat().st_mtime > frames_path.stat().st_mtime:
             print(f"reusing {out_path.name}", flush=True)
             records = sif.read_jsonl(out_path)
         else:
-            print(f"running {name} on {set_name} ({len(frame_sets[set_name])} frames)", flush=True)
-            records, failure = _run_solver(name, info, frames_path, out_path, args, catalog_folder)
+            print(f"running {name} on {set_name} ({len(frame_sets[frames_name])} frames)", flush=True)
+            records, failure = _run_solver(name, info, frames_path, out_path, args, catalog_folder,
+                                           PRIOR_PASSES.get(set_name, ()))
             if records is None:
                 return None, failure
-        if set_name == "tracking":
-            scored["tracking"] = {}
+        if set_name == "main":
+            meta = Path(str(out_path) + ".meta.json")
+            scored["setup_ms"] = json.loads(meta.read_text()).get("setup_ms") if meta.is_file() else None
+        if set_name in PRIOR_PASSES:
+            scored[set_name] = {}
             for error_deg in sif.TRACKING_PRIOR_ERRORS_DEG:
                 subset = [f for f in frame_sets["tracking"] if f["prior_error_deg"] == error_deg]
                 label = f"{error_deg:g}"
-                scored["tracking"][label] = evaluate(subset, records, stars, camera,
-                                                     _crb_rng(args.seed, name, f"tracking{label}"))
+                scored[set_name][label] = evaluate(subset, records, stars, camera,
+                                                   _crb_rng(args.seed, name, f"{set_name}{label}"))
         else:
             scored[set_name] = evaluate(frame_sets[set_name], records, stars, camera,
                                         _crb_rng(args.seed, name, set_name))
@@ -456,7 +504,7 @@ def main():
     catalog_folder = write_peer_catalogs(args.work, sif.CATALOG_EPOCH)
 
     table = _solver_table()
-    solvers, results, tracking = {}, {}, {}
+    solvers, results, tracking, subcatalog = {}, {}, {}, {}
     for name in [s.strip() for s in args.solvers.split(",") if s.strip()]:
         info = dict(table[name], available=True, reason=None)
         if not info["python"].exists():
@@ -470,8 +518,11 @@ def main():
                 print(f"  {name}: not run ({failure})", flush=True)
             else:
                 results[name] = {set_name: scored[set_name] for set_name in SET_NAMES}
+                info["setup_ms"] = scored.get("setup_ms")
                 if "tracking" in scored:
                     tracking[name] = scored["tracking"]
+                if "subcatalog" in scored:
+                    subcatalog[name] = scored["subcatalog"]
         solvers[name] = {key: (os.path.relpath(value, HERE.parent) if isinstance(value, Path) else value)
                          for key, value in info.items()}
 
@@ -481,14 +532,16 @@ def main():
           f"success/false over all frames; errors of the successes [arcsec]; solve ms of the solver call")
     print_tables(results, tracking, solvers, SET_NAMES)
     print(f"({REFERENCE}: every true star centroid with its true HIP, SVD refit -- the accuracy reference, not a solver)")
-    goals = evaluate_goals(results, tracking)
+    if "startrack" in subcatalog:
+        print_subcatalog(subcatalog["startrack"], results["startrack"]["main"]["solve_ms"]["median"])
+    goals = evaluate_goals(results, tracking, subcatalog.get("startrack"))
     if goals:
-        print("\ngoals (issue 6) for startrack:")
+        print("\ngoals (issues 6 and 17) for startrack:")
         for goal in goals:
             state = "met" if goal["met"] else f"NOT met, short by {goal['shortfall']:.4g}"
             print(f"  {goal['goal']}: measured {goal['measured']:.4g} vs {goal['target']:.4g} -> {state}")
     output = {
-        "benchmark": "star identification, startrack vs cedar-solve vs tetra3rs (issue 6)",
+        "benchmark": "star identification, startrack vs cedar-solve vs tetra3rs (issues 6 and 17)",
         "utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "machine": {"python": platform.python_version(), "platform": platform.platform(),
                     "cpus": os.cpu_count()},
@@ -504,6 +557,7 @@ def main():
         "solvers": solvers,
         "results": results,
         "tracking": tracking,
+        "subcatalog": subcatalog,
         "goals": goals,
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)

@@ -21,7 +21,7 @@ clean 0 / 0, stress 0-10 / 0-5.  Frame ``k`` of a set draws from child ``k`` of
 ``SeedSequence([seed, set index])`` (spawn key ``(k,)``), so it is the same whatever the number of frames.
 
 Tracking priors: the truth attitude turned by a fixed angle (0.5, 1, 2, 5, 7 deg) about a
-uniformly random axis, q_prior = q_IS (x) exp(angle axis) (body-axis error as in DESIGN.md).
+uniformly random axis, q_prior = q_IS (x) exp(angle axis) (body-axis error as in docs/design.md).
 
 JSON Lines, one frame per line::
 
@@ -45,8 +45,8 @@ from scipy.spatial.transform import Rotation
 from startrack.attitude_angles import radec_roll_from_quaternion
 from startrack.camera import Camera
 from startrack.star_catalog import StarCatalog, load_star_catalog
+from startrack.units import DEG
 
-DEG = np.pi / 180.0
 
 FOV_DEG = 16.0
 WIDTH_PX = 1024

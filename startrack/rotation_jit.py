@@ -1,6 +1,6 @@
-"""Compiled twin of :mod:`startrack.rotation` for one quaternion / vector at a time (numba), used
-inside the compiled filter and identification loops. Same convention and the same numbers; each
-function is tested against its vectorised counterpart."""
+"""Compiled twin of :mod:`startrack.rotation` for one quaternion / vector / attitude profile at a time
+(numba), used inside the compiled filter and identification loops. Same convention and the same
+numbers; each function is tested against its vectorised counterpart."""
 
 import numpy as np
 
@@ -82,3 +82,87 @@ def skew(v):
     S[2, 0] = -v[1]
     S[2, 1] = v[0]
     return S
+
+
+@njit
+def _symmetric_eigen(M):
+    """(eigenvalues (3,), eigenvectors (3, 3) as columns) of a symmetric 3x3 matrix by cyclic Jacobi sweeps."""
+    A = M.copy()
+    V = np.eye(3)
+    for _ in range(64):
+        off = A[0, 1] ** 2 + A[0, 2] ** 2 + A[1, 2] ** 2
+        if off <= 1e-34 * (A[0, 0] ** 2 + A[1, 1] ** 2 + A[2, 2] ** 2):
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            if A[p, q] == 0.0:
+                continue
+            theta = (A[q, q] - A[p, p]) / (2.0 * A[p, q])
+            t = 1.0 / (theta + np.sqrt(theta * theta + 1.0)) if theta >= 0.0 else -1.0 / (-theta + np.sqrt(theta * theta + 1.0))
+            c = 1.0 / np.sqrt(t * t + 1.0)
+            s = t * c
+            for k in range(3):
+                a_kp, a_kq = A[k, p], A[k, q]
+                A[k, p], A[k, q] = c * a_kp - s * a_kq, s * a_kp + c * a_kq
+            for k in range(3):
+                a_pk, a_qk = A[p, k], A[q, k]
+                A[p, k], A[q, k] = c * a_pk - s * a_qk, s * a_pk + c * a_qk
+            for k in range(3):
+                v_kp, v_kq = V[k, p], V[k, q]
+                V[k, p], V[k, q] = c * v_kp - s * v_kq, s * v_kp + c * v_kq
+    return np.array([A[0, 0], A[1, 1], A[2, 2]]), V
+
+
+@njit
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit
+def _unit(a):
+    return a / np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit
+def _apply(M, a):
+    return np.array([_dot(M[0], a), _dot(M[1], a), _dot(M[2], a)])
+
+
+@njit
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit
+def wahba_svd(ref_I, obs_S):
+    """R_IS (3, 3) minimising sum |obs_i - R_IS^T ref_i|^2, equal weights (SVD, Markley 1988): the
+    compiled twin of :func:`startrack.rotation.nearest_rotation` of the transposed attitude profile.
+
+    B = sum obs_i ref_i^T = U S V^T and A = U diag(1, 1, det U det V) V^T (I -> S), R_IS = A^T: the
+    solution of :class:`startrack.attitude.SvdWahba` (used for every fit inside the identification).
+    The SVD of the 3x3 B comes from the symmetric eigenproblem B^T B = V S^2 V^T (Jacobi sweeps):
+    u_i = B v_i / s_i for the two largest s_i, and v_3 = v_1 x v_2, u_3 = u_1 x u_2, which is exactly
+    the determinant correction of Markley's formula.  Needs two non-parallel stars.
+    """
+    B = np.zeros((3, 3))
+    for n in range(obs_S.shape[0]):
+        for r in range(3):
+            for c in range(3):
+                B[r, c] += obs_S[n, r] * ref_I[n, c]
+    BtB = np.zeros((3, 3))
+    for r in range(3):
+        for c in range(3):
+            BtB[r, c] = B[0, r] * B[0, c] + B[1, r] * B[1, c] + B[2, r] * B[2, c]
+    eigenvalues, V = _symmetric_eigen(BtB)
+    order = np.argsort(-eigenvalues)
+    v1 = V[:, order[0]].copy()
+    v2 = _unit(V[:, order[1]] - _dot(V[:, order[1]], v1) * v1)
+    v3 = _cross(v1, v2)
+    u1 = _unit(_apply(B, v1))
+    u2 = _apply(B, v2)
+    u2 = _unit(u2 - _dot(u2, u1) * u1)
+    u3 = _cross(u1, u2)
+    R_IS = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            R_IS[r, c] = v1[r] * u1[c] + v2[r] * u2[c] + v3[r] * u3[c]  # (U V^T)^T = V U^T
+    return R_IS

@@ -19,11 +19,12 @@ which R_IS = [-j, -k, i] (columns: sensor x, y, z in ICRS).
 import hashlib
 import logging
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
-from runner_io import common_arguments, nearest_indices, read_frames, run_frames, timed
+from runner_io import common_arguments, nearest_indices, read_frames, run_frames, timed, write_meta
 
 
 def cedar_axes_to_R_IS(ra_deg, dec_deg, roll_deg):
@@ -58,7 +59,9 @@ def main():
     from tetra3 import tetra3 as cedar
 
     logging.getLogger("tetra3").setLevel(logging.WARNING)
+    start = time.perf_counter()
     solver = load_or_build_database(tetra3, args.catalog, args.work, args.fov_deg, args.mag)
+    write_meta(args.out, setup_ms=1e3 * (time.perf_counter() - start))
     logging.getLogger("tetra3.Tetra3").setLevel(logging.WARNING)
     for handler in logging.getLogger("tetra3.Tetra3").handlers:
         handler.setLevel(logging.WARNING)

@@ -9,7 +9,7 @@ and writes one result per frame, JSON Lines::
      frame has a prior), "method": the solver's strategy that answered (or null), "reason": text
      (status "error" only)}
 
-``q_IS`` is scalar-last and rotates sensor-frame vectors into ICRS (DESIGN.md); sensor frame
+``q_IS`` is scalar-last and rotates sensor-frame vectors into ICRS (docs/design.md); sensor frame
 +x along image columns, +y along rows (down), +z boresight.  ``solve_ms`` is the wall-clock time
 of the solver call alone, measured the same way for every solver (:func:`timed`).
 """
@@ -102,6 +102,13 @@ def run_frames(frames, solve, out_path, progress_label):
             out.write(json.dumps(record) + "\n")
             if (n + 1) % 250 == 0:
                 print(f"  {progress_label}: {n + 1}/{len(frames)} frames", flush=True)
+
+
+def write_meta(out_path, **fields):
+    """Write ``fields`` (e.g. ``setup_ms``: database or kernel loading, timed apart from the solves) to
+    ``<out_path>.meta.json`` beside the results."""
+    with open(str(out_path) + ".meta.json", "w") as stream:
+        json.dump(fields, stream)
 
 
 def nearest_indices(points, targets):

@@ -22,11 +22,12 @@ R_IS = rotation_matrix_icrs_to_camera^T.
 
 import hashlib
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
-from runner_io import common_arguments, read_frames, run_frames, timed
+from runner_io import common_arguments, read_frames, run_frames, timed, write_meta
 
 
 def load_or_build_database(tetra3rs, catalog, work, fov_deg, mag):
@@ -54,7 +55,9 @@ def main():
     args = parser.parse_args()
     import tetra3rs
 
+    start = time.perf_counter()
     database = load_or_build_database(tetra3rs, args.catalog, args.work, args.fov_deg, args.mag)
+    write_meta(args.out, setup_ms=1e3 * (time.perf_counter() - start))
     centre = np.array([(args.width - 1) / 2.0, (args.height - 1) / 2.0])
     options = dict(fov_estimate_deg=args.fov_deg, fov_max_error_deg=args.fov_max_error_deg,
                    image_width=args.width, image_height=args.height)

@@ -45,8 +45,8 @@ from startrack.render import SensorModel, Sources, Windows, expected_charge, ren
 from startrack.sphere import angular_distance, radec_to_vector  # noqa: E402
 from startrack.stacking import DimStarCache  # noqa: E402
 from startrack.star_catalog import load_star_catalog  # noqa: E402
+from startrack.units import DEG  # noqa: E402
 
-DEG = np.pi / 180.0
 ARCMIN = DEG / 60.0
 OUT = Path(__file__).resolve().parents[1] / "out"
 

@@ -41,9 +41,8 @@ from startrack.identify.simulate import centroid_frame  # noqa: E402
 from startrack.navigation_catalog import load_navigation_catalog  # noqa: E402
 from startrack.sphere import vector_to_radec  # noqa: E402
 from startrack.star_catalog import load_star_catalog  # noqa: E402
+from startrack.units import ARCSEC, DEG  # noqa: E402
 
-DEG = math.pi / 180.0
-ARCSEC = DEG / 3600.0
 AXIS = np.array([math.sqrt(2.0) / 2.0, 0.5, 0.5])
 FRAME_PERIOD_S = 0.5
 SIGMA_PX = 1.0 / math.sqrt(2.0)  # angular distance error ~ 1 px

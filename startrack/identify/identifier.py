@@ -1,4 +1,4 @@
-"""The star identifier: one call per frame, strategies tried in the order of DESIGN.md's closed loop.
+"""The star identifier: one call per frame, strategies tried in the order of docs/design.md's closed loop.
 
 ``StarIdentifier(catalog, camera, ...)`` holds the navigation catalog (guide stars, pattern pairs,
 k-vector, sub-catalogs), the field stars used for verification (every Hipparcos star to the
@@ -7,8 +7,15 @@ catalog's magnitude limit) and three strategies, each an object with ``identify(
 * :class:`~startrack.identify.tracking.Tracking` -- needs ``prior.q_IS`` (and optionally a rate);
 * :class:`~startrack.identify.subcatalog.SubCatalog` -- needs a prior boresight (from ``prior.q_IS``
   or ``prior.boresight``);
-* :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing; searches the guide catalog,
-  then (``dense_fallback``) the pairs of every field star.
+* :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing; searches the pairs of every
+  field star (``dense_fallback``, the default) or of the guide catalog.
+
+Each strategy is one compiled call per frame (:mod:`startrack.identify.pyramid`: feature search,
+hypotheses, verification and refit); the Python layer checks the input, orders the centroids and
+turns them into directions (one compiled call), and builds the result.  Profile of the full-sky call
+on the benchmark frames (16 deg, ~30 centroids, warm, median): ~13 us Python (input, result),
+~25 us compiled, of which ~8 us verification (two match/refit passes) and ~3 us features; before
+issue 17 the same call took ~180 us, ~60 us of it in Python orchestration of several kernels.
 
 ``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
 vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
@@ -18,20 +25,24 @@ reason); a wrong configuration raises :class:`startrack.errors.InputError` at co
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.attitude_angles import radec_roll_from_matrix
 from startrack.errors import InputError
-from startrack.identify.features import FrameFeatures
-from startrack.identify.lost_in_space import LostInSpace, PairTable, PatternMatcher
+from startrack.identify.context import SearchContext
+from startrack.identify.features import (ALL_OUTSIDE, BAD_COORDINATE, BAD_FLUX, DIRECTIONS_OK, FrameFeatures,
+                                         brightest_first, centroid_directions)
+from startrack.identify.lost_in_space import LostInSpace
 from startrack.identify.result import IdentificationResult
 from startrack.identify.subcatalog import SubCatalog
 from startrack.identify.tracking import Tracking, propagate
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
+from startrack.identify.warmup import load_kernels
+from startrack.jit import njit
 from startrack.rotation import from_matrix
 
 #: Strategy names in the order they are tried.
@@ -71,11 +82,18 @@ class Prior:
                                            or abs(self.boresight[1]) > math.pi / 2):
             raise InputError(f"prior boresight must be (ra, dec) in rad with |dec| <= pi/2; got {self.boresight!r}.")
 
+    @functools.cached_property
+    def predicted_R_IS(self):
+        """R_IS (3, 3) predicted at the frame (the prior propagated by ``rate_S`` over ``dt``), or None."""
+        if self.q_IS is None:
+            return None
+        return propagate(self.q_IS, _NO_RATE if self.rate_S is None else self.rate_S, float(self.dt))
+
     def boresight_radec(self):
         """(ra, dec) [rad] of the predicted boresight, or None."""
         if self.q_IS is not None:
-            ra, dec, _ = radec_roll_from_matrix(propagate(self.q_IS, self.rate_S, self.dt))
-            return float(ra), float(dec)
+            x, y, z = self.predicted_R_IS[:, 2].tolist()
+            return math.atan2(y, x) % (2.0 * math.pi), math.asin(max(-1.0, min(1.0, z)))
         if self.boresight is not None:
             return float(self.boresight[0]), float(self.boresight[1])
         return None
@@ -94,29 +112,30 @@ class StarIdentifier:
     catalog: :class:`startrack.navigation_catalog.NavigationCatalog`; camera: :class:`startrack.camera.Camera`;
     centroid_sigma_px: centroid noise per axis [px] (covariance and gates); delta_sigmas: the error
     bound delta of 001 §4.3.1 in units of it (3); gate_sigmas: verification match radius in units of it
-    (5); pattern_stars: brightest centroids searched first (16, at most 31; then twice as many); max_stars: centroids used at all
-    (None: all); max_groups: four-star groups searched for (4); max_triangles: triangles kept for frames
-    without a group (8); false_match_threshold: acceptance threshold
-    (1e-6); tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
+    (5); pattern_stars: brightest centroids searched first (16, at most 31; then twice as many); max_stars:
+    centroids used at all (None: all); false_match_threshold: acceptance threshold (1e-6);
+    tracking_window_px: tracking window radius (20 px); methods: strategies tried, a subset of
     :data:`METHODS`; neighbours: search the 4 redundant sub-catalogs; field_stars: a
     :class:`~startrack.identify.verify.FieldStars` (default: every Hipparcos star with V <= field_mag_limit,
-    by default the catalog's magnitude limit); dense_fallback: when the guide catalog finds nothing,
-    search the pairs of every field star (lost-in-space only; built at construction, ~0.2 s).
+    by default the catalog's magnitude limit); dense_fallback: also search the pairs of every field star
+    when the guide catalog finds nothing (built at construction, ~0.2 s).
+
+    Construction loads (or compiles, once per machine) every kernel by solving a synthetic frame with
+    each strategy, so that no solve pays for it; :attr:`load_ms` is the time that took [ms].
     """
 
     def __init__(self, catalog, camera, centroid_sigma_px=0.2, delta_sigmas=3.0, gate_sigmas=5.0,
-                 pattern_stars=16, max_stars=None, max_groups=4, max_triangles=8,
-                 false_match_threshold=DEFAULT_FALSE_MATCH_THRESHOLD, tracking_window_px=20.0,
-                 methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None, dense_fallback=True):
+                 pattern_stars=16, max_stars=None, false_match_threshold=DEFAULT_FALSE_MATCH_THRESHOLD,
+                 tracking_window_px=20.0, methods=METHODS, neighbours=True, field_stars=None, field_mag_limit=None,
+                 dense_fallback=True):
         self.catalog = catalog
         self.camera = camera
         self.centroid_sigma_px = _positive("centroid_sigma_px", centroid_sigma_px, 100.0)
         self.delta_px = _positive("delta_sigmas", delta_sigmas, 100.0) * self.centroid_sigma_px
         self.verify_gate = _positive("gate_sigmas", gate_sigmas, 100.0) * self.centroid_sigma_px / camera.focal_px
-        for name, value, least, most in (("pattern_stars", pattern_stars, 4, 31), ("max_groups", max_groups, 1, 10**4),
-                                         ("max_triangles", max_triangles, 1, 10**4)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not least <= value <= most:
-                raise InputError(f"star identifier option {name} = {value!r} must be an integer in [{least}, {most}].")
+        if isinstance(pattern_stars, bool) or not isinstance(pattern_stars, (int, np.integer)) \
+                or not 4 <= pattern_stars <= 31:
+            raise InputError(f"star identifier option pattern_stars = {pattern_stars!r} must be an integer in [4, 31].")
         if max_stars is not None and (isinstance(max_stars, bool) or not isinstance(max_stars, (int, np.integer))
                                       or max_stars < 3):
             raise InputError(f"star identifier option max_stars = {max_stars!r} must be an integer >= 3 or None.")
@@ -133,21 +152,20 @@ class StarIdentifier:
                 catalog, camera, load_star_catalog(catalog.params.epoch),
                 catalog.params.mag_limit if field_mag_limit is None else _positive("field_mag_limit", field_mag_limit, 20.0))
         self.field = field_stars
-        matcher = PatternMatcher(catalog.guide_vectors, self.field, self.pattern_stars, int(max_groups),
-                                 int(max_triangles), self.false_match_threshold)
-        dense = None
-        if dense_fallback and ("lost_in_space" in methods or "subcatalog" in methods):
-            dense = (PatternMatcher(self.field.vectors, self.field, self.pattern_stars, int(max_groups),
-                                    int(max_triangles), self.false_match_threshold),
-                     PairTable.of_stars(self.field.vectors, catalog.params.theta_min, catalog.params.theta_max))
+        window_px = _positive("tracking_window_px", tracking_window_px, 1e4)
+        context = SearchContext(catalog, self.field, self.pattern_stars, self.verify_gate, self.false_match_threshold,
+                                self.centroid_sigma_px / camera.focal_px, dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
         available = {
-            "tracking": Tracking(self.field, _positive("tracking_window_px", tracking_window_px, 1e4),
-                                 self.false_match_threshold),
-            "subcatalog": SubCatalog(catalog, matcher, neighbours, dense),
-            "lost_in_space": LostInSpace(catalog, matcher, dense),
+            "tracking": lambda: Tracking(context, window_px),
+            "subcatalog": lambda: SubCatalog(context, neighbours),
+            "lost_in_space": lambda: LostInSpace(context, context.dense),
         }
-        self.strategies = [available[m] for m in METHODS if m in methods]
-        self._image_max = np.array([camera.width - 0.5, camera.height - 0.5])
+        self.strategies = [available[m]() for m in METHODS if m in methods]
+        self._max_stars = -1 if self.max_stars is None else self.max_stars
+        self._sigma = self.centroid_sigma_px / camera.focal_px
+        start = time.perf_counter()
+        load_kernels(self)
+        self.load_ms = 1e3 * (time.perf_counter() - start)
 
     # ------------------------------------------------------------------ public calls
     def solve(self, uv, flux=None, prior: Prior | None = None) -> IdentificationResult:
@@ -156,24 +174,17 @@ class StarIdentifier:
         uv = _float_array(uv)
         if uv is None or uv.ndim != 2 or uv.shape[1] != 2:
             return _failed("error", "centroids must be an array of shape (n, 2) of numbers", start)
-        if not np.isfinite(uv).all():
-            return _failed("error", "a centroid coordinate is NaN or infinite", start)
-        inside = ((uv >= -0.5) & (uv <= self._image_max)).all(axis=1)
-        index = None if inside.all() else np.flatnonzero(inside)
-        if index is not None and index.size == 0 and uv.shape[0]:
-            cam = self.camera
-            return _failed("error", f"all {uv.shape[0]} centroids lie outside the {cam.width} x {cam.height} px sensor",
-                           start)
         flux = self._checked_flux(flux, uv.shape[0])
         if isinstance(flux, str):
             return _failed("error", flux, start)
-        if index is None:
-            index = np.arange(uv.shape[0])
-        else:
-            uv = uv[index]
-            flux = None if flux is None else flux[index]
-        obs_S = self.camera.unproject(uv) if uv.shape[0] else np.zeros((0, 3))
-        return self._solve(obs_S, index, flux, prior, start)
+        status, obs_S, index, beta, gate, filled = centroid_directions(
+            np.ascontiguousarray(uv), flux, self.field.camera_params, self._max_stars, 2 * self.pattern_stars)
+        if status != DIRECTIONS_OK:
+            return _failed("error", self._direction_errors[status].format(n=uv.shape[0]), start)
+        if len(obs_S) < 3:
+            return _too_few(len(obs_S), start)
+        return self._solve(FrameFeatures(obs_S, index, beta, gate, filled, self.camera.focal_px, self.delta_px,
+                                         self.verify_gate), prior, start)
 
     def solve_vectors(self, obs_S, flux=None, prior: Prior | None = None) -> IdentificationResult:
         """Identify directions ``obs_S`` (n, 3) in the sensor frame (normalised here), brightest first unless ``flux``."""
@@ -187,30 +198,37 @@ class StarIdentifier:
         flux = self._checked_flux(flux, obs.shape[0])
         if isinstance(flux, str):
             return _failed("error", flux, start)
-        return self._solve(obs / norms[:, None], np.arange(obs.shape[0]), flux, prior, start)
+        if not np.all(np.isfinite(flux)):
+            return _failed("error", "a flux value is NaN or infinite", start)
+        index = brightest_first(flux, obs.shape[0], self._max_stars)
+        if len(index) < 3:
+            return _too_few(len(index), start)
+        return self._solve(self.features(obs[index] / norms[index, None], index), prior, start)
 
     # ------------------------------------------------------------------ internals
     @staticmethod
     def _checked_flux(flux, n):
+        """``flux`` as a float array ((0,) when None), or the reason it cannot be one."""
         if flux is None:
-            return None
+            return _NO_FLUX
         flux = _float_array(flux)
         if flux is None or flux.shape != (n,):
             return f"flux must be one number per centroid ({n})"
-        if not np.all(np.isfinite(flux)):
-            return "a flux value is NaN or infinite"
-        return flux
+        return np.ascontiguousarray(flux)
 
-    def _solve(self, obs_S, index, flux, prior, start):
-        if flux is not None:
-            order = np.argsort(-flux, kind="stable")
-            obs_S, index = obs_S[order], index[order]
-        if self.max_stars is not None:
-            obs_S, index = obs_S[: self.max_stars], index[: self.max_stars]
-        if len(obs_S) < 3:
-            return _failed("too_few", f"{len(obs_S)} usable centroids; at least 3 are needed", start)
-        frame = FrameFeatures.build(obs_S, index, self.camera.focal_px, self.delta_px, self.verify_gate,
-                                    2 * self.pattern_stars)
+    @property
+    def _direction_errors(self):
+        cam = self.camera
+        return {BAD_COORDINATE: "a centroid coordinate is NaN or infinite", BAD_FLUX: "a flux value is NaN or infinite",
+                ALL_OUTSIDE: f"all {{n}} centroids lie outside the {cam.width} x {cam.height} px sensor"}
+
+    def features(self, obs_S, index) -> FrameFeatures:
+        """The frame's features for the search: ``obs_S`` (n, 3) directions brightest first, ``index`` their
+        positions in the caller's list."""
+        return FrameFeatures.build(obs_S, index, self.camera.focal_px, self.delta_px, self.verify_gate,
+                                   2 * self.pattern_stars, n_filled=0)
+
+    def _solve(self, frame, prior, start):
         for strategy in self.strategies:
             verified = strategy.identify(frame, prior)
             if verified is not None:
@@ -219,26 +237,41 @@ class StarIdentifier:
         return _failed("no_match", f"no star pattern was verified ({tried or 'no method applicable'})", start)
 
     def _result(self, frame, verified, strategy, prior, start):
-        centroid = frame.index[verified.obs_index]
-        order = np.argsort(centroid)
-        star_index = verified.star_index[order]
-        hip = self.field.hip[star_index]
+        matches, obs_S, ref_I = matched_stars(frame.index, frame.obs_S, verified.obs_index, verified.star_index,
+                                              self.field.hip, self.field.vectors)
         lost = entered = _NO_STARS
         if strategy.name == "tracking":
-            lost, entered = strategy.lost_and_entered(prior, verified.R_IS, hip)
+            lost, entered = strategy.lost_and_entered(prior, verified.R_IS, matches[:, 1])
         return IdentificationResult(
-            status="ok", q_IS=from_matrix(verified.R_IS),
-            matches=np.column_stack([centroid[order], hip]), obs_S=frame.obs_S[verified.obs_index[order]],
-            ref_I=self.field.vectors[star_index], sigma=self.centroid_sigma_px / self.camera.focal_px,
-            false_match_probability=verified.false_match_probability, method=strategy.name,
+            status="ok", q_IS=from_matrix(verified.R_IS), matches=matches, obs_S=obs_S, ref_I=ref_I,
+            sigma=self._sigma, false_match_probability=verified.false_match_probability, method=strategy.name,
             solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered)
 
 
+@njit
+def matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma: no cover  (compiled)
+    """(matches (M, 2) rows (centroid index, HIP), obs_S (M, 3), ref_I (M, 3)) ordered by centroid index."""
+    centroid = index[obs_index]
+    order = np.argsort(centroid)
+    matches = np.empty((order.size, 2), np.int64)
+    seen = np.empty((order.size, 3))
+    ref = np.empty((order.size, 3))
+    for m in range(order.size):
+        matches[m, 0], matches[m, 1] = centroid[order[m]], hip[star_index[order[m]]]
+        seen[m] = obs_S[obs_index[order[m]]]
+        ref[m] = vectors[star_index[order[m]]]
+    return matches, seen, ref
+
+
 _NO_STARS = np.zeros(0, np.int64)
+_NO_FLUX = np.zeros(0)
+_NO_RATE = np.zeros(3)
 
 
 def _float_array(value):
     """``value`` as a float array, or None when it is not numbers (text, ragged lists, objects)."""
+    if type(value) is np.ndarray and value.dtype == np.float64:
+        return value
     if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
         return value.astype(float, copy=False)
     try:
@@ -246,6 +279,10 @@ def _float_array(value):
     except (ValueError, TypeError):
         return None
     return array.astype(float) if array.dtype.kind in "biuf" else None
+
+
+def _too_few(n, start):
+    return _failed("too_few", f"{n} usable centroids; at least 3 are needed", start)
 
 
 def _failed(status, reason, start):

@@ -1,7 +1,7 @@
 """The result record of a star identification (one per frame).
 
 Angles are radians inside (``ra``, ``dec``, ``roll``, ``residuals``, ``covariance``); :meth:`to_dict`
-gives the JSON form of the ``startrack solve`` contract (DESIGN.md) with degrees and arcseconds.
+gives the JSON form of the ``startrack solve`` contract (docs/design.md) with degrees and arcseconds.
 """
 
 from __future__ import annotations

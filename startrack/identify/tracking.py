@@ -6,8 +6,8 @@ quaternion kinematics of 000 eq. 9 integrated exactly for a constant rate).  Eve
 then projects inside the image (grown by the window) is predicted; each centroid is matched to its
 nearest predicted star and back (one-to-one) if they lie within the tracking window; with three or
 more matches the attitude is refitted by SVD and verified like a lost-in-space hypothesis
-(:func:`startrack.identify.verify.verify` with the window as its first gate, one hypothesis -- the
-prior -- and no seed stars).  Stars entering the field are simply new predictions, stars
+(:func:`startrack.identify.verify.verify_near` with the window as its first gate, one hypothesis --
+the prior -- and no seed stars): one compiled call.  Stars entering the field are simply new predictions, stars
 leaving it drop out of the prediction; the stars tracked before that are predicted in the field but
 not found now are reported as lost.
 """
@@ -15,17 +15,25 @@ not found now are reported as lost.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from startrack.identify.verify import verify
+from startrack.identify.verify import verify_near
+from startrack.jit import njit
 
 
-def propagate(q_IS, rate_S, dt: float):
-    """R_IS (3, 3) at dt [s] after the attitude q_IS for the constant body rate rate_S [rad/s] (sensor axes)."""
-    rotation = Rotation.from_quat(q_IS)
-    if rate_S is not None and dt != 0.0:
-        rotation = rotation * Rotation.from_rotvec(np.asarray(rate_S, dtype=float) * dt)
-    return rotation.as_matrix()
+@njit
+def propagate(q_IS, rate_S, dt):  # pragma: no cover  (compiled)
+    """R_IS (3, 3) at dt [s] after the unit attitude q_IS (scalar-last) for the constant body rate rate_S
+    [rad/s] (sensor axes): R(q_IS) exp([rate_S x] dt), the exponential by Rodrigues' formula."""
+    x, y, z, w = q_IS
+    R = np.array([[1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+                  [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+                  [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
+    angle = np.sqrt(rate_S[0] ** 2 + rate_S[1] ** 2 + rate_S[2] ** 2) * abs(dt)
+    if angle == 0.0:
+        return R
+    k = rate_S * np.sign(dt) / (angle / abs(dt))
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return R @ (np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K))
 
 
 class Tracking:
@@ -33,18 +41,17 @@ class Tracking:
 
     name = "tracking"
 
-    def __init__(self, field, window_px: float, threshold: float):
-        self.field = field
+    def __init__(self, context, window_px: float):
+        self.context = context
+        self.field = context.field
         self.window_px = float(window_px)
-        self.threshold = threshold
+        self._field = context.with_first_gate(self.window_px / self.field.camera.focal_px)
 
     def identify(self, frame, prior):
         """Verified solution or None; needs ``prior.q_IS``."""
         if prior is None or prior.q_IS is None:
             return None
-        R_IS = propagate(prior.q_IS, prior.rate_S, prior.dt)
-        return verify(frame.obs_S, R_IS, self.field, frame.verify_gate, n_hypotheses=1, threshold=self.threshold,
-                      n_seed=0, first_gate=self.window_px / self.field.camera.focal_px)
+        return self.context.verified(verify_near(frame.obs_S, prior.predicted_R_IS, self._field, 1, 0))
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""

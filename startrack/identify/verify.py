@@ -26,7 +26,12 @@ gate, both orientations) can be fooled by any of them, hence (Bonferroni)
 
     P_false = min(1, N_h * P[Binomial(n_other, p) >= K]).
 
-A hypothesis is accepted when P_false <= threshold (default 1e-6).
+The radius is the one the matches reached: d_K, the largest angle between a matched centroid and its
+star after the final refit (never below the centroid noise sigma, never above the gate r).  P[Binomial
+(n_other, p(d)) >= K] is the probability that the K-th closest chance match lies within d, i.e. the
+exact tail of the observed order statistic, so it is as valid as the fixed gate and far sharper for
+frames with few stars (4 true stars among false ones: p(2 sigma) is 6x smaller than p(5 sigma) per
+star).  A hypothesis is accepted when P_false <= threshold (default 1e-6).
 """
 
 from __future__ import annotations
@@ -37,94 +42,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
+from startrack.rotation_jit import wahba_svd
 
 #: Default acceptance threshold of the false-match probability.
 DEFAULT_FALSE_MATCH_THRESHOLD = 1e-6
-
-
-@njit
-def _symmetric_eigen(M):  # pragma: no cover  (compiled)
-    """(eigenvalues (3,), eigenvectors (3, 3) as columns) of a symmetric 3x3 matrix by cyclic Jacobi sweeps."""
-    A = M.copy()
-    V = np.eye(3)
-    for _ in range(64):
-        off = A[0, 1] ** 2 + A[0, 2] ** 2 + A[1, 2] ** 2
-        if off <= 1e-34 * (A[0, 0] ** 2 + A[1, 1] ** 2 + A[2, 2] ** 2):
-            break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            if A[p, q] == 0.0:
-                continue
-            theta = (A[q, q] - A[p, p]) / (2.0 * A[p, q])
-            t = 1.0 / (theta + np.sqrt(theta * theta + 1.0)) if theta >= 0.0 else -1.0 / (-theta + np.sqrt(theta * theta + 1.0))
-            c = 1.0 / np.sqrt(t * t + 1.0)
-            s = t * c
-            for k in range(3):
-                a_kp, a_kq = A[k, p], A[k, q]
-                A[k, p], A[k, q] = c * a_kp - s * a_kq, s * a_kp + c * a_kq
-            for k in range(3):
-                a_pk, a_qk = A[p, k], A[q, k]
-                A[p, k], A[q, k] = c * a_pk - s * a_qk, s * a_pk + c * a_qk
-            for k in range(3):
-                v_kp, v_kq = V[k, p], V[k, q]
-                V[k, p], V[k, q] = c * v_kp - s * v_kq, s * v_kp + c * v_kq
-    return np.array([A[0, 0], A[1, 1], A[2, 2]]), V
-
-
-@njit
-def _dot(a, b):  # pragma: no cover  (compiled)
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-@njit
-def _unit(a):  # pragma: no cover  (compiled)
-    return a / np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-
-
-@njit
-def _apply(M, a):  # pragma: no cover  (compiled)
-    return np.array([_dot(M[0], a), _dot(M[1], a), _dot(M[2], a)])
-
-
-@njit
-def _cross(a, b):  # pragma: no cover  (compiled)
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit
-def wahba_svd(ref_I, obs_S):  # pragma: no cover  (compiled)
-    """R_IS (3, 3) minimising sum |obs_i - R_IS^T ref_i|^2, equal weights (SVD, Markley 1988).
-
-    B = sum obs_i ref_i^T = U S V^T and A = U diag(1, 1, det U det V) V^T (I -> S), R_IS = A^T: the
-    solution of :class:`startrack.attitude.SvdWahba` (used for every fit inside the identification).
-    The SVD of the 3x3 B comes from the symmetric eigenproblem B^T B = V S^2 V^T (Jacobi sweeps):
-    u_i = B v_i / s_i for the two largest s_i, and v_3 = v_1 x v_2, u_3 = u_1 x u_2, which is exactly
-    the determinant correction of Markley's formula.  Needs two non-parallel stars.
-    """
-    B = np.zeros((3, 3))
-    for n in range(obs_S.shape[0]):
-        for r in range(3):
-            for c in range(3):
-                B[r, c] += obs_S[n, r] * ref_I[n, c]
-    BtB = np.zeros((3, 3))
-    for r in range(3):
-        for c in range(3):
-            BtB[r, c] = B[0, r] * B[0, c] + B[1, r] * B[1, c] + B[2, r] * B[2, c]
-    eigenvalues, V = _symmetric_eigen(BtB)
-    order = np.argsort(-eigenvalues)
-    v1 = V[:, order[0]].copy()
-    v2 = _unit(V[:, order[1]] - _dot(V[:, order[1]], v1) * v1)
-    v3 = _cross(v1, v2)
-    u1 = _unit(_apply(B, v1))
-    u2 = _apply(B, v2)
-    u2 = _unit(u2 - _dot(u2, u1) * u1)
-    u3 = _cross(u1, u2)
-    R_IS = np.empty((3, 3))
-    for r in range(3):
-        for c in range(3):
-            R_IS[r, c] = v1[r] * u1[c] + v2[r] * u2[c] + v3[r] * u3[c]  # (U V^T)^T = V U^T
-    return R_IS
 
 
 @njit
@@ -161,40 +85,55 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
 
 
 @njit
-def verify_near(obs_S, field_vectors, R_IS, cos_field_radius, camera_params, pass_gates, focal_px, solid_angle,
-                n_hypotheses, threshold, n_seed):  # pragma: no cover  (compiled)
-    """:func:`verify` in one compiled call, the field stars taken by brute force (all within the field
-    radius of the boresight, ``cos_field_radius`` its cosine); returns (ok, R_IS, obs indices, star
-    indices into ``field_vectors``, P_false, stars predicted in the field)."""
-    boresight = R_IS[:, 2].copy()
-    near = np.empty(field_vectors.shape[0], np.int64)
-    count = 0
-    for s in range(field_vectors.shape[0]):
-        if (field_vectors[s, 0] * boresight[0] + field_vectors[s, 1] * boresight[1]
-                + field_vectors[s, 2] * boresight[2]) >= cos_field_radius:
-            near[count] = s
-            count += 1
-    near = near[:count]
-    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
-        obs_S, field_vectors[near], R_IS, camera_params, pass_gates, focal_px)
+def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  (compiled)
+    """Verification (module text) of the attitude hypothesis R_IS for the centroid directions ``obs_S``
+    (n, 3) in one compiled call.  ``field`` = (vectors, zone index (:mod:`startrack.identify.zones`),
+    radius [rad] around the boresight holding every star the image can show, camera parameters, pass
+    gates [rad], f [px], field solid angle [sr], threshold, centroid noise sigma [rad]); ``n_seed`` stars
+    seeded the hypothesis, ``n_hypotheses`` N_h.  Returns (ok, R_IS, obs indices, star indices into
+    the vectors, P_false, stars predicted in the field)."""
+    vectors, zones, radius, camera_params, pass_gates, focal_px, solid_angle, threshold, sigma = field
+    near = np.empty(vectors.shape[0], np.int64)
+    near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), radius, near)]
+    stars = vectors[near]
+    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(obs_S, stars, R_IS, camera_params, pass_gates,
+                                                                   focal_px)
     if not ok:
         return False, R_IS, obs_index, star_index, 1.0, n_predicted
+    reached = 1.0
+    for m in range(obs_index.size):  # cosine of the largest residual
+        star = stars[star_index[m]]
+        cosine = 0.0
+        for c in range(3):
+            cosine += (star[0] * R_IS[0, c] + star[1] * R_IS[1, c] + star[2] * R_IS[2, c]) * obs_S[obs_index[m], c]
+        reached = min(reached, cosine)
+    gate = min(max(np.arccos(min(reached, 1.0)), sigma), pass_gates[-1])
     probability = false_match_probability(max(obs_S.shape[0] - n_seed, 0), max(obs_index.size - n_seed, 0),
-                                          pass_gates[-1], max(n_predicted, 1) / solid_angle, n_hypotheses)
+                                          gate, max(n_predicted, 1) / solid_angle, n_hypotheses)
     return probability <= threshold, R_IS, obs_index, near[star_index], probability, n_predicted
 
 
 @njit
 def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
-    """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [rad]."""
+    """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [rad].
+
+    Only pairs whose x components differ by at most the chord of the gate, 2 sin(gate / 2), can lie
+    within it; the predictions are sorted by x and each centroid compares those in its window.  A
+    nearest neighbour outside the window lies outside the gate, so the matches are those of the
+    comparison of every pair.
+    """
     n, m = obs_S.shape[0], pred_S.shape[0]
     cos_gate = np.cos(gate)
+    width = 2.0 * np.sin(0.5 * min(gate, np.pi)) * (1.0 + 1e-12)
+    order = np.argsort(pred_S[:, 0])
+    x = pred_S[order, 0]
     best_pred = np.full(n, -1, np.int64)
     best_pred_cos = np.full(n, -2.0)
     best_obs = np.full(m, -1, np.int64)
     best_obs_cos = np.full(m, -2.0)
     for i in range(n):
-        for j in range(m):
+        for e in range(np.searchsorted(x, obs_S[i, 0] - width), np.searchsorted(x, obs_S[i, 0] + width, side="right")):
+            j = order[e]
             c = obs_S[i, 0] * pred_S[j, 0] + obs_S[i, 1] * pred_S[j, 1] + obs_S[i, 2] * pred_S[j, 2]
             if c > best_pred_cos[i]:
                 best_pred_cos[i] = c
@@ -257,8 +196,8 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
 
     Each pass predicts with the field grown by its gate, matches, and refits with every match; the
     final gate is repeated (up to ``_EXTRA_PASSES`` times) while it adds stars, since a first fit from
-    a few stars may leave distant ones outside the gate; a last check drops matches outside the final
-    gate and refits.  Returns (ok, R_IS, obs indices, star
+    a few stars may leave distant ones outside the gate; once every centroid is matched no further
+    pass is made; a last check drops matches outside the final gate and refits.  Returns (ok, R_IS, obs indices, star
     indices, number of stars predicted in the field); ok is False below 3 matches.
     """
     empty = np.zeros(0, np.int64)
@@ -276,8 +215,9 @@ def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px): 
             return False, R_IS, empty, empty, n_predicted
         star_index = index[pred_index]
         R_IS = wahba_svd(stars_I[star_index], obs_S[obs_index])
-        if p >= pass_gates.size - 1 and obs_index.size <= previous:
-            break  # the final gate no longer adds stars
+        if obs_index.size == obs_S.shape[0] or (p >= pass_gates.size - 1 and obs_index.size <= previous):
+            break  # every centroid matched (later passes could only drop some, as the last check does), or
+            # the final gate no longer adds stars
     cos_gate = np.cos(pass_gates[-1])
     keep = np.empty(obs_index.size, np.bool_)
     for m in range(obs_index.size):
@@ -335,7 +275,8 @@ class FieldStars:
         self.hip = np.asarray(hip, dtype=np.int64)
         self.v_mag = np.asarray(v_mag, dtype=float)
         self.field_radius = _field_radius(camera)
-        self.cos_field_radius = math.cos(self.field_radius + _FIELD_MARGIN)  # brute-force neighbourhood of verify_near
+        self.search_radius = self.field_radius + _FIELD_MARGIN  # the stars verify_near projects
+        self.zones = zone_index(self.vectors)
         self.solid_angle = _field_solid_angle(camera)
         radius = self.field_radius + catalog.s_max
         pairs = cKDTree(catalog.base_vectors).sparse_distance_matrix(
@@ -387,26 +328,3 @@ class Verified:
     star_index: np.ndarray
     false_match_probability: float
     n_predicted: int
-
-
-def verify(obs_S, R_IS, field: FieldStars, gate: float, n_hypotheses: int, threshold: float,
-           n_seed: int = 2, first_gate: float | None = None):
-    """Verify the attitude hypothesis R_IS for the centroid directions obs_S (n, 3); a :class:`Verified` or None.
-
-    Matches in passes with the gates ``first_gate`` (if given, e.g. a tracking window), 3 r and r
-    [rad], refitting by SVD after each (:func:`match_and_refit`), and accepts when P_false <=
-    ``threshold`` (module model; ``n_seed`` stars seeded the hypothesis; ``n_hypotheses`` N_h).
-    """
-    cell = field.cell(R_IS[:, 2])
-    gates = np.array([3.0 * gate, gate] if first_gate is None else [first_gate, 3.0 * gate, gate])
-    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(
-        obs_S, field.vectors[cell], np.ascontiguousarray(R_IS), field.camera_params, gates, field.camera.focal_px)
-    if not ok:
-        return None
-    probability = false_match_probability(
-        n_other=max(len(obs_S) - n_seed, 0), n_matched_other=max(int(obs_index.size) - n_seed, 0), gate=gate,
-        density=max(n_predicted, 1) / field.solid_angle, n_hypotheses=n_hypotheses)
-    if not probability <= threshold:
-        return None
-    return Verified(R_IS=R_IS, obs_index=obs_index, star_index=cell[star_index],
-                    false_match_probability=probability, n_predicted=int(n_predicted))

@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from startrack.camera import Camera
 from startrack.identify import Prior, StarIdentifier
+from startrack.identify.pairs import SubCatalogPairs
 from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.navigation_catalog import load_navigation_catalog
 from startrack.sphere import vector_to_radec
@@ -70,17 +71,32 @@ def test_far_prior_falls_back_to_the_full_sky(setup):
     assert only_sub.solve(frame.uv, frame.flux).status == "no_match"  # no prior: nothing to search
 
 
-def test_regional_table_holds_exactly_the_field_pairs_near_the_cell(setup):
-    """The regional fall-back table gathered through the near stars' pairs equals a pass over every
-    pair of the dense table (both stars within 2 rho_sub of the base point), in distance order."""
-    catalog, camera, _ = setup
-    sub = StarIdentifier(catalog, camera, methods=("subcatalog",)).strategies[0]
-    matcher, table = sub.dense
+def test_sub_catalog_tables_hold_exactly_its_pairs(setup):
+    """The contiguous per-sub-catalog tables the search reads are the sub-catalog's pattern pairs of 000 §2.3
+    (distances in single precision: within 1.5e-8 rad (3 mas), far inside any gate)."""
+    catalog, _, _ = setup
+    tables = SubCatalogPairs(catalog)
     for b in (0, 137, len(catalog.base_vectors) // 2, len(catalog.base_vectors) - 1):
-        near = matcher.guide_vectors @ catalog.base_vectors[b] >= np.cos(2.0 * catalog.rho_sub)
-        expected = np.flatnonzero(near[table.first] & near[table.second])
-        regional = sub._regional_table(b)
-        np.testing.assert_array_equal(regional.theta, table.theta[expected])
-        np.testing.assert_array_equal(regional.first, table.first[expected])
-        np.testing.assert_array_equal(regional.second, table.second[expected])
-        assert len(expected) > 0
+        pairs = catalog.sub_catalog_pairs(b)
+        theta, first, second = tables.arrays(b)[:3]
+        np.testing.assert_allclose(theta, catalog.pair_theta[pairs], rtol=0, atol=2e-8)  # [rad], single precision
+        np.testing.assert_array_equal(first, catalog.pair_i[pairs])
+        np.testing.assert_array_equal(second, catalog.pair_j[pairs])
+        assert np.all(np.diff(theta) >= 0.0) and len(pairs) > 0
+
+
+def test_frames_with_two_guide_stars_are_found_in_the_region(setup):
+    """Keep only 2 guide stars of each frame: no sub-catalog can identify it; the field stars within
+    2 rho_sub of the predicted boresight can, with no full-sky search."""
+    catalog, camera, stars = setup
+    identifier = StarIdentifier(catalog, camera, centroid_sigma_px=0.2, methods=("subcatalog",))
+    guide = set(catalog.guide_hip.tolist())
+    rng = np.random.default_rng(23)
+    for _ in range(5):
+        frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, 0.2, n_false=2)
+        is_guide = np.array([h in guide for h in frame.hip])
+        keep = ~is_guide | (np.cumsum(is_guide) <= 2)
+        prior = Prior(boresight=_disturbed_boresight(frame.q_IS, 3.0 * DEG, rng))
+        result = identifier.solve(frame.uv[keep], frame.flux[keep], prior)
+        assert result.ok and result.method == "subcatalog", result.reason
+        np.testing.assert_array_equal(frame.hip[keep][result.matches[:, 0]], result.matches[:, 1])

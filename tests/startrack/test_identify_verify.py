@@ -9,7 +9,7 @@ from scipy.stats import binom
 
 from startrack.attitude import SvdWahba
 from startrack.camera import Camera
-from startrack.identify.lost_in_space import PairTable
+from startrack.identify.pairs import PairTable, kvector_range, pair_range
 from startrack.identify.verify import (FieldStars, binomial_tail, false_match_probability, match_nearest,
                                        wahba_svd)
 from startrack.navigation_catalog import load_navigation_catalog
@@ -95,12 +95,11 @@ def test_close_pairs_are_left_out_of_the_field_stars(catalog):
 
 def test_kvector_ranges_contain_the_exact_ranges(catalog):
     table = PairTable.full_sky(catalog)
-    from startrack.identify.lost_in_space import _pair_range
-
     rng = np.random.default_rng(9)
     for _ in range(200):
         low = rng.uniform(0.0, 0.3)
         high = low + rng.uniform(0.0, 3e-3)
-        lo, hi = _pair_range(table.theta, table.k, table.slope, table.intercept, low, high)
+        lo, hi = kvector_range(table.theta, table.k, table.slope, table.intercept, low, high)
         exact_lo, exact_hi = np.searchsorted(table.theta, low), np.searchsorted(table.theta, high, "right")
         assert lo <= exact_lo and hi >= exact_hi and hi - lo <= exact_hi - exact_lo + 16  # a bucket or two each side
+        assert pair_range(table.arrays, low, high) == (exact_lo, exact_hi)

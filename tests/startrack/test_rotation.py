@@ -77,3 +77,14 @@ def test_shepperd_at_180_degrees(axis):
     q = np.zeros(4)
     q[axis] = 1.0
     np.testing.assert_allclose(np.abs(rot.from_matrix(rot.to_matrix(q))), q, atol=1e-15)
+
+
+def test_compiled_wahba_svd_is_the_nearest_rotation_of_the_attitude_profile():
+    """rotation_jit.wahba_svd (Jacobi eigen-decomposition) equals the numpy SVD solution R_IS =
+    nearest_rotation(Bᵀ), B = Σ obs_i ref_iᵀ, for noisy star sets."""
+    R_IS = Rotation.random(20, random_state=5).as_matrix()
+    for R in R_IS:
+        ref = RNG.standard_normal((6, 3))
+        ref /= np.linalg.norm(ref, axis=1, keepdims=True)
+        obs = ref @ R + 1e-3 * RNG.standard_normal((6, 3))
+        np.testing.assert_allclose(rotation_jit.wahba_svd(ref, obs), rot.nearest_rotation((obs.T @ ref).T), atol=1e-12)
