@@ -69,7 +69,7 @@ def measure_image(duration_s, repeats):
         start = time.perf_counter()
         result = simulate(prepared, seed)
         times.append(time.perf_counter() - start)
-    frame_ms = result.series["frame_ms"]
+    frame_ms = result.timing_series["frame_ms"]
     return {"duration_s": duration_s, "wall_s": times, "realtime_factor_best": duration_s / min(times),
             "frame_ms_median": float(sorted(frame_ms)[len(frame_ms) // 2]), "frame_ms_max": float(max(frame_ms))}
 

@@ -8,12 +8,11 @@
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
 
-import argparse
 import json
 import sys
 from pathlib import Path
 
-from startrack.errors import InputError, run_command
+from startrack.errors import ArgumentParser, InputError, run_command
 
 # Each command imports what it needs when it runs, so ``navsim --help`` starts at once.
 
@@ -31,7 +30,7 @@ def _print_summary(summary, out):
         f"NEES                mean {nees['mean']:.2f} (dof {nees['dof']}), "
         f"{100 * nees['fraction_in_band']:.1f} % inside the 95 % band",
         f"updates             {updates['accepted']} accepted, {updates['rejected']} rejected",
-        f"wall time           {summary['wall_seconds']:.2f} s",
+        f"wall time           {summary['timing']['wall_seconds']:.2f} s",
         f"written to          {out}",
     ]
     print("\n".join(lines))
@@ -39,23 +38,27 @@ def _print_summary(summary, out):
 
 def _run(args):
     from navsim.output import write_run, write_study
+    from navsim.places import check_file, check_output, publish
     from navsim.scenario import resolve_scenario
     from navsim.simulation import run, run_study
     from navsim.studies import STUDIES
 
-    if args.report and Path(args.report).suffix.lower() != ".pdf":
-        raise InputError(f"--report {args.report}: the report file name must end in .pdf.")
+    _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
+    kind = "study" if scenario.is_study else "run"
+    check_output(args.out, kind)
+    if args.report:
+        check_file(args.report, "--report", ".pdf")
     if scenario.is_study:
         result = run_study(scenario, seed=args.seed, progress=True)
-        out = write_study(args.out, result)
+        out = publish(args.out, kind, lambda directory: write_study(directory, result))
         print(f"study               {scenario.name} ({scenario['study']['kind']}, seed {result.summary['seed']}, "
               f"{result.summary['wall_seconds']:.1f} s)")
         print("\n".join(STUDIES[scenario["study"]["kind"]].text(result.summary, scenario.study_parameters)))
         print(f"written to          {out}")
     else:
         result = run(scenario, seed=args.seed)
-        out = write_run(args.out, result)
+        out = publish(args.out, kind, lambda directory: write_run(directory, result))
         _print_summary(result.summary, out)
     if args.report is not None:
         from navsim.report import write_report
@@ -66,10 +69,17 @@ def _run(args):
 
 
 def _report(args):
+    from navsim.places import check_file
     from navsim.report import write_report
 
+    check_file(args.output, "-o", ".pdf")
     print(write_report(args.directory, args.output))
     return 0
+
+
+def _check_seed(seed):
+    if seed is not None and not 0 <= seed < 2**63:
+        raise InputError(f"--seed {seed}: must be an integer from 0 to 2**63 - 1")
 
 
 def _montecarlo(args):
@@ -79,11 +89,16 @@ def _montecarlo(args):
         raise InputError("give either --workers or --scheduler, not both")
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
+    _check_seed(args.seed)
     summary = run_campaign(args.scenario, args.runs, args.out, base_seed=args.seed, overrides=args.set or (),
-                           workers=args.workers, scheduler=args.scheduler)
+                           workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed)
     cross, roll, nees = summary.get("cross_boresight_rms_arcsec", {}), summary.get("roll_rms_arcsec", {}), summary.get("nees", {})
     print(f"campaign            {summary['scenario']}: {summary['runs_finished']} of {summary['runs_requested']} runs "
           f"finished, {summary['runs_failed']} failed")
+    if summary["failures"]:
+        first = summary["failures"][0]
+        print(f"first failure       run {first['run']}: {first['error']} (all in {args.out}/runs/*/error.json; "
+              "rerun with --retry-failed once the cause is fixed)")
     if cross:
         print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
     if nees:
@@ -98,8 +113,11 @@ def _montecarlo(args):
 def _tune(args):
     from navsim.campaign.tuning import tune
 
+    _check_seed(args.seed)
     if args.runs < 1:
         raise InputError(f"--runs must be at least 1, got {args.runs}")
+    if args.evaluations < 1:
+        raise InputError(f"--evaluations must be at least 1, got {args.evaluations}")
     result = tune(args.scenario, runs=args.runs, seed=args.seed, overrides=args.set or (), evaluations=args.evaluations)
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
@@ -117,7 +135,7 @@ def _tune(args):
 
 
 def build_parser():
-    parser = argparse.ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
+    parser = ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     p = sub.add_parser("run", help="simulate one scenario (or run a static study) and write summary.json and "
                                    "timeseries.npz (study.npz)")
@@ -142,6 +160,9 @@ def build_parser():
     p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask distributed scheduler")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="run again the runs that failed for a cause in the scenario (runs that failed for a cause "
+                        "outside it, such as a full disk, are always run again)")
     p.set_defaults(func=_montecarlo)
 
     p = sub.add_parser("tune", help="fit the filter's Q and R scale factors for NEES/NIS consistency")
@@ -156,7 +177,7 @@ def build_parser():
 
 
 def main(argv=None) -> int:
-    return run_command("navsim", build_parser(), argv)
+    return run_command("navsim", build_parser, argv)
 
 
 if __name__ == "__main__":

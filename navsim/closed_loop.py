@@ -53,7 +53,7 @@ def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compi
     (M, 3) the true body rate of each interval; ``jumps``: an :class:`~navsim.sensors.faults.AttitudeJumps`
     or None; ``observers``: per-run observers; ``compiled``: allow the fast path.
     """
-    log = FrameLog(grid.n_frames, sensor_run.log_fields)
+    log = FrameLog(grid.n_frames, sensor_run.log_fields, sensor_run.timing_fields)
     record = sensor_run.record()
     if compiled and record is not None and jumps is None and not observers:
         log.arrays.update(filt.process_record(imu[: grid.n_frames * grid.ratio], grid.ratio, grid.dt, record))
@@ -95,18 +95,21 @@ def fuse(filt, frame):
 
 
 class FrameLog:
-    """Per-frame arrays of a run — the filter's snapshot, the update statistics, the sensor's
-    ``log_fields`` and (with a sensor that logs its mode) the frame time [ms] — and the list of
-    mode transitions with their reasons."""
+    """Per-frame arrays of a run — the filter's snapshot, the update statistics and the sensor's
+    ``log_fields`` — and the list of mode transitions with their reasons (``arrays``, reproducible
+    from the seed); apart, in ``timing``, the wall-clock measurements: the sensor's ``timing_fields``
+    and (with a sensor that logs its mode) the time of each frame [ms]."""
 
-    def __init__(self, n_frames, sensor_fields):
+    def __init__(self, n_frames, sensor_fields, timing_fields):
         self.n_frames = n_frames
         self.arrays = {name: np.full(n_frames, fill, dtype) for name, (dtype, fill) in UPDATE_FIELDS.items()}
-        for name, (shape, dtype, fill) in sensor_fields.items():
-            self.arrays[name] = np.full((n_frames, *shape), fill, dtype)
+        self.timing = {}
+        for fields, target in ((sensor_fields, self.arrays), (timing_fields, self.timing)):
+            for name, (shape, dtype, fill) in fields.items():
+                target[name] = np.full((n_frames, *shape), fill, dtype)
         self.logs_modes = "mode" in sensor_fields
         if self.logs_modes:
-            self.arrays["frame_ms"] = np.zeros(n_frames)
+            self.timing["frame_ms"] = np.zeros(n_frames)
         self.transitions = []
 
     def record(self, j, t, snapshot, frame, update, frame_ms):
@@ -115,14 +118,14 @@ class FrameLog:
                 self.arrays[name] = np.empty((self.n_frames, *np.shape(value)))
             self.arrays[name][j] = value
         for name, value in frame.info.items():
-            self.arrays[name][j] = value
+            (self.timing if name in self.timing else self.arrays)[name][j] = value
         if update is not None:
             self.arrays["n_measurements"][j] = update.accepted.size
             stats = update.statistics()
             for name, value in zip(("n_accepted", "nis", "nis_dof", "innovation_rms"), stats):
                 self.arrays[name][j] = value
         if self.logs_modes:
-            self.arrays["frame_ms"][j] = frame_ms
+            self.timing["frame_ms"][j] = frame_ms
             self._note_mode(t, frame, update)
 
     def _note_mode(self, t, frame, update):
@@ -133,19 +136,25 @@ class FrameLog:
 
 
 def mode_statistics(arrays, transitions):
-    """Per-mode frame counts, identified stars and identification times for the run summary."""
+    """Per-mode frame counts and identified stars for the run summary."""
     out = {}
     for code, name in enumerate(MODES):
         frames = arrays["mode"] == code
-        if not frames.any():
-            continue
-        ms = arrays["id_ms"][frames]
-        ms = ms[np.isfinite(ms)]
-        out[name] = {
-            "frames": int(frames.sum()),
-            "identified_stars_mean": float(arrays["n_identified"][frames].mean()),
-            "id_ms_median": float(np.median(ms)) if ms.size else None,
-            "id_ms_p95": float(np.percentile(ms, 95)) if ms.size else None,
-        }
+        if frames.any():
+            out[name] = {"frames": int(frames.sum()), "identified_stars_mean": float(arrays["n_identified"][frames].mean())}
     return {"modes": list(MODES), "per_mode": out, "transitions": transitions,
             "stacked_frames": int(arrays["n_stacked"].sum())}
+
+
+def mode_timing(mode, timing):
+    """Wall-clock figures of the run summary's ``timing``: identification time per mode and the
+    frame time [ms] (median, p95)."""
+    out = {}
+    for code, name in enumerate(MODES):
+        ms = timing["id_ms"][(mode == code) & np.isfinite(timing["id_ms"])]
+        if ms.size:
+            out[name] = {"id_ms_median": float(np.median(ms)), "id_ms_p95": float(np.percentile(ms, 95))}
+    frame_ms = timing["frame_ms"]
+    return {"identification_ms": out, "frame_ms": {"median": float(np.median(frame_ms)),
+                                                   "p95": float(np.percentile(frame_ms, 95)),
+                                                   "max": float(frame_ms.max())}}

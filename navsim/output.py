@@ -1,5 +1,6 @@
 """Run outputs: ``scenario.json`` (the validated scenario), ``summary.json`` and ``timeseries.npz``
-(``study.npz`` for a static study), byte-identical for the same inputs (but for ``wall_seconds``).
+(``study.npz`` for a static study), identical for the same seed but for the summary's ``timing``;
+the per-frame wall-clock times go to ``timing.npz``.
 
 ``np.savez`` stamps the current time into the zip; :func:`write_npz` writes the same format
 (a zip of ``.npy`` members, readable by ``np.load(..., allow_pickle=False)``) with a fixed
@@ -54,6 +55,8 @@ def write_run(directory, result, max_frames=None):
         stride = -(-frames // max_frames)
         series = {k: (v[stride - 1 :: stride] if v.shape[:1] == (frames,) else v) for k, v in series.items()}
     write_npz(directory / "timeseries.npz", series)
+    if result.timing_series:
+        write_npz(directory / "timing.npz", result.timing_series)
     if result.sample_frame is not None:
         np.save(directory / "frame.npy", result.sample_frame["image"], allow_pickle=False)
         write_json(directory / "frame_detections.json", result.sample_frame["detections"])

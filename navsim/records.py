@@ -8,6 +8,9 @@ per-frame observers' statistics (:mod:`navsim.studies`), written at the top leve
 observer's key. The ``format`` key names the record and its version; a file of another version is
 refused with one clear message.
 
+Every wall-clock measurement (run time, identification and frame times, the time comparisons of
+000 §5) lives under the key ``timing``: the rest of a summary is reproduced exactly by the same seed.
+
 Units at this edge: attitude in arcsec, gyro bias in deg/h, times in seconds.
 """
 
@@ -90,7 +93,9 @@ class RunSummary(Record):
     ``gyro_calibration``: per calibration group the filter carries (scale factors [ppm], misalignment
     [arcsec]) the truth, the final estimate, its σ and the normalised error;
     ``identification``/``modes``: the image-fidelity sensor's modes, counts and transitions;
-    ``paper_comparison``: rows {quantity, ours, paper, source}; ``notes``: sentences explaining them.
+    ``paper_comparison``: rows {quantity, ours, paper, source}; ``notes``: sentences explaining them;
+    ``timing``: the wall-clock figures {wall_seconds, identification_ms, frame_ms, observers' times with
+    their comparison rows and notes}.
     """
 
     FORMAT = RUN_FORMAT
@@ -112,7 +117,7 @@ class RunSummary(Record):
     nees: dict
     nis: dict
     updates: dict
-    wall_seconds: float = 0.0
+    timing: dict = field(default_factory=dict)
     gyro_calibration: dict | None = None
     identification: dict | None = None
     modes: list | None = None
@@ -152,4 +157,5 @@ class CampaignSummary(Record):
     identification: dict | None = None
     paper_comparison: list | None = None
     notes: list | None = None
+    timing: dict = field(default_factory=dict)
     findings: dict = field(default_factory=dict)

@@ -7,13 +7,14 @@ directly; at image fidelity stream 1 spawns four, all before the first frame: 0 
 in one process, a pool or a cluster.
 """
 
+import dataclasses
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from navsim.closed_loop import FrameGrid, mode_statistics, run_loop
+from navsim.closed_loop import FrameGrid, mode_statistics, mode_timing, run_loop
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.records import RunSummary
 from navsim.scenario import build, resolve_scenario
@@ -36,12 +37,14 @@ class RunResult:
     """``summary``: the run's :class:`~navsim.records.RunSummary` (reads as the JSON mapping of
     summary.json); ``series``: arrays logged at every star-sensor frame; ``scenario``: the validated
     scenario (units in key names) the run used; ``sample_frame``: one rendered frame with its
-    detections and identifications (image fidelity)."""
+    detections and identifications (image fidelity); ``timing_series``: per-frame wall-clock times
+    [ms] (image fidelity), apart from ``series`` because they differ between runs of one seed."""
 
     summary: RunSummary
     series: dict
     scenario: dict
     sample_frame: dict | None = None
+    timing_series: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -119,29 +122,41 @@ def simulate(prepared, seed, compiled=True):
     series["nees"] = nees(series["P"][:, :NEES_DOF, :NEES_DOF],
                           np.concatenate([series["attitude_error"], series["bias_true"] - series["bias_est"]], axis=1))
     summary = summarize(scenario, seed, series, p.R_BS).replace(gyro_calibration=calibration_summary(filt, record.matrix))
+    timing = {}
     if log.logs_modes:
         summary = summary.replace(identification=mode_statistics(series, log.transitions), modes=list(MODES))
-    summary = _with_findings(summary, series, observers, series["t"] >= scenario["settle_s"])
-    summary = summary.replace(wall_seconds=round(time.perf_counter() - started, 4))
+        timing = mode_timing(series["mode"], log.timing)
+    summary = _with_findings(summary, series, observers, series["t"] >= scenario["settle_s"], timing)
+    summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
     series["P_diag"] = np.diagonal(series.pop("P"), axis1=1, axis2=2).copy()
-    return RunResult(summary=summary, series=series, scenario=scenario.data,
-                     sample_frame=sensor_run.sample)
+    return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,
+                     timing_series=log.timing)
 
 
-def _with_findings(summary, series, observers, steady):
-    """The summary with each observer's findings, comparison rows and notes; their series join ``series``."""
-    findings, rows, notes = {}, [], []
-    for observer in observers:
-        found = observer.finish(series, steady)
-        if found is None:
-            continue
-        findings[found.key] = found.stats
-        rows += found.rows
-        notes += found.notes
+def _with_findings(summary, series, observers, steady, timing):
+    """The summary with each observer's findings, comparison rows and notes; their series join
+    ``series`` and their wall-clock figures ``timing``."""
+    findings = [found for found in (observer.finish(series, steady) for observer in observers) if found is not None]
+    for found in findings:
         series.update(found.series)
+    add_timing(timing, findings)
     if not findings:
         return summary
-    return summary.replace(findings=findings, paper_comparison=rows, notes=notes)
+    return summary.replace(findings={f.key: f.stats for f in findings}, paper_comparison=[r for f in findings for r in f.rows],
+                           notes=[n for f in findings for n in f.notes])
+
+
+def add_timing(timing, findings):
+    """Put the findings' wall-clock figures, time comparisons and notes into a summary's ``timing``."""
+    for found in findings:
+        if found.timing:
+            timing[found.key] = found.timing
+    rows = [r for f in findings for r in f.timing_rows]
+    notes = [n for f in findings for n in f.timing_notes]
+    if rows:
+        timing["paper_comparison"] = rows
+    if notes:
+        timing["notes"] = notes
 
 
 def run(scenario, seed=None, overrides=(), star_catalog=None):
@@ -153,8 +168,8 @@ def run(scenario, seed=None, overrides=(), star_catalog=None):
     started = time.perf_counter()
     prepared = prepare(scenario, overrides, star_catalog)
     result = simulate(prepared, prepared.scenario["seed"] if seed is None else int(seed))
-    summary = result.summary.replace(wall_seconds=round(time.perf_counter() - started, 4))
-    return RunResult(summary=summary, series=result.series, scenario=result.scenario, sample_frame=result.sample_frame)
+    summary = result.summary.replace(timing={**result.summary.timing, "wall_seconds": round(time.perf_counter() - started, 4)})
+    return dataclasses.replace(result, summary=summary)
 
 
 def run_study(scenario, seed=None, overrides=(), progress=False):

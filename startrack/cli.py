@@ -8,14 +8,14 @@ import argparse
 import importlib
 import sys
 
-from startrack.errors import run_command
+from startrack.errors import ArgumentParser, run_command
 
 #: Sub-command modules under ``startrack.commands``, in the order ``--help`` lists them.
 COMMANDS = ("catalog", "address", "render", "detect", "solve")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="startrack",
         description="Star sensor: navigation catalog, rendering, centroiding, identification, attitude.",
     )
@@ -26,7 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    return run_command("startrack", build_parser(), argv)
+    return run_command("startrack", build_parser, argv)
 
 
 if __name__ == "__main__":

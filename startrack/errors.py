@@ -1,28 +1,53 @@
 """The one exception type for bad user input, shared by both packages, and the command-line runner.
 
-Raising :class:`InputError` anywhere below a command-line entry point ends the
-program with its message on one line and exit status 2, never a traceback.
+Raising :class:`InputError` anywhere below a command-line entry point ends the program with its
+message on one line and exit status 2, never a traceback. The runner also turns an interruption
+(Ctrl-C: exit 130), a failing file system (disk full, permission: exit 1) and an unexpected internal
+error (exit 70, with the traceback only when ``STARTRACK_DEBUG`` is set) into one line each.
 """
 
+import argparse
 import os
 import sys
+import traceback
 
 
 class InputError(ValueError):
     """Bad input named in one clear sentence (file, key, value and what is wrong)."""
 
 
-def run_command(prog, parser, argv=None) -> int:
-    """Parse ``argv`` and call ``args.func(args)``; bad input -> one line on stderr and exit 2."""
-    args = parser.parse_args(argv)
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with its usage errors on one line (the option and the problem, then where to look)."""
+
+    def error(self, message):
+        print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def run_command(prog, build_parser, argv=None) -> int:
+    """Build the parser, parse ``argv`` and call ``args.func(args)``; every failure is one line on stderr."""
     try:
+        args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
     except InputError as error:
-        print(f"{prog}: error: {error}", file=sys.stderr)
-        return 2
+        return _fail(prog, error, 2)
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return 130
+        return _fail(prog, "interrupted", 130, label="")
     except BrokenPipeError:  # output piped into a reader that stopped early (| head)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except OSError as error:  # the file system refused: no space, no permission, read-only, ...
+        where = f"{error.filename}: " if error.filename else ""
+        return _fail(prog, f"{where}{error.strerror or error}", 1)
+    except MemoryError:
+        return _fail(prog, "out of memory: make the run shorter or the rates lower", 1)
+    except Exception as error:  # a defect of ours: say so in one line, keep the traceback for debugging
+        if os.environ.get("STARTRACK_DEBUG"):
+            traceback.print_exc()
+        return _fail(prog, f"{type(error).__name__}: {error} (an internal error; set STARTRACK_DEBUG=1 "
+                           "for the traceback and please report it)", 70, label="internal error: ")
+
+
+def _fail(prog, message, status, label="error: "):
+    print(f"{prog}: {label}{message}", file=sys.stderr)
+    return status

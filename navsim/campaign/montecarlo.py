@@ -17,6 +17,7 @@ way the runs were produced.
 
 import json
 import os
+import re
 import shutil
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -27,9 +28,10 @@ from tqdm import tqdm
 
 from navsim.estimation.consistency import nees_statistics
 from navsim.output import read_npz, write_json, write_run
+from navsim.places import campaign_lock, check_output, mark
 from navsim.records import CampaignSummary, RunSummary
 from navsim.scenario import Scenario, resolve_scenario
-from navsim.simulation import prepare, simulate
+from navsim.simulation import add_timing, prepare, simulate
 from navsim.studies import observers
 from startrack import units
 from startrack.errors import InputError
@@ -47,10 +49,17 @@ def run_seed(base_seed, index):
 CAMPAIGN_MAX_FRAMES = 2000
 
 
+#: Most runs one campaign holds (its run directories and summaries live on one disk).
+MAX_RUNS = 1_000_000
+#: Failures a rerun may cure (the machine, not the scenario): retried whenever a campaign resumes.
+ENVIRONMENT_ERRORS = (OSError, MemoryError, TimeoutError)
+
+
 def run_chunk(scenario_data, source, members):
     """Run campaign members [(seed, run_dir), ...] of one scenario, preparing its seed-free part
     once (:func:`navsim.simulation.prepare`); each run is written atomically, and a run that
-    raises is recorded in ``run_dir/error.json`` without stopping the others. Returns the errors."""
+    raises is recorded in ``run_dir/error.json`` (with its cause: the scenario, or the environment
+    when a rerun may cure it) without stopping the others. Returns the errors."""
     errors = []
     try:
         prepared = prepare(Scenario(data=scenario_data, source=source))
@@ -66,100 +75,138 @@ def run_chunk(scenario_data, source, members):
             write_run(partial, simulate(prepared, seed), max_frames=CAMPAIGN_MAX_FRAMES)
             shutil.rmtree(run_dir, ignore_errors=True)
             os.replace(partial, run_dir)
+        except KeyboardInterrupt:
+            shutil.rmtree(partial, ignore_errors=True)
+            raise
         except Exception as error:  # recorded, not raised: one bad run must not stop the others
             shutil.rmtree(partial, ignore_errors=True)
-            run_dir.mkdir(parents=True, exist_ok=True)
-            message = f"{type(error).__name__}: {error}"
-            write_json(run_dir / "error.json", {"seed": seed, "error": message, "traceback": traceback.format_exc()})
-            errors.append(message)
+            errors.append(_record_failure(run_dir, seed, error))
     return errors
+
+
+def _record_failure(run_dir, seed, error):
+    message = f"{type(error).__name__}: {error}"
+    cause = "environment" if isinstance(error, ENVIRONMENT_ERRORS) else "scenario"
+    try:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        run_dir.mkdir(parents=True, exist_ok=True)
+        write_json(run_dir / "error.json", {"seed": seed, "error": message, "cause": cause,
+                                            "traceback": traceback.format_exc()})
+    except OSError:  # the disk refuses even the error record: the run stays pending
+        pass
+    return message
 
 
 def _prepare(directory, scenario, runs, base_seed, backend):
     directory = Path(directory)
-    request = {
-        "scenario": scenario.name,
-        "source": scenario.source,
-        "base_seed": base_seed,
-        "backend": backend,
-        "runs": runs,
-        "scenario_data": scenario.data,
-        "seeds": [run_seed(base_seed, k) for k in range(runs)],
-    }
+    request = {"scenario": scenario.name, "source": scenario.source, "base_seed": base_seed, "backend": backend,
+               "runs": runs, "scenario_data": scenario.data}
     path = directory / "campaign.json"
     if path.exists():
-        try:
-            previous = json.loads(path.read_text())
-        except json.JSONDecodeError:
-            raise InputError(f"{path}: not a readable campaign file") from None
-        same = {k: previous.get(k) for k in ("scenario_data", "base_seed")} == {
-            k: request[k] for k in ("scenario_data", "base_seed")
-        }
-        if not same:
-            raise InputError(
-                f"{directory}: holds a different campaign (scenario, overrides or seed differ); "
-                "use a new --out directory"
-            )
-        if previous["runs"] > runs:
-            request["runs"] = previous["runs"]
-            request["seeds"] = previous["seeds"]
+        previous = _read_request(path)
+        if {k: previous.get(k) for k in ("scenario_data", "base_seed")} != {k: request[k] for k in ("scenario_data", "base_seed")}:
+            raise InputError(f"{directory}: holds a different campaign (scenario, overrides or seed differ); "
+                             "use a new --out directory")
+        request["runs"] = max(runs, int(previous.get("runs", 0)))
     (directory / "runs").mkdir(parents=True, exist_ok=True)
+    mark(directory, "campaign")
     write_json(path, request)
     return directory, request
 
 
-def pending_runs(directory, request):
-    """Indices of runs with neither a finished result nor a recorded error."""
+def _read_request(path):
+    try:
+        previous = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise InputError(f"{path}: not a readable campaign file (not JSON)") from None
+    if not isinstance(previous, dict) or not isinstance(previous.get("runs"), int):
+        raise InputError(f"{path}: not a campaign file (expected an object with runs, base_seed and scenario_data)")
+    return previous
+
+
+def pending_runs(directory, request, retry_failed=False):
+    """Indices of runs to do: neither finished nor failed, or failed for a cause outside the scenario
+    (a full disk, a killed worker: retried on every resume), or failed at all with ``retry_failed``."""
     runs_dir = Path(directory) / "runs"
     todo = []
     for k in range(request["runs"]):
         run_dir = runs_dir / RUN_DIR.format(k)
-        if not (run_dir / "summary.json").exists() and not (run_dir / "error.json").exists():
+        if (run_dir / "summary.json").exists():
+            continue
+        error = run_dir / "error.json"
+        if not error.exists() or retry_failed or _failure_cause(error) != "scenario":
             todo.append(k)
     return todo
 
 
+def _failure_cause(path):
+    try:
+        return json.loads(path.read_text(encoding="utf-8")).get("cause", "scenario")
+    except (OSError, ValueError, AttributeError):
+        return "environment"
+
+
 def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None, scheduler=None,
-                 progress=True, chunk_size=25):
+                 progress=True, chunk_size=25, retry_failed=False):
     """Run (or resume) a campaign; returns the aggregate summary (also written to out/summary.json).
 
     ``workers``: local processes (default: the machine's cores); ``scheduler``: the address of a
     Dask distributed scheduler ('tcp://host:8786'), or a ``distributed.Client``. Runs are sent in
-    chunks of at most ``chunk_size`` that share the scenario's seed-free part.
+    chunks of at most ``chunk_size`` that share the scenario's seed-free part. Runs that failed
+    for a cause outside the scenario are run again; ``retry_failed`` runs every failed run again.
+    Interrupted (Ctrl-C), it cancels what is pending and keeps every finished run.
     """
-    if runs < 1:
-        raise InputError(f"--runs must be at least 1, got {runs}")
+    if not 1 <= runs <= MAX_RUNS:
+        raise InputError(f"--runs must be from 1 to {MAX_RUNS:,}, got {runs}; for more, run several campaigns "
+                         "with different --seed")
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a Monte Carlo campaign")
+    check_output(out, "campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)
-    directory, request = _prepare(out, scenario, runs, base_seed, _backend(scheduler, n_workers))
-    todo = pending_runs(directory, request)
-    members = [(request["seeds"][k], str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
-    size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
-    chunks = [members[i : i + size] for i in range(0, len(members), size)]
-    bar = tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
-               unit="run", disable=not progress)
-    try:
-        if not chunks:
-            pass
-        elif scheduler is not None:
-            _run_dask(scenario, chunks, scheduler, bar)
-        elif n_workers == 1:
-            for chunk in chunks:
-                run_chunk(scenario.data, scenario.source, chunk)
-                bar.update(len(chunk))
-        else:
-            with ProcessPoolExecutor(max_workers=n_workers) as pool:
-                futures = {pool.submit(run_chunk, scenario.data, scenario.source, c): len(c) for c in chunks}
-                for future in as_completed(futures):
-                    future.result()
-                    bar.update(futures[future])
-    finally:
-        bar.close()
-    summary = aggregate(directory)
-    write_json(directory / "summary.json", summary.to_json())
+    Path(out).mkdir(parents=True, exist_ok=True)
+    with campaign_lock(out):
+        directory, request = _prepare(out, scenario, runs, base_seed, _backend(scheduler, n_workers))
+        todo = pending_runs(directory, request, retry_failed)
+        members = [(run_seed(base_seed, k), str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
+        size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
+        chunks = [members[i : i + size] for i in range(0, len(members), size)]
+        with tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
+                  unit="run", disable=not progress) as bar:
+            _execute(scenario, chunks, n_workers, scheduler, bar)
+        summary = aggregate(directory)
+        write_json(directory / "summary.json", summary.to_json())
     return summary
+
+
+def _execute(scenario, chunks, n_workers, scheduler, bar):
+    """Run the chunks serially, on local processes or on a Dask cluster."""
+    if not chunks:
+        return
+    if scheduler is not None:
+        _run_dask(scenario, chunks, scheduler, bar)
+    elif n_workers == 1:
+        for chunk in chunks:
+            run_chunk(scenario.data, scenario.source, chunk)
+            bar.update(len(chunk))
+    else:
+        _run_pool(scenario, chunks, n_workers, bar)
+
+
+def _run_pool(scenario, chunks, n_workers, bar):
+    """Local processes; on Ctrl-C the pending chunks are cancelled and the workers stopped at once."""
+    pool = ProcessPoolExecutor(max_workers=n_workers)
+    try:
+        futures = {pool.submit(run_chunk, scenario.data, scenario.source, c): len(c) for c in chunks}
+        for future in as_completed(futures):
+            future.result()
+            bar.update(futures[future])
+    except KeyboardInterrupt:
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.terminate()
+        raise
+    pool.shutdown()
 
 
 def _backend(scheduler, n_workers):
@@ -169,11 +216,15 @@ def _backend(scheduler, n_workers):
     return "serial" if n_workers == 1 else f"{n_workers} local processes"
 
 
+#: A Dask scheduler address: [scheme://]host:port.
+SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls|ws|wss|ucx|inproc)://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}$")
+
+
 def _run_dask(scenario, chunks, scheduler, bar):
     from distributed import Client
     from distributed import as_completed as dask_completed
 
-    client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+    client = scheduler if isinstance(scheduler, Client) else _connect(Client, scheduler)
     try:
         futures = [client.submit(run_chunk, scenario.data, scenario.source, chunk, pure=False) for chunk in chunks]
         sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks)}
@@ -185,19 +236,26 @@ def _run_dask(scenario, chunks, scheduler, bar):
             client.close()
 
 
+def _connect(client_class, address, timeout_s=10):
+    """A Dask client of the scheduler at ``address``, or one InputError within ``timeout_s``."""
+    if not SCHEDULER_ADDRESS.match(address):
+        raise InputError(f"--scheduler {address}: not a scheduler address (expected tcp://HOST:PORT)")
+    try:
+        return client_class(address, timeout=f"{timeout_s}s")
+    except (OSError, TimeoutError) as error:
+        raise InputError(f"--scheduler {address}: cannot connect within {timeout_s} s ({error})") from None
+
+
 def _pooled_findings(summaries):
     """The observers' findings pooled over the runs (:func:`navsim.studies.observers`), with their
-    comparison rows and notes."""
-    findings, rows, notes = {}, [], []
-    for kind in observers():
-        pooled = kind.pool(summaries)
-        if pooled is not None:
-            findings[pooled.key] = pooled.stats
-            rows += pooled.rows
-            notes += pooled.notes
-    if not findings:
+    comparison rows and notes; their wall-clock figures under ``timing``."""
+    pooled = [found for found in (kind.pool(summaries) for kind in observers()) if found is not None]
+    timing = {}
+    add_timing(timing, pooled)
+    if not pooled:
         return {}
-    return {"findings": findings, "paper_comparison": rows, "notes": notes}
+    return {"findings": {f.key: f.stats for f in pooled}, "paper_comparison": [r for f in pooled for r in f.rows],
+            "notes": [n for f in pooled for n in f.notes], "timing": timing}
 
 
 def load_runs(directory):

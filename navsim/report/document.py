@@ -223,7 +223,7 @@ def _key_results(doc, run):
         ("NEES inside 95 % band", None if get("nees", "fraction_in_band") is None
          else 100 * get("nees", "fraction_in_band"), "%", 1),
         ("NIS mean per dof", get("nis", "mean_per_dof"), "", 3),
-        ("wall time", get("wall_seconds"), "s", 2),
+        ("wall time", get("timing", "wall_seconds"), "s", 2),
     ]
     rows = [(label, xyz(v, digits) if isinstance(v, list) else number(v, digits), unit)
             for label, v, unit, digits in quantities

@@ -11,6 +11,7 @@ draws are checked; everything optional may be absent. Bad input raises
 """
 
 import json
+import re
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,6 +22,8 @@ from navsim.records import CampaignSummary, RunSummary
 from navsim.studies import STUDIES
 from startrack.errors import InputError
 
+#: A finished or failed run's directory (a leftover ``run_NNNNN.partial`` is neither).
+RUN_NAME = re.compile(r"run_\d{5,}")
 #: Arrays every run must have; the report cannot say anything without them.
 REQUIRED_SERIES = ("t", "attitude_error")
 #: Per-frame arrays and the trailing shape each must have when present (() for one number per frame).
@@ -151,6 +154,8 @@ def directory_kind(directory: Path) -> str:
 def load_run(directory: Path) -> RunData:
     summary = RunSummary.read(directory / "summary.json")
     series = read_series(directory / "timeseries.npz")
+    if (directory / "timing.npz").is_file():  # wall-clock times per frame, kept apart from the reproducible series
+        series |= _read_timing(directory / "timing.npz", series["t"].size)
     scenario = read_json(directory / "scenario.json")
     frame, detections = None, None
     if (directory / "frame.npy").is_file():
@@ -180,6 +185,19 @@ def load_study(directory: Path) -> StudyData:
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
     return StudyData(directory, summary, scenario, arrays)
+
+
+def _read_timing(path: Path, frames: int) -> dict:
+    """The per-frame arrays of ``timing.npz`` (one value per frame each)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            timing = {name: data[name] for name in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+        raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
+    for name, values in timing.items():
+        if values.shape != (frames,) or values.dtype.kind != "f":
+            raise InputError(f"{path}: array '{name}' has shape {values.shape}, expected ({frames},) times in ms.")
+    return timing
 
 
 def _read_frame(path: Path) -> np.ndarray:
@@ -219,7 +237,7 @@ def load_campaign(directory: Path) -> CampaignData:
     summary = CampaignSummary.read(summary_path) if summary_path.is_file() else None
     data = CampaignData(directory, campaign, summary, scenario=campaign.get("scenario_data"))
     runs_dir = directory / "runs"
-    run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir()) if runs_dir.is_dir() else []
+    run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir() and RUN_NAME.fullmatch(p.name)) if runs_dir.is_dir() else []
     for run_dir in run_dirs:
         if (run_dir / "error.json").is_file():
             error = read_json(run_dir / "error.json")

@@ -252,7 +252,7 @@ RUN_METRICS = (
     ("NEES mean", "", ("nees", "mean")),
     ("NEES in 95 % band", "%", ("nees", "fraction_in_band")),
     ("NIS mean per dof", "", ("nis", "mean_per_dof")),
-    ("wall time", "s", ("wall_seconds",)),
+    ("wall time", "s", ("timing", "wall_seconds")),
 )
 
 

@@ -21,41 +21,46 @@ from navsim.studies import STUDIES
 from startrack.errors import InputError
 
 PROFILES = ("constant_rate", "sinusoidal_axis", "rate_segments", "rigid_body")
+#: Upper bounds of physical values, far beyond any real vehicle or sensor: rates [deg/s], angle
+#: errors [arcsec], gyro noise [deg/√h, deg/h/√h] and bias [deg/h].
+MAX_RATE, MAX_ARCSEC, MAX_ARW, MAX_RRW, MAX_BIAS = 1e4, 36000.0, 1e3, 1e4, 1e6
+#: What one run holds in memory: gyro samples, truth samples (the finer grid) and star-sensor frames.
+MAX_GYRO_SAMPLES, MAX_TRUTH_SAMPLES, MAX_FRAMES = 1e7, 4e7, 2e5
 
 SCHEMA = Table(
     {
         "name": Value("str"),
         "description": Value("str", default=""),
-        "duration_s": Value("float", exclusive_minimum=0.0),
-        "seed": Value("int", default=0, minimum=0),
+        "duration_s": Value("float", exclusive_minimum=0.0, maximum=2.6e6),
+        "seed": Value("int", default=0, minimum=0, maximum=2**63 - 1),
         "epoch_jyear": Value("float", default=2000.0, minimum=1900.0, maximum=2100.0),
         "settle_s": Value("float", default=None, minimum=0.0,
                           doc="errors are summarised after this time (default: 10 % of the run)"),
         "truth": Table(
             {
                 "profile": Value("str", choices=PROFILES),
-                "rate_hz": Value("float", default=None, exclusive_minimum=0.0,
+                "rate_hz": Value("float", default=None, exclusive_minimum=0.0, maximum=1e5,
                                  doc="truth integration rate, an integer multiple of the gyro rate"),
                 "initial_q_IB": Value("quaternion", default=[0.0, 0.0, 0.0, 1.0]),
                 "initial_radec_roll_deg": Value("vector", default=None,
                                                 doc="initial boresight RA, Dec and roll (003 §1.1) instead of "
                                                     "initial_q_IB; with the nominal mounting"),
-                "constant_rate": Table({"rate_deg_per_s": Value("vector")}, optional=True),
+                "constant_rate": Table({"rate_deg_per_s": Value("vector", minimum=-MAX_RATE, maximum=MAX_RATE)}, optional=True),
                 "sinusoidal_axis": Table(
                     {
-                        "axis": Value("vector"),
-                        "theta0_deg": Value("float", default=0.0),
-                        "amplitude_deg": Value("float"),
-                        "angular_frequency_rad_per_s": Value("float", minimum=0.0),
-                        "phase_deg": Value("float", default=0.0),
+                        "axis": Value("vector", minimum=-1e6, maximum=1e6),
+                        "theta0_deg": Value("float", default=0.0, minimum=-1e6, maximum=1e6),
+                        "amplitude_deg": Value("float", minimum=-1e6, maximum=1e6),
+                        "angular_frequency_rad_per_s": Value("float", minimum=0.0, maximum=1e4),
+                        "phase_deg": Value("float", default=0.0, minimum=-1e6, maximum=1e6),
                     },
                     optional=True,
                 ),
                 "rate_segments": Table(
                     {
                         "segments": ListOfTables(
-                            Table({"duration_s": Value("float", exclusive_minimum=0.0),
-                                   "rate_deg_per_s": Value("vector")}),
+                            Table({"duration_s": Value("float", exclusive_minimum=0.0, maximum=2.6e6),
+                                   "rate_deg_per_s": Value("vector", minimum=-MAX_RATE, maximum=MAX_RATE)}),
                             required=True,
                             min_length=1,
                         )
@@ -64,11 +69,11 @@ SCHEMA = Table(
                 ),
                 "rigid_body": Table(
                     {
-                        "inertia_kg_m2": Value("matrix"),
-                        "initial_rate_deg_per_s": Value("vector"),
+                        "inertia_kg_m2": Value("matrix", minimum=-1e12, maximum=1e12),
+                        "initial_rate_deg_per_s": Value("vector", minimum=-MAX_RATE, maximum=MAX_RATE),
                         "torque_segments": ListOfTables(
-                            Table({"duration_s": Value("float", exclusive_minimum=0.0),
-                                   "torque_N_m": Value("vector")})
+                            Table({"duration_s": Value("float", exclusive_minimum=0.0, maximum=2.6e6),
+                                   "torque_N_m": Value("vector", minimum=-1e9, maximum=1e9)})
                         ),
                     },
                     optional=True,
@@ -78,16 +83,16 @@ SCHEMA = Table(
         "gyro": Table(
             {
                 "preset": Value("str", default=None, choices=("navigation", "tactical", "mems")),
-                "rate_hz": Value("float", exclusive_minimum=0.0),
-                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0),
-                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0),
-                "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0),
-                "bias_instability_deg_per_h": Value("float", default=None, minimum=0.0),
-                "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0),
-                "scale_factor_ppm": Value("float", default=None, minimum=0.0),
-                "misalignment_arcsec": Value("float", default=None, minimum=0.0),
-                "quantization_arcsec": Value("float", default=None, minimum=0.0),
-                "saturation_deg_per_s": Value("float", default=None, exclusive_minimum=0.0),
+                "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e5),
+                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW),
+                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_RRW),
+                "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
+                "bias_instability_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
+                "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
+                "scale_factor_ppm": Value("float", default=None, minimum=0.0, maximum=1e5),
+                "misalignment_arcsec": Value("float", default=None, minimum=0.0, maximum=MAX_ARCSEC),
+                "quantization_arcsec": Value("float", default=None, minimum=0.0, maximum=MAX_ARCSEC),
+                "saturation_deg_per_s": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_RATE),
             }
         ),
         "star_sensor": Table(
@@ -96,18 +101,18 @@ SCHEMA = Table(
                                   doc="vector: noisy star vectors or fixes; image: rendered frames through "
                                       "detection, identification and (dim stars) stacking"),
                 "measurement": Value("str", default="stars", choices=("stars", "attitude")),
-                "rate_hz": Value("float", exclusive_minimum=0.0),
+                "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
                 "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
                                  doc="full cone angle of the circular field"),
                 "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0),
-                "max_stars": Value("int", default=10, minimum=1),
-                "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0,
+                "max_stars": Value("int", default=10, minimum=1, maximum=1000),
+                "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC,
                                            doc="1σ direction error per star and tangent axis"),
-                "attitude_sigma_cross_arcsec": Value("float", default=5.0, exclusive_minimum=0.0),
-                "attitude_sigma_roll_arcsec": Value("float", default=40.0, exclusive_minimum=0.0),
-                "mounting_rotvec_deg": Value("vector", default=[0.0, 0.0, 0.0],
+                "attitude_sigma_cross_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
+                "attitude_sigma_roll_arcsec": Value("float", default=40.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
+                "mounting_rotvec_deg": Value("vector", default=[0.0, 0.0, 0.0], minimum=-360.0, maximum=360.0,
                                              doc="nominal R_BS (sensor to body) as a rotation vector"),
-                "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0],
+                "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0], minimum=-MAX_ARCSEC, maximum=MAX_ARCSEC,
                                              doc="true, unknown mounting error (rotation vector in S)"),
                 "image": Table(
                     {
@@ -117,13 +122,13 @@ SCHEMA = Table(
                                        doc="circular: the circle of diameter fov_deg inscribed in the width"),
                         "psf_sigma_px": Value("float", default=0.671, exclusive_minimum=0.0, maximum=10.0),
                         "exposure_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=10.0),
-                        "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0),
-                        "read_noise_e": Value("float", default=20.0, minimum=0.0),
+                        "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0, maximum=1e15),
+                        "read_noise_e": Value("float", default=20.0, minimum=0.0, maximum=1e6),
                         "render_mag_limit": Value("float", default=7.0, minimum=-2.0, maximum=12.0,
                                                   doc="faintest star drawn into the frames"),
-                        "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0,
+                        "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
                                                   doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
-                        "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0,
+                        "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0, maximum=100.0,
                                                    doc="centroid error the identification assumes (its gates); the filter takes each star's σ from its detection"),
                         "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
                                             doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
@@ -131,10 +136,10 @@ SCHEMA = Table(
                                                                 doc="max(δ) of eq. 6 of 000"),
                         "tracking_window_px": Value("int", default=5, minimum=2, maximum=50,
                                                     doc="half-width of the readout windows while tracking"),
-                        "max_identified_stars": Value("int", default=12, minimum=3),
+                        "max_identified_stars": Value("int", default=12, minimum=3, maximum=1000),
                         "dim_star_stacking": Value("bool", default=True,
                                                    doc="stack the predicted dim star over 4 frames when < 3 stars"),
-                        "sky_hip": Value("list", default=[], minimum=1.0,
+                        "sky_hip": Value("ints", default=[], minimum=1, maximum=10**6,
                                          doc="render only these Hipparcos stars (004 §3 renders four); "
                                              "empty: the whole catalog"),
                         "start_tracking": Value("bool", default=False,
@@ -161,7 +166,7 @@ SCHEMA = Table(
                                                         "end_s": Value("float", minimum=0.0),
                                                         "count": Value("int", minimum=1, maximum=1000)})),
                 "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
-                                                       "step_deg_per_h": Value("vector")})),
+                                                       "step_deg_per_h": Value("vector", minimum=-MAX_BIAS, maximum=MAX_BIAS)})),
                 "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
                 "tracking_failure_probes": Table(
                     {"count": Value("int", minimum=1, maximum=100000),
@@ -175,11 +180,11 @@ SCHEMA = Table(
         ),
         "filter": Table(
             {
-                "initial_attitude_sigma_deg": Value("float", default=0.1, exclusive_minimum=0.0),
-                "initial_bias_sigma_deg_per_h": Value("float", default=None, exclusive_minimum=0.0),
-                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0,
+                "initial_attitude_sigma_deg": Value("float", default=0.1, exclusive_minimum=0.0, maximum=180.0),
+                "initial_bias_sigma_deg_per_h": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_BIAS),
+                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW,
                                             doc="ARW the filter assumes (default: the gyro's)"),
-                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0,
+                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_RRW,
                                                   doc="RRW the filter assumes (default: the gyro's; plus the "
                                                       "Gauss-Markov drive when bias_instability is ignored)"),
                 "bias_instability": Value("str", default=None, choices=TREATMENTS,
@@ -194,14 +199,14 @@ SCHEMA = Table(
                                                "estimate when the gyro has them"),
                 "mounting": Value("str", default="ignore", choices=TREATMENTS,
                                   doc="the star-sensor mounting error δm (star_sensor.misalignment_arcsec is its truth)"),
-                "initial_scale_factor_sigma_ppm": Value("float", default=None, exclusive_minimum=0.0,
+                "initial_scale_factor_sigma_ppm": Value("float", default=None, exclusive_minimum=0.0, maximum=1e6,
                                                         doc="default: the gyro's scale-factor σ"),
-                "initial_gyro_misalignment_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0,
+                "initial_gyro_misalignment_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_ARCSEC,
                                                                 doc="default: the gyro's misalignment σ"),
-                "initial_mounting_sigma_arcsec": Value("float", default=60.0, exclusive_minimum=0.0),
+                "initial_mounting_sigma_arcsec": Value("float", default=60.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
                 "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
-                "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
-                "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0),
+                "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
+                "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
             }
         ),
     }
@@ -269,6 +274,8 @@ def parse_override(text):
         value = tomllib.loads(f"v = {raw.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw.strip()
+    except RecursionError:
+        raise InputError(f"--set {key.strip()}: the value is nested too deeply") from None
     return path, value
 
 
@@ -327,6 +334,9 @@ def validate(data, source="<scenario>"):
     truth["rate_hz"] = truth_hz
     if checked["duration_s"] * sensor_hz < 1.0:
         raise InputError(f"{source}: duration_s: shorter than one star-sensor frame")
+    _check_run_size(checked, source)
+    if profile == "sinusoidal_axis" and not any(truth["sinusoidal_axis"]["axis"]):
+        raise InputError(f"{source}: truth.sinusoidal_axis.axis: must not be the zero vector (it is the rotation axis)")
     if profile == "rate_segments":
         covered = sum(s["duration_s"] for s in truth["rate_segments"]["segments"])
         if covered + 1e-9 < checked["duration_s"]:
@@ -357,6 +367,19 @@ def validate(data, source="<scenario>"):
         if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise InputError(f"{source}: truth.rigid_body.inertia_kg_m2: must be symmetric positive definite")
     return Scenario(data=checked, source=source)
+
+
+def _check_run_size(checked, source):
+    """One run must fit in memory: bounds on its gyro samples, truth samples and frames."""
+    duration = checked["duration_s"]
+    sizes = (("gyro.rate_hz", duration * checked["gyro"]["rate_hz"], MAX_GYRO_SAMPLES, "gyro samples"),
+             ("truth.rate_hz", duration * checked["truth"]["rate_hz"], MAX_TRUTH_SAMPLES, "truth samples"),
+             ("star_sensor.rate_hz", duration * checked["star_sensor"]["rate_hz"], MAX_FRAMES, "star-sensor frames"))
+    for key, count, limit, what in sizes:
+        if count > limit:
+            raise InputError(f"{source}: duration_s: {duration:g} s at {key} = {checked[key.split('.')[0]]['rate_hz']:g} Hz "
+                             f"is {count:.3g} {what}, more than the {limit:.0e} one run holds in memory; shorten the "
+                             "run (a campaign of shorter runs covers more) or lower the rate")
 
 
 def _checked(schema, data, source):
@@ -408,11 +431,13 @@ def load_scenario(path, overrides=()):
     if path.is_dir():
         raise InputError(f"{path}: is a directory, expected a scenario .toml file")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a byte-order mark is not an error
     except UnicodeDecodeError:
-        raise InputError(f"{path}: not a text file") from None
+        raise InputError(f"{path}: not a text file (not UTF-8)") from None
     except tomllib.TOMLDecodeError as error:
         raise InputError(f"{path}: invalid TOML: {error}") from None
+    except RecursionError:
+        raise InputError(f"{path}: invalid TOML: arrays or tables nested too deeply") from None
     return validate(apply_overrides(data, overrides, str(path)), source=path.name)
 
 

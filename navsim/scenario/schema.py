@@ -85,6 +85,8 @@ class Value:
             if not isinstance(value, list) or len(value) != self.size:
                 raise InputError(f"{where}: must be a {self.size}x{self.size} list of lists of numbers")
             value = [_numbers(where, row, self.size) for row in value]
+            for v in (v for row in value for v in row):
+                self._check_range(where, v)
         else:  # pragma: no cover - schema authoring error
             raise AssertionError(self.kind)
         return value

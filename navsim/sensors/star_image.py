@@ -41,12 +41,14 @@ from startrack.stacking import DimStarCache
 #: 24 seeds (176 stacked frames): (0.35, 0.25) px RMS in (u, v), against (0.45, 0.38) px uncorrected.
 STACKED_SIGMA_PX = 0.30
 
-#: Per-frame log quantities: name -> (trailing shape, dtype, value before the frame is logged).
+#: Per-frame log quantities: name -> (trailing shape, dtype, value before the frame is logged); the
+#: identification time [ms] is a wall-clock measurement, kept apart from the reproducible log.
 LOG_FIELDS = {
     "mode": ((), np.int8, 0), "n_detected": ((), np.int32, 0), "n_identified": ((), np.int32, 0),
-    "n_stacked": ((), np.int32, 0), "id_ms": ((), np.float64, np.nan), "boresight_radec": ((2,), np.float64, np.nan),
+    "n_stacked": ((), np.int32, 0), "boresight_radec": ((2,), np.float64, np.nan),
     "subcatalog_index": ((), np.int32, 0), "subcatalog_address": ((2,), np.int32, 0),
 }
+TIMING_FIELDS = {"id_ms": ((), np.float64, np.nan)}
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,7 @@ class ImageRun:
     the random streams of rendering and false stars, and one full frame kept for the report."""
 
     log_fields = LOG_FIELDS
+    timing_fields = TIMING_FIELDS
 
     def __init__(self, sensor, storm_rng, render_rng, n_frames, full_frames):
         self.sensor = sensor

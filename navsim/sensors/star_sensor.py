@@ -13,7 +13,8 @@ which answers three calls:
 
 ``record()`` returns the measurements of every frame when they are known before the run (vector
 fidelity: they do not depend on the filter), which lets the filter take its compiled fast path;
-otherwise None. ``log_fields`` declares the per-frame quantities the sensor adds to the run log.
+otherwise None. ``log_fields`` declares the per-frame quantities the sensor adds to the run log, and
+``timing_fields`` those that are wall-clock measurements (kept apart: they differ between runs of one seed).
 """
 
 from dataclasses import dataclass, field

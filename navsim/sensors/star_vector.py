@@ -142,6 +142,7 @@ class VectorRun:
     :class:`Record` frame by frame; tracking state and faults other than lost frames do not apply."""
 
     log_fields = {}
+    timing_fields = {}
     sample = None
 
     def __init__(self, record):

@@ -19,14 +19,18 @@ class StudyResult:
 
 class Findings:
     """A per-frame observer's findings for a run or a campaign: ``stats`` (the summary's entry under
-    ``key``), ``series`` (extra per-frame arrays of a run) and, from the subclass, ``rows`` (the
-    comparison table) and ``notes`` (sentences explaining it)."""
+    ``key``), ``timing`` (its wall-clock figures, under the summary's ``timing``), ``series`` (extra
+    per-frame arrays of a run) and, from the subclass, ``rows`` and ``timing_rows`` (the comparison
+    table) and ``notes`` and ``timing_notes`` (sentences explaining it)."""
 
     key = ""
+    timing_rows = ()
+    timing_notes = ()
 
-    def __init__(self, stats, series=None):
+    def __init__(self, stats, series=None, timing=None):
         self.stats = stats
         self.series = series or {}
+        self.timing = timing or {}
 
 
 def percent(ours, paper):

@@ -180,6 +180,7 @@ class _ScriptedSensor:
     """Frame 0: three stars from a sub-catalog identification; 1: an attitude fix; 2: nothing; then stars."""
 
     log_fields = {"mode": ((), np.int8, 0)}
+    timing_fields = {}
     sample = None
 
     def __init__(self):
