@@ -13,7 +13,7 @@ Keys carry their units (``rate_deg_per_s``); every problem raises one
 """
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 from typing import NamedTuple
 
 import numpy as np
@@ -398,5 +398,5 @@ def _build(kind, row, where):
     except InputError as error:
         raise InputError(f"{where}.{error}") from None
     except TypeError:
-        missing = sorted(f.name for f in fields(kind) if f.name not in row)
+        missing = [f.name for f in fields(kind) if f.name not in row and f.default is MISSING]
         raise InputError(f"{where}.{missing[0]}: missing") from None

@@ -1,0 +1,117 @@
+"""Strapdown mechanization: our trajectory generator's IMU integrated by ours reproduces the truth, and
+the free-INS error dynamics follow their closed forms (Schuler period and amplitude, north gyro drift).
+
+The free vertical channel is unstable (e-folding time √(a/2g) ≈ 570 s): runs longer than ~1 h damp it
+with the baro loop fed by the true height (a perfect baro), as every real INS does."""
+
+import numpy as np
+import pytest
+from scipy.optimize import curve_fit
+
+from navsim.earth.gravity import normal_gravity
+from navsim.earth.wgs84 import radii
+from navsim.ins import strapdown
+from navsim.truth import trajectory
+from navsim.truth.segments import Hold, Profile, Start
+from navsim.truth.tables import AIRCRAFT_2H
+from startrack import rotation as rot
+from startrack import units
+from startrack.errors import InputError
+from tests.navsim.ins_helpers import attitude_errors, position_errors
+
+
+def _start(truth, q_nb=None):
+    return strapdown.initial_state(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0],
+                                   truth.q_nb[0] if q_nb is None else q_nb)
+
+
+def aircraft_first_hour():
+    """The 2 h aircraft table cut at 1 h: climb to 7 km, four turns, a speed change and the start of
+    the descent."""
+    segments = AIRCRAFT_2H["segments"][:9]
+    head = Profile.from_table({**AIRCRAFT_2H, "segments": segments}).duration
+    return Profile.from_table({**AIRCRAFT_2H, "segments": segments + [{"kind": "straight", "duration_s": 3600.0 - head}]})
+
+
+@pytest.fixture(scope="module")
+def aircraft_hour():
+    """The aircraft's first hour with its IMU at 100 Hz."""
+    return trajectory.generate(aircraft_first_hour(), 100.0)
+
+
+def test_our_imu_integrated_by_ours_reproduces_the_aircraft_truth(aircraft_hour):
+    """1 h of flight, perfect sensors, free INS (vertical channel undamped): position within 0.1 m,
+    velocity within 1 mm/s, attitude within 0.001"."""
+    truth = aircraft_hour
+    log = strapdown.run(_start(truth), truth.dtheta, truth.dv, truth.dt, every=100)
+    errors = position_errors(log, truth, every=100)
+    assert np.max(np.linalg.norm(errors, axis=1)) < 0.1
+    assert np.max(np.abs(log.v_n - truth.v_n[::100])) < 1e-3
+    assert np.max(np.abs(attitude_errors(log, truth, every=100))) < 1e-3 * units.ARCSEC
+
+
+def test_stationary_day_stays_within_one_metre():
+    """24 h at rest (45 deg N), perfect sensors at 5 Hz, baro-damped vertical: within 1 m."""
+    truth = trajectory.generate(Profile(Start(45.0, 10.0, 150.0, heading_deg=40.0), (Hold(86400.0),)), 5.0)
+    log = strapdown.run(_start(truth), truth.dtheta, truth.dv, truth.dt, baro_h=truth.h[1:], every=50)
+    assert np.max(np.linalg.norm(position_errors(log, truth, every=50), axis=1)) < 1.0
+
+
+@pytest.fixture(scope="module")
+def equator_rest():
+    """4 h at rest on the equator at 10 Hz: no Foucault coupling (ω_ie sin L = 0), so each horizontal
+    channel is a pure Schuler loop."""
+    return trajectory.generate(Profile(Start(0.0, 30.0, 0.0), (Hold(4 * 3600.0),)), 10.0)
+
+
+def _schuler_fit(t, error, omega0):
+    model = lambda t, a, b, c, w: a + b * np.cos(w * t) + c * np.sin(w * t)  # noqa: E731
+    (a, b, c, w), _ = curve_fit(model, t, error, p0=[error.mean(), -error.mean(), 0.0, omega0])
+    return 2.0 * np.pi / w, np.hypot(b, c)
+
+
+def test_accelerometer_bias_gives_the_schuler_oscillation(equator_rest):
+    """A north accelerometer bias ∇: δN(t) = (R∇/g)(1 − cos ω_s t), ω_s = √(g/R): period 84.4 min
+    (within 0.5 %) and amplitude R∇/g (within 2 %)."""
+    truth, bias = equator_rest, 1e-4
+    dv = truth.dv + np.array([bias, 0.0, 0.0]) * truth.dt  # body x is north (heading 0, level)
+    log = strapdown.run(_start(truth), truth.dtheta, dv, truth.dt, baro_h=truth.h[1:], every=10)
+    r_m, g = radii(0.0)[0], normal_gravity(0.0, 0.0)
+    period, amplitude = _schuler_fit(truth.t[::10], position_errors(log, truth, every=10)[:, 0], np.sqrt(g / r_m))
+    assert period / 60.0 == pytest.approx(84.4, rel=0.005)
+    assert period == pytest.approx(2.0 * np.pi * np.sqrt(r_m / g), rel=1e-4)
+    assert amplitude == pytest.approx(r_m * bias / g, rel=0.02)
+
+
+def test_initial_tilt_gives_the_schuler_oscillation(equator_rest):
+    """An initial tilt φ_N about north: δE(t) = −R φ_N (1 − cos ω_s t). (About north, because on the
+    equator the east-tilt channel also exchanges with the heading error at the Earth rate.)"""
+    truth, tilt = equator_rest, 20 * units.ARCSEC
+    q_est = rot.multiply(rot.from_rotation_vector([-tilt, 0.0, 0.0]), truth.q_nb[0])  # C_est = (I − [φ×]) C
+    log = strapdown.run(_start(truth, q_est), truth.dtheta, truth.dv, truth.dt, baro_h=truth.h[1:], every=10)
+    r_n, g = radii(0.0)[1], normal_gravity(0.0, 0.0)
+    period, amplitude = _schuler_fit(truth.t[::10], position_errors(log, truth, every=10)[:, 1], np.sqrt(g / r_n))
+    assert period / 60.0 == pytest.approx(84.4, rel=0.005)
+    assert amplitude == pytest.approx(r_n * tilt, rel=0.02)
+
+
+def test_north_gyro_drift_gives_the_textbook_growth(equator_rest):
+    """A north gyro drift ε: δE(t) = R ε (t − sin(ω_s t)/ω_s) (→ g ε t³/6 early, R ε t late), within 1 %."""
+    truth, drift = equator_rest, units.deg_per_h_to_rad_per_s(0.01)
+    dtheta = truth.dtheta + np.array([drift, 0.0, 0.0]) * truth.dt
+    log = strapdown.run(_start(truth), dtheta, truth.dv, truth.dt, baro_h=truth.h[1:], every=10)
+    r_n, g = radii(0.0)[1], normal_gravity(0.0, 0.0)
+    w = np.sqrt(g / r_n)
+    t = truth.t[::10]
+    expected = r_n * drift * (t - np.sin(w * t) / w)
+    east = position_errors(log, truth, every=10)[:, 1]
+    assert np.max(np.abs(east - expected)) < 0.01 * np.max(expected)
+
+
+def test_bad_start_is_named():
+    with pytest.raises(InputError, match="lat"):
+        strapdown.initial_state(2.0, 0.0, 0.0, np.zeros(3), [0, 0, 0, 1.0])
+    with pytest.raises(InputError, match="height"):
+        strapdown.initial_state(0.5, 0.0, -2000.0, np.zeros(3), [0, 0, 0, 1.0])
+    with pytest.raises(InputError, match="baro_time_constant_s"):
+        strapdown.baro_gains(0.0)
