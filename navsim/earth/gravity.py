@@ -46,6 +46,19 @@ def normal_gravity_height_gradient(lat, h):
     return gamma0 * (-2.0 / A * (1.0 + F + M - 2.0 * F * s2) + 6.0 * h / (A * A))
 
 
+@njit
+def normal_gravity_latitude_gradient(lat, h):
+    """∂γ/∂L [m/s²/rad] of :func:`normal_gravity` (about 0.05 sin 2L)."""
+    s = np.sin(lat)
+    c = np.cos(lat)
+    s2 = s * s
+    w = 1.0 - E2 * s2
+    gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(w)
+    d_gamma0 = GAMMA_E * 2.0 * s * c * (K_SOMIGLIANA / np.sqrt(w) + (1.0 + K_SOMIGLIANA * s2) * E2 / (2.0 * w**1.5))
+    height = 1.0 - 2.0 / A * (1.0 + F + M - 2.0 * F * s2) * h + 3.0 * h * h / (A * A)
+    return d_gamma0 * height + gamma0 * (8.0 * F * s * c * h / A)
+
+
 @dataclass(frozen=True)
 class GravityDisturbance:
     """Deflection of the vertical ξ, η [rad] and anomaly Δg [m/s²] along a track.

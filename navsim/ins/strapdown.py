@@ -86,7 +86,7 @@ def _rates(lat, h, v):
 
 @njit
 def _velocity_step(v, u_n, lat, h, dt):
-    """(v_k, Δv_sf^n, ζ) from u_n = C_nb Δv_b: steps 3-4 with the midpoint predictor-corrector."""
+    """(v_k, ζ) from u_n = C_nb Δv_b: steps 3-4 with the midpoint predictor-corrector."""
     w_ie, w_en, g = _rates(lat, h, v)
     zeta = (w_ie + w_en) * dt
     dv_sf = u_n - 0.5 * _cross(zeta, u_n)
@@ -97,12 +97,12 @@ def _velocity_step(v, u_n, lat, h, dt):
     w_ie, w_en, g = _rates(lat_mid, h_mid, v_mid)
     zeta = (w_ie + w_en) * dt
     dv_sf = u_n - 0.5 * _cross(zeta, u_n)
-    return v + dv_sf + (g - _cross(2.0 * w_ie + w_en, v_mid)) * dt, dv_sf, zeta
+    return v + dv_sf + (g - _cross(2.0 * w_ie + w_en, v_mid)) * dt, zeta
 
 
 @njit
 def step(nav, dtheta, dv, dt):
-    """Advance ``nav`` in place by one interval; returns the specific-force increment Δv_sf^n (3,)."""
+    """Advance ``nav`` in place by one interval of increments Δθ, Δv (3,) and length dt [s]."""
     lat, lon, h = nav[0], nav[1], nav[2]
     v = nav[3:6].copy()
     q = nav[6:10].copy()
@@ -111,7 +111,7 @@ def step(nav, dtheta, dv, dt):
     rotation = _cross(dtheta, dv)
     dv_b = dv + 0.5 * rotation + _cross(dtheta, rotation) / 6.0 + (_cross(dtheta_prev, dv) + _cross(dv_prev, dtheta)) / 12.0
     u_n = quat_to_matrix(q) @ dv_b
-    v_new, dv_sf, zeta = _velocity_step(v, u_n, lat, h, dt)
+    v_new, zeta = _velocity_step(v, u_n, lat, h, dt)
     h_new = h - 0.5 * dt * (v[2] + v_new[2])
     r_m, r_n = radii(lat)
     lat_new = lat + 0.5 * dt * (v[0] / (r_m + h) + v_new[0] / (r_m + h_new))
@@ -124,7 +124,6 @@ def step(nav, dtheta, dv, dt):
     nav[6:10] = q_new
     nav[10:13] = dtheta
     nav[13:16] = dv
-    return dv_sf
 
 
 @njit
