@@ -3,6 +3,8 @@
 import numpy as np
 
 from navsim.earth.wgs84 import radii
+from navsim.truth.segments import Profile
+from navsim.truth.tables import AIRCRAFT_2H
 from startrack import rotation as rot
 
 
@@ -16,3 +18,11 @@ def position_errors(log, truth, every=1):
 def attitude_errors(log, truth, every=1):
     """Attitude error rotation vectors [rad] (K, 3) of q_est against q_true (in the truth's b axes)."""
     return rot.attitude_error(truth.q_nb[::every], log.q_nb)
+
+
+def aircraft_first_hour():
+    """The 2 h aircraft table cut at 1 h: climb to 7 km, four turns, a speed change and the start of
+    the descent."""
+    segments = AIRCRAFT_2H["segments"][:9]
+    head = Profile.from_table({**AIRCRAFT_2H, "segments": segments}).duration
+    return Profile.from_table({**AIRCRAFT_2H, "segments": segments + [{"kind": "straight", "duration_s": 3600.0 - head}]})

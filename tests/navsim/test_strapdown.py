@@ -13,24 +13,15 @@ from navsim.earth.wgs84 import radii
 from navsim.ins import strapdown
 from navsim.truth import trajectory
 from navsim.truth.segments import Hold, Profile, Start
-from navsim.truth.tables import AIRCRAFT_2H
 from startrack import rotation as rot
 from startrack import units
 from startrack.errors import InputError
-from tests.navsim.ins_helpers import attitude_errors, position_errors
+from tests.navsim.ins_helpers import aircraft_first_hour, attitude_errors, position_errors
 
 
 def _start(truth, q_nb=None):
     return strapdown.initial_state(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0],
                                    truth.q_nb[0] if q_nb is None else q_nb)
-
-
-def aircraft_first_hour():
-    """The 2 h aircraft table cut at 1 h: climb to 7 km, four turns, a speed change and the start of
-    the descent."""
-    segments = AIRCRAFT_2H["segments"][:9]
-    head = Profile.from_table({**AIRCRAFT_2H, "segments": segments}).duration
-    return Profile.from_table({**AIRCRAFT_2H, "segments": segments + [{"kind": "straight", "duration_s": 3600.0 - head}]})
 
 
 @pytest.fixture(scope="module")
