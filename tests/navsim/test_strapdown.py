@@ -106,3 +106,42 @@ def test_bad_start_is_named():
         strapdown.initial_state(0.5, 0.0, -2000.0, np.zeros(3), [0, 0, 0, 1.0])
     with pytest.raises(InputError, match="baro_time_constant_s"):
         strapdown.baro_gains(0.0)
+
+
+@pytest.mark.slow
+def test_earth_rate_oscillation_in_the_ship_run():
+    """24 h of the ship (35 N, 8 m/s, rolling, pitching, heaving), IMU at 10 Hz, a body-x gyro drift
+    ε = 0.01 deg/h, baro-damped vertical. With the Schuler oscillation averaged out (84-min running
+    mean), the position error is a line plus an oscillation at the sidereal day (the psi-angle
+    equation ψ̇ = −ω_ie × ψ − ε: the drift's part across the Earth's axis turns at ω_ie) of amplitude
+    R ε_⊥/ω_ie (within 5 %); periods of 20 h or 28 h fit four times worse."""
+    from navsim.earth.wgs84 import OMEGA_IE
+    from navsim.truth.tables import SHIP_24H
+
+    table = {"start": SHIP_24H["start"], "segments": [{**SHIP_24H["segments"][0], "duration_s": 86400.0}]}
+    truth = trajectory.generate(Profile.from_table(table), 10.0)
+    drift = units.deg_per_h_to_rad_per_s(0.01)
+    log = strapdown.run(_start(truth), truth.dtheta + np.array([drift, 0.0, 0.0]) * truth.dt, truth.dv, truth.dt,
+                        baro_h=truth.h[1:], every=600)
+    errors, t = position_errors(log, truth, every=600), truth.t[::600]
+    mean = np.ones(84) / 84.0
+    ts = np.convolve(t, mean, mode="valid")
+
+    def fit(series, period_h):
+        w = 2.0 * np.pi / (period_h * 3600.0)
+        A = np.stack([np.ones_like(ts), ts, np.cos(w * ts), np.sin(w * ts)], axis=-1)
+        c = np.linalg.lstsq(A, series, rcond=None)[0]
+        return np.sqrt(np.mean((A @ c - series) ** 2)), np.hypot(c[2], c[3])
+
+    sidereal_h = 2.0 * np.pi / OMEGA_IE / 3600.0
+    lat, heading = np.radians(35.0), np.radians(60.0)
+    drift_n = drift * np.array([np.cos(heading), np.sin(heading), 0.0])
+    axis = np.array([np.cos(lat), 0.0, -np.sin(lat)])
+    across = np.linalg.norm(drift_n - axis * (drift_n @ axis))
+    for channel in (0, 1):
+        series = np.convolve(errors[:, channel], mean, mode="valid")
+        residual, amplitude = fit(series, sidereal_h)
+        assert residual < 0.02 * amplitude
+        assert min(fit(series, 20.0)[0], fit(series, 28.0)[0]) > 4.0 * residual
+    assert fit(np.convolve(errors[:, 0], mean, mode="valid"), sidereal_h)[1] == pytest.approx(
+        radii(lat)[0] * across / OMEGA_IE, rel=0.05)
