@@ -102,14 +102,15 @@ def discretize(F, q_c, dt):
 
 
 @njit
-def correct(dtheta, dv, imu, dt, n):
-    """Increments corrected by the bias and scale-factor estimates ``imu`` = [b̂_g, b̂_a, ŝ_g, ŝ_a]."""
-    a = dtheta - imu[0:3] * dt
-    b = dv - imu[3:6] * dt
-    if n > 15:
-        a = (1.0 - imu[6:9]) * a
-        b = (1.0 - imu[9:12]) * b
-    return a, b
+def correct(dtheta, dv, imu, dt, n, a, b):
+    """Write into ``a``, ``b`` the increments corrected by the estimates ``imu`` = [b̂_g, b̂_a, ŝ_g, ŝ_a]:
+    (1 − ŝ_g)(Δθ − b̂_g Δt) and (1 − ŝ_a)(Δv − b̂_a Δt)."""
+    for i in range(3):
+        a[i] = dtheta[i] - imu[i] * dt
+        b[i] = dv[i] - imu[3 + i] * dt
+        if n > 15:
+            a[i] *= 1.0 - imu[6 + i]
+            b[i] *= 1.0 - imu[9 + i]
 
 
 @njit
@@ -140,7 +141,7 @@ def flush(nav, P, acc, q_c, dt):
     C_f = acc[22:31].reshape(3, 3) / span
     F = continuous_f(nav[0], nav[2], nav[3:6], acc[1:4] / span, C, C_w, C_f, n)
     Phi, Q = discretize(F, q_c, span)
-    P_next = mm_t(mm(Phi, P), Phi) + Q
+    P_next = mm(Phi, mm(Phi, P).T.copy()) + Q  # Φ (Φ P)ᵀ = Φ P Φᵀ with sparse left factors
     P[:, :] = 0.5 * (P_next + P_next.T)
     acc[:] = 0.0
 
@@ -150,8 +151,9 @@ def predict(nav, imu, P, acc, dtheta, dv, dt, q_c, every):
     """Mechanize the corrected increments (M, 3) and propagate P every ``every`` intervals
     (the remainder stays in ``acc`` until the next call or update). All arrays change in place."""
     n = P.shape[0]
+    a, b = np.empty(3), np.empty(3)
     for k in range(dtheta.shape[0]):
-        a, b = correct(dtheta[k], dv[k], imu, dt, n)
+        correct(dtheta[k], dv[k], imu, dt, n, a, b)
         accumulate(acc, nav[6:10], a, b)
         step(nav, a, b, dt)
         if acc[0] >= every:

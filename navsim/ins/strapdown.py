@@ -72,58 +72,71 @@ def baro_gains(time_constant):
 
 
 @njit
-def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+def _cross(a0, a1, a2, b0, b1, b2):
+    """a × b of two vectors given by their components (scalar arithmetic: no allocation)."""
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
 @njit
-def _rates(lat, h, v):
-    """(ω_ie^n, ω_en^n, g_n) at (L, h, v) as (3,) arrays."""
-    w_ie = np.array(earth_rate_n(lat))
-    w_en = np.array(transport_rate_n(lat, h, v[0], v[1]))
-    return w_ie, w_en, np.array([0.0, 0.0, normal_gravity(lat, h)])
+def _velocity_change(lat, h, v0, v1, v2, u0, u1, u2, dt):
+    """(Δv_n (3), ζ (3)) over dt with the rates at (L, h, v): Δv_n = Δv_sf^n + [g_n − (2ω_ie^n + ω_en^n)
+    × v] dt, Δv_sf^n = u − ½ ζ × u (steps 3-4 for u = C_nb Δv_b), ζ = (ω_ie^n + ω_en^n) dt."""
+    e0, e1, e2 = earth_rate_n(lat)
+    t0, t1, t2 = transport_rate_n(lat, h, v0, v1)
+    z0, z1, z2 = (e0 + t0) * dt, (e1 + t1) * dt, (e2 + t2) * dt
+    r0, r1, r2 = _cross(z0, z1, z2, u0, u1, u2)
+    c0, c1, c2 = _cross(2.0 * e0 + t0, 2.0 * e1 + t1, 2.0 * e2 + t2, v0, v1, v2)
+    g = normal_gravity(lat, h)
+    return (u0 - 0.5 * r0 - c0 * dt, u1 - 0.5 * r1 - c1 * dt, u2 - 0.5 * r2 + (g - c2) * dt), (z0, z1, z2)
 
 
 @njit
-def _velocity_step(v, u_n, lat, h, dt):
-    """(v_k, ζ) from u_n = C_nb Δv_b: steps 3-4 with the midpoint predictor-corrector."""
-    w_ie, w_en, g = _rates(lat, h, v)
-    zeta = (w_ie + w_en) * dt
-    dv_sf = u_n - 0.5 * _cross(zeta, u_n)
-    v_pred = v + dv_sf + (g - _cross(2.0 * w_ie + w_en, v)) * dt
-    v_mid = 0.5 * (v + v_pred)
-    h_mid = h - 0.5 * dt * v_mid[2]
-    lat_mid = lat + 0.5 * dt * v_mid[0] / (radii(lat)[0] + h_mid)
-    w_ie, w_en, g = _rates(lat_mid, h_mid, v_mid)
-    zeta = (w_ie + w_en) * dt
-    dv_sf = u_n - 0.5 * _cross(zeta, u_n)
-    return v + dv_sf + (g - _cross(2.0 * w_ie + w_en, v_mid)) * dt, zeta
+def _body_increment(dtheta, dv, dtheta_prev, dv_prev):
+    """(α, Δv_b): the coning-corrected rotation vector and the rotation/sculling-corrected velocity
+    increment in the body frame at the start of the interval (steps 1-2)."""
+    t0, t1, t2 = dtheta[0], dtheta[1], dtheta[2]
+    v0, v1, v2 = dv[0], dv[1], dv[2]
+    c0, c1, c2 = _cross(dtheta_prev[0], dtheta_prev[1], dtheta_prev[2], t0, t1, t2)
+    alpha = np.array([t0 + c0 / 12.0, t1 + c1 / 12.0, t2 + c2 / 12.0])
+    r0, r1, r2 = _cross(t0, t1, t2, v0, v1, v2)
+    s0, s1, s2 = _cross(t0, t1, t2, r0, r1, r2)
+    p0, p1, p2 = _cross(dtheta_prev[0], dtheta_prev[1], dtheta_prev[2], v0, v1, v2)
+    q0, q1, q2 = _cross(dv_prev[0], dv_prev[1], dv_prev[2], t0, t1, t2)
+    dv_b = (v0 + 0.5 * r0 + s0 / 6.0 + (p0 + q0) / 12.0,
+            v1 + 0.5 * r1 + s1 / 6.0 + (p1 + q1) / 12.0,
+            v2 + 0.5 * r2 + s2 / 6.0 + (p2 + q2) / 12.0)
+    return alpha, dv_b
 
 
 @njit
 def step(nav, dtheta, dv, dt):
     """Advance ``nav`` in place by one interval of increments Δθ, Δv (3,) and length dt [s]."""
-    lat, lon, h = nav[0], nav[1], nav[2]
-    v = nav[3:6].copy()
-    q = nav[6:10].copy()
-    dtheta_prev, dv_prev = nav[10:13], nav[13:16]
-    alpha = dtheta + _cross(dtheta_prev, dtheta) / 12.0
-    rotation = _cross(dtheta, dv)
-    dv_b = dv + 0.5 * rotation + _cross(dtheta, rotation) / 6.0 + (_cross(dtheta_prev, dv) + _cross(dv_prev, dtheta)) / 12.0
-    u_n = quat_to_matrix(q) @ dv_b
-    v_new, zeta = _velocity_step(v, u_n, lat, h, dt)
-    h_new = h - 0.5 * dt * (v[2] + v_new[2])
+    lat, lon, h, v0, v1, v2 = nav[0], nav[1], nav[2], nav[3], nav[4], nav[5]
+    alpha, dv_b = _body_increment(dtheta, dv, nav[10:13], nav[13:16])
+    C = quat_to_matrix(nav[6:10])
+    u0 = C[0, 0] * dv_b[0] + C[0, 1] * dv_b[1] + C[0, 2] * dv_b[2]
+    u1 = C[1, 0] * dv_b[0] + C[1, 1] * dv_b[1] + C[1, 2] * dv_b[2]
+    u2 = C[2, 0] * dv_b[0] + C[2, 1] * dv_b[1] + C[2, 2] * dv_b[2]
+    # predictor with the rates at the start, corrector with the rates at the midpoint
+    a, _ = _velocity_change(lat, h, v0, v1, v2, u0, u1, u2, dt)
+    m0, m1, m2 = v0 + 0.5 * a[0], v1 + 0.5 * a[1], v2 + 0.5 * a[2]
+    h_mid = h - 0.5 * dt * m2
+    lat_mid = lat + 0.5 * dt * m0 / (radii(lat)[0] + h_mid)
+    a, zeta = _velocity_change(lat_mid, h_mid, m0, m1, m2, u0, u1, u2, dt)
+    w0, w1, w2 = v0 + a[0], v1 + a[1], v2 + a[2]
+    h_new = h - 0.5 * dt * (v2 + w2)
     r_m, r_n = radii(lat)
-    lat_new = lat + 0.5 * dt * (v[0] / (r_m + h) + v_new[0] / (r_m + h_new))
-    r_n_new = radii(lat_new)[1]
-    lon_new = lon + 0.5 * dt * (v[1] / ((r_n + h) * np.cos(lat)) + v_new[1] / ((r_n_new + h_new) * np.cos(lat_new)))
-    q_new = quat_multiply(quat_from_rotation_vector(-zeta), quat_multiply(q, quat_from_rotation_vector(alpha)))
-    q_new /= np.sqrt(np.sum(q_new * q_new))
-    nav[0], nav[1], nav[2] = lat_new, lon_new, h_new
-    nav[3:6] = v_new
-    nav[6:10] = q_new
-    nav[10:13] = dtheta
-    nav[13:16] = dv
+    lat_new = lat + 0.5 * dt * (v0 / (r_m + h) + w0 / (r_m + h_new))
+    lon_new = lon + 0.5 * dt * (v1 / ((r_n + h) * np.cos(lat)) + w1 / ((radii(lat_new)[1] + h_new) * np.cos(lat_new)))
+    minus_zeta = np.array([-zeta[0], -zeta[1], -zeta[2]])
+    q = quat_multiply(quat_from_rotation_vector(minus_zeta), quat_multiply(nav[6:10], quat_from_rotation_vector(alpha)))
+    norm = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    nav[0], nav[1], nav[2], nav[3], nav[4], nav[5] = lat_new, lon_new, h_new, w0, w1, w2
+    for i in range(4):
+        nav[6 + i] = q[i] / norm
+    for i in range(3):
+        nav[10 + i] = dtheta[i]
+        nav[13 + i] = dv[i]
 
 
 @njit
