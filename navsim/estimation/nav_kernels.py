@@ -79,26 +79,44 @@ def continuous_f(lat, h, v, f_n, C, C_w, C_f, n):
 
 
 @njit
+def _sparse_times(rows, cols, values, B, out):
+    """out = S B for S given by its non-zero triplets (rows, cols, values)."""
+    out[:, :] = 0.0
+    for k in range(values.shape[0]):
+        i, p, a = rows[k], cols[k], values[k]
+        for j in range(B.shape[1]):
+            out[i, j] += a * B[p, j]
+
+
+@njit
 def discretize(F, q_c, dt):
     """(Φ, Q_d) over dt [s] for F and the diagonal continuous noise ``q_c`` (n,) by their Taylor
     series to fifth order: Φ = Σ (FΔt)^k/k! and Van Loan's integral
     Q_d = ∫₀^Δt e^(Fs) Q e^(Fᵀs) ds = Σ L_k Δt^(k+1)/(k+1)!, L_0 = Q, L_k = F L_(k−1) + L_(k−1) Fᵀ
-    (Van Loan 1978). F is sparse, so each product costs O(nnz(F) n)."""
+    (Van Loan 1978). F is sparse: each product runs over its non-zeros only."""
     n = F.shape[0]
-    A = F * dt
-    Phi = np.eye(n)
-    term = np.eye(n)
-    L = np.diag(q_c)
-    Q = L * dt
+    rows, cols = np.nonzero(F)
+    values = np.empty(rows.shape[0])
+    for k in range(rows.shape[0]):
+        values[k] = F[rows[k], cols[k]]
+    Phi, term, product = np.eye(n), np.eye(n), np.empty((n, n))
+    L = np.zeros((n, n))
+    Q = np.zeros((n, n))
+    for i in range(n):
+        L[i, i] = q_c[i]
+        Q[i, i] = q_c[i] * dt
     coefficient = dt
     for k in range(1, 6):
-        term = mm(A, term) / k
+        _sparse_times(rows, cols, values * (dt / k), term, product)
+        term[:, :] = product
         Phi += term
-        FL = mm(F, L)
-        L = FL + FL.T
+        _sparse_times(rows, cols, values, L, product)
         coefficient *= dt / (k + 1)
-        Q += coefficient * L
-    return Phi, 0.5 * (Q + Q.T)
+        for i in range(n):
+            for j in range(n):
+                L[i, j] = product[i, j] + product[j, i]
+                Q[i, j] += coefficient * L[i, j]
+    return Phi, Q
 
 
 @njit
