@@ -16,7 +16,7 @@ the vertical ξ (north-south) and η (east-west) [rad] and anomaly Δg [m/s²] g
     δg_n = [−ξ γ, −η γ, Δg]
 
 (ξ > 0 when the astronomic zenith lies north of the ellipsoidal one, so the plumb line points
-south of the normal; Jekeli, *Inertial Navigation Systems with Geodetic Applications*, §6.1).
+south of the normal; Jekeli, *Inertial Navigation Systems with Geodetic Applications*, ch. 6).
 """
 
 from dataclasses import dataclass
@@ -66,7 +66,7 @@ class GravityDisturbance:
     ``constant``: the same (ξ, η, Δg) everywhere. ``random``: each component a first-order
     Gauss-Markov process in travelled distance s with correlation length ``correlation_length``
     [m] and steady σ ``sigma`` = (σ_ξ, σ_η, σ_Δg), the along-track form of the Kaula/Jordan
-    covariance models used in inertial geodesy (Jekeli §6.4): x(s + Δs) = ρ x(s) + σ √(1 − ρ²) w,
+    covariance models used in inertial geodesy (Jekeli ch. 6): x(s + Δs) = ρ x(s) + σ √(1 − ρ²) w,
     ρ = exp(−Δs/D), drawn from the seeded generator. Build with :meth:`constant` or :meth:`random`.
     """
 

@@ -2,8 +2,10 @@
 
 The four defining parameters (a, 1/f, GM, ω_ie) are those of NIMA TR8350.2 (3rd ed., 2000),
 Table 3.1; every other constant is derived from them here, including the normal gravity at the
-equator and the pole (Hofmann-Wellenhof & Moritz, *Physical Geodesy*, 2nd ed., eq. 2-141), so the
-published values of TR8350.2 Table 3.4 are a test of this module, not an input to it.
+equator and the pole (the closed formulas of the level ellipsoid, Moritz 1980, *Geodetic Reference
+System 1980*; Hofmann-Wellenhof & Moritz, *Physical Geodesy*, 2nd ed., §2.7-2.8), so the published
+values of TR8350.2 (Table 3.4: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s²) test this module rather
+than feed it.
 
 The functions are compiled (numba) and take scalars or arrays alike; functions of vectors return
 their components as a tuple (north, east, down) or (x, y, z), so the same code serves the compiled
@@ -29,15 +31,15 @@ OMEGA_IE = 7.292115e-5
 B = A * (1.0 - F)
 #: First eccentricity squared e² = f (2 − f).
 E2 = F * (2.0 - F)
-#: m = ω² a² b / GM (TR8350.2 eq. 4-2).
+#: m = ω² a² b / GM (TR8350.2 §4).
 M = OMEGA_IE**2 * A**2 * B / GM
 
 
 def _normal_gravity_at_equator_and_pole():
-    """(γ_e, γ_p) [m/s²] of the level ellipsoid from (a, b, GM, ω): Hofmann-Wellenhof & Moritz
-    eq. 2-141, γ_e = GM/(ab) (1 − m − m e' q0'/(6 q0)), γ_p = GM/a² (1 + m e' q0'/(3 q0)),
+    """(γ_e, γ_p) [m/s²] of the level ellipsoid from (a, b, GM, ω) (Moritz 1980):
+    γ_e = GM/(ab) (1 − m − m e' q0'/(6 q0)), γ_p = GM/a² (1 + m e' q0'/(3 q0)),
     with e' the second eccentricity, q0 = ½[(1 + 3/e'²) atan e' − 3/e'] and
-    q0' = 3 (1 + 1/e'²)(1 − atan(e')/e') − 1 (eq. 2-113, 2-139)."""
+    q0' = 3 (1 + 1/e'²)(1 − atan(e')/e') − 1."""
     ep = math.sqrt(A * A - B * B) / B
     q0 = 0.5 * ((1.0 + 3.0 / ep**2) * math.atan(ep) - 3.0 / ep)
     q0p = 3.0 * (1.0 + 1.0 / ep**2) * (1.0 - math.atan(ep) / ep) - 1.0

@@ -17,11 +17,11 @@ state. Nobody else writes the state or P: read them through the properties.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
 
 from navsim.earth.wgs84 import radii
 from navsim.estimation import nav_kernels
 from navsim.estimation.attitude_filter import UpdateResult
+from navsim.estimation.consistency import chi2_quantile
 from navsim.ins import strapdown
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -72,7 +72,7 @@ class NavFilter:
         self.dt = float(dt)
         self.covariance_interval = int(covariance_interval)
         self.q_c = noise.spectral_densities(self.n)
-        self.gate = {dof: float(chi2.ppf(gate_probability, dof)) for dof in (1, 3)}
+        self.gate = {dof: float(chi2_quantile(gate_probability, dof)) for dof in (1, 3)}
         self._imu = np.zeros(12)
         self._imu[0:3], self._imu[3:6] = gyro_bias, accel_bias
         self.reset(lat, lon, h, v_n, q_nb, P)
@@ -113,6 +113,12 @@ class NavFilter:
 
     def _flush(self):
         nav_kernels.flush(self._nav, self._P, self._acc, self.q_c, self.dt)
+
+    def snapshot(self):
+        """What a run log keeps of the filter at an epoch: position, velocity, attitude, IMU error
+        estimates and P (copies)."""
+        return {"lat": self._nav[0], "lon": self._nav[1], "h": self._nav[2], "v_n": self.v_n, "q_nb": self.q_nb,
+                "gyro_bias": self.gyro_bias, "accel_bias": self.accel_bias, "P": self.P}
 
     @property
     def P(self):

@@ -30,7 +30,7 @@ ACC_SIZE = 31
 def continuous_f(lat, h, v, f_n, C, C_w, C_f, n):
     """Continuous error dynamics F (n x n) at (L, h, v_n) [rad, m, m/s] for the specific force f_n
     [m/s²] in n, the mean C_nb ``C``, and (for the scale-factor columns) C_nb diag(ω_b) ``C_w``
-    [rad/s] and C_nb diag(f_b) ``C_f`` [m/s²] (Titterton & Weston, 2nd ed., §12.2.3; Groves,
+    [rad/s] and C_nb diag(f_b) ``C_f`` [m/s²] (Titterton & Weston, 2nd ed., ch. 12; Groves,
     2nd ed., §14.2.4, with this φ sign):
 
     φ̇ = −ω_in × φ + δω_in − C_nb (ε + diag(ω_b) δs_g),

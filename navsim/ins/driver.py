@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.wgs84 import radii
-from navsim.estimation.kernels import quadratic_forms
+from navsim.estimation.consistency import nees
 from navsim.estimation.nav_filter import ImuNoise, NavFilter, error_state
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -87,7 +87,7 @@ def position_aided_run(truth, gyro, accel, P0, fix_rate_hz, fix_sigma, seed, cov
         accepted.append(result.accepted[0])
     error, P_log = np.array(rows), np.array(P_log)
     return AidedRun(t=truth.t[epochs], error=error, sigma=np.sqrt(np.diagonal(P_log, axis1=1, axis2=2)),
-                    nees=quadratic_forms(P_log, error), nis=np.array(nis), accepted=np.array(accepted))
+                    nees=nees(P_log, error), nis=np.array(nis), accepted=np.array(accepted))
 
 
 def _noisy_fix(truth, k, sigma, rng):

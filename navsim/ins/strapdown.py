@@ -17,8 +17,8 @@ increments Δθ, Δv [rad, m/s] of one interval of length dt [s] and updates, in
    R_N(L_k);
 6. attitude: q_nb,k = q(−ζ) ⊗ q_nb,(k−1) ⊗ q(α), q(·) the quaternion of a rotation vector.
 
-Optional barometric damping of the vertical channel (third-order loop, Titterton & Weston, 2nd ed.,
-§10.7.2; Widnall & Sinha 1980): with δh = h − h_baro,
+Optional barometric damping of the vertical channel (the third-order loop of Widnall & Sinha 1980):
+with δh = h − h_baro,
 ḣ ← ḣ − k1 δh, v̇_D ← v̇_D + k2 δh + u, u̇ = k3 δh, and k1 = 3/τ, k2 = 3/τ² + 2γ/a, k3 = 1/τ³
 (three poles at −1/τ once the 2γ/a instability is cancelled).
 """

@@ -77,33 +77,10 @@ def _finite(key, value):
         raise InputError(f"{key}: must be a finite number, got {value!r}")
 
 
-def _steady(tau, entry, climb=0.0):
+def _steady(tau, entry):
     """Channels of constant speed and heading, wings level."""
     zero = np.zeros_like(tau)
-    return Channels(zero + entry.speed, zero, zero + entry.heading, zero, zero + climb, zero, zero, zero, zero, zero)
-
-
-@dataclass(frozen=True)
-class Hold:
-    """Stationary (zero ground speed) for ``duration_s``."""
-
-    duration_s: float
-
-    def __post_init__(self):
-        _positive("duration_s", self.duration_s)
-
-    def duration_from(self, entry):
-        return float(self.duration_s)
-
-    def check_entry(self, entry):
-        if abs(entry.speed) > 1e-9:
-            raise InputError(f"kind: a hold needs zero speed, entered at {entry.speed} m/s (decelerate first)")
-
-    def channels(self, tau, entry):
-        return _steady(tau, entry)
-
-    def exit(self, entry):
-        return entry
+    return Channels(zero + entry.speed, zero, zero + entry.heading, zero, zero, zero, zero, zero, zero, zero)
 
 
 @dataclass(frozen=True)
@@ -126,6 +103,15 @@ class Straight:
 
     def exit(self, entry):
         return entry
+
+
+@dataclass(frozen=True)
+class Hold(Straight):
+    """Stationary (zero ground speed) for ``duration_s``."""
+
+    def check_entry(self, entry):
+        if abs(entry.speed) > 1e-9:
+            raise InputError(f"kind: a hold needs zero speed, entered at {entry.speed} m/s (decelerate first)")
 
 
 @dataclass(frozen=True)

@@ -123,7 +123,7 @@ def _attitude(ch):
 
 def _body_rate_from_euler(ch):
     """ω_nb^b (..., 3) [rad/s] from the ZYX Euler angles (yaw ψ, pitch θ, roll φ) and their rates
-    (Titterton & Weston, 2nd ed., §3.6.3.3, the inverse of the Euler-rate equations):
+    (the inverse of the ZYX Euler-rate equations; Titterton & Weston, 2nd ed., ch. 3):
     [φ̇ − ψ̇ sin θ, θ̇ cos φ + ψ̇ sin φ cos θ, −θ̇ sin φ + ψ̇ cos φ cos θ]."""
     sr, cr = np.sin(ch.roll), np.cos(ch.roll)
     sp, cp = np.sin(ch.pitch), np.cos(ch.pitch)

@@ -104,8 +104,8 @@ def test_process_noise_matches_van_loan(dt):
 
 from dataclasses import replace  # noqa: E402
 
-from scipy.stats import chi2  # noqa: E402
 
+from navsim.estimation.consistency import chi2_band  # noqa: E402
 from navsim.estimation.nav_filter import ImuNoise, NavFilter  # noqa: E402
 from navsim.ins import driver  # noqa: E402
 from navsim.sensors.accelerometer import AccelerometerModel  # noqa: E402
@@ -146,7 +146,7 @@ def _check_campaign(results, P0):
     run-axis cases, expected 99.7 %) with its horizontal σ reduced by the turns."""
     runs = len(results)
     nees = np.array([r.nees for r in results]).mean(axis=0)
-    low, high = chi2.ppf([0.025, 0.975], 15 * runs) / runs
+    low, high = chi2_band(15, runs)
     assert low <= nees.mean() <= high
     assert np.mean((nees >= low) & (nees <= high)) >= 0.8
     divergent = [r for r in results if not np.all(np.isfinite(r.error)) or np.any(np.abs(r.error) > 10 * r.sigma)]
