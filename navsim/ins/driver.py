@@ -74,18 +74,20 @@ def position_aided_run(truth, gyro, accel, P0, fix_rate_hz, fix_sigma, seed, cov
     fix_sigma = np.broadcast_to(np.asarray(fix_sigma, dtype=float), (3,))
     fix_rng = np.random.default_rng(fix_seed)
     epochs = np.arange(ratio, truth.dtheta.shape[0] + 1, ratio)
-    rows, P_log, nis, accepted = [], [], [], []
+    states, P_log, nis, accepted = [], [], [], []
     for k0, k1 in zip(np.concatenate([[0], epochs[:-1]]), epochs):
         nav_filter.predict(gyro_record.omega[k0:k1] * truth.dt, accel_record.force[k0:k1] * truth.dt)
         result = nav_filter.update_position(*_noisy_fix(truth, k1, fix_sigma, fix_rng))
-        lat, lon, h = nav_filter.position
-        rows.append(error_state(lat, lon, h, nav_filter.v_n, nav_filter.q_nb, nav_filter.gyro_bias,
-                                nav_filter.accel_bias, truth.lat[k1], truth.lon[k1], truth.h[k1], truth.v_n[k1],
-                                truth.q_nb[k1], gyro_record.bias[k1 - 1], accel_record.bias[k1 - 1]))
-        P_log.append(nav_filter.P)
+        snapshot = nav_filter.snapshot()
+        states.append(np.concatenate([[snapshot["lat"], snapshot["lon"], snapshot["h"]], snapshot["v_n"],
+                                      snapshot["q_nb"], snapshot["gyro_bias"], snapshot["accel_bias"]]))
+        P_log.append(snapshot["P"])
         nis.append(result.nis[0])
         accepted.append(result.accepted[0])
-    error, P_log = np.array(rows), np.array(P_log)
+    s, P_log = np.array(states), np.array(P_log)
+    error = error_state(s[:, 0], s[:, 1], s[:, 2], s[:, 3:6], s[:, 6:10], s[:, 10:13], s[:, 13:16],
+                        truth.lat[epochs], truth.lon[epochs], truth.h[epochs], truth.v_n[epochs], truth.q_nb[epochs],
+                        gyro_record.bias[epochs - 1], accel_record.bias[epochs - 1])
     return AidedRun(t=truth.t[epochs], error=error, sigma=np.sqrt(np.diagonal(P_log, axis1=1, axis2=2)),
                     nees=nees(P_log, error), nis=np.array(nis), accepted=np.array(accepted))
 
