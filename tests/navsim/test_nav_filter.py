@@ -214,3 +214,29 @@ def test_bad_filter_input_is_named():
         driver.check_aiding_rate(100.0, 0.0, "aiding.rate_hz")
     with pytest.raises(InputError, match="not a multiple"):
         driver.check_aiding_rate(100.0, 3.0, "aiding.rate_hz")
+
+
+def test_scale_factor_states_are_estimated_within_three_sigma():
+    """21 states on the 7-min turns with tactical scale factors (gyro 100 ppm, accelerometer 300 ppm)
+    and no misalignment: every scale factor ends within 3σ, no σ grows, and the vertical
+    accelerometer's (sensing g throughout) is the best observed in 7 min."""
+    truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
+    gyro, accel = _tactical_matched(50.0)
+    gyro, accel = replace(gyro, scale_factor_sigma=100e-6), replace(accel, scale_factor_sigma=300e-6)
+    g_seed, a_seed = np.random.SeedSequence(4).spawn(2)
+    g_rec, a_rec = gyro.measure(truth.dtheta / truth.dt, g_seed), accel.measure(truth.dv / truth.dt, a_seed)
+    P15 = driver.initial_covariance(gyro, accel, np.array([0.05, 0.05, 0.3]) * units.DEG, 0.1, 5.0, truth.lat[0], truth.h[0])
+    P = np.zeros((21, 21))
+    P[:15, :15] = P15
+    P[15:18, 15:18], P[18:21, 18:21] = np.eye(3) * 100e-6**2, np.eye(3) * 300e-6**2
+    noise = ImuNoise(gyro.arw, accel.vrw, gyro.filter_rrw, accel.filter_bias_rw)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt,
+                  estimate_scale_factors=True)
+    for k in range(0, truth.dtheta.shape[0], 50):
+        f.predict(g_rec.omega[k:k + 50] * truth.dt, a_rec.force[k:k + 50] * truth.dt)
+        f.update_position(truth.lat[k + 50], truth.lon[k + 50], truth.h[k + 50], 3.0)
+    s_g, s_a = f.scale_factors
+    error = np.concatenate([np.diag(g_rec.matrix) - 1.0 - s_g, np.diag(a_rec.matrix) - 1.0 - s_a])
+    sigma = np.sqrt(np.diag(f.P)[15:21])
+    assert np.all(np.abs(error) <= 3.0 * sigma)
+    assert np.all(sigma <= np.array([100e-6] * 3 + [300e-6] * 3)) and sigma[5] < 0.9 * 300e-6
