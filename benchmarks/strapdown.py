@@ -61,7 +61,8 @@ def sensors():
 def measured_increments(truth, seed):
     gyro, accel = sensors()
     g_seed, a_seed = np.random.SeedSequence(seed).spawn(2)
-    return gyro.measure(truth.dtheta / truth.dt, g_seed).omega * truth.dt, accel.measure(truth.dv / truth.dt, a_seed).force * truth.dt
+    dtheta = gyro.measure(truth.dtheta / truth.dt, g_seed).omega * truth.dt
+    return dtheta, accel.measure(truth.dv / truth.dt, a_seed).force * truth.dt
 
 
 def best(function, repeats):
@@ -204,7 +205,8 @@ def main():
           f"{results['pyins_filter']['s_per_h_best']:11.1f} {GOALS['filter_s_per_h']:6.1f}")
     print(f"truth generation (not in the above): {results['truth_generation_s_per_h']:.2f} s per hour")
     print(f"campaign 1000 x 1 h on 2 cores (estimated from {len(results['campaign']['run_wall_s_in_two_processes'])} runs): "
-          f"{results['campaign']['estimated_1000x1h_min_on_2_cores']:.1f} min (goal {GOALS['campaign_1000x1h_min_on_2_cores']:.0f})")
+          f"{results['campaign']['estimated_1000x1h_min_on_2_cores']:.1f} min "
+          f"(goal {GOALS['campaign_1000x1h_min_on_2_cores']:.0f})")
     out = Path(__file__).resolve().parent / "results" / "strapdown.json"
     out.parent.mkdir(parents=True, exist_ok=True)
     payload = {"machine": platform.platform(), "python": platform.python_version(), "imu_rate_hz": RATE_HZ,

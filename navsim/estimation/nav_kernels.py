@@ -20,7 +20,8 @@ from navsim.ins.strapdown import step
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, skew
 
-PHI, DV, DP, EPS, NABLA, SG, SA = 0, 3, 6, 9, 12, 15, 18
+#: First index of the position error (δL, δλ, δh) in the error state.
+DP = 6
 #: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
 #: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].
 ACC_SIZE = 31

@@ -36,7 +36,6 @@ from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix
 
 SIZE = 17
-POSITION, VELOCITY, ATTITUDE, PREV_DTHETA, PREV_DV, BARO_U = 0, 3, 6, 10, 13, 16
 
 
 class Log(NamedTuple):
@@ -58,8 +57,8 @@ def initial_state(lat, lon, h, v_n, q_nb):
         raise InputError(f"height: must be >= -1000 m, got {h}")
     nav = np.zeros(SIZE)
     nav[0:3] = lat, lon, h
-    nav[VELOCITY:VELOCITY + 3] = v_n
-    nav[ATTITUDE:ATTITUDE + 4] = rot.normalize(q_nb)
+    nav[3:6] = v_n
+    nav[6:10] = rot.normalize(q_nb)
     return nav
 
 

@@ -25,7 +25,8 @@ def test_allan_deviation_recovers_vrw_and_bias_random_walk():
     vrw = units.vrw_to_si(0.05)
     bias_rw = np.sqrt(3.0) * vrw / 30.0
     record = AccelerometerModel(rate_hz=1.0, vrw=vrw, bias_rw=bias_rw).measure(np.zeros((2**20, 3)), 21)
-    n_est = [np.mean(adev * np.sqrt(tau)) for tau, adev in (_adev(record.force[:, a], np.array([1.0, 2.0]), 1.0) for a in range(3))]
+    short = (_adev(record.force[:, a], np.array([1.0, 2.0]), 1.0) for a in range(3))
+    n_est = [np.mean(adev * np.sqrt(tau)) for tau, adev in short]
     k_est = [np.mean(adev * np.sqrt(3.0 / tau)) for tau, adev in
              (_adev(record.force[:, a], np.array([600.0, 1200.0, 2400.0, 4800.0]), 1.0) for a in range(3))]
     assert np.mean(n_est) == pytest.approx(vrw, rel=0.10)
@@ -108,7 +109,8 @@ def test_baro_noise_bias_and_lag():
     assert lagged[9] == 0.0 and lagged[9 + 20] == pytest.approx(10.0 * (1.0 - np.exp(-1.0)), rel=1e-12)
 
 
-@pytest.mark.parametrize("kwargs, key", [({"rate_hz": 0.0}, "baro.rate_hz"), ({"rate_hz": 1.0, "noise_sigma": -1.0}, "baro.noise_sigma")])
+@pytest.mark.parametrize("kwargs, key", [({"rate_hz": 0.0}, "baro.rate_hz"),
+                                         ({"rate_hz": 1.0, "noise_sigma": -1.0}, "baro.noise_sigma")])
 def test_baro_bad_input_is_named(kwargs, key):
     with pytest.raises(InputError, match=key):
         BaroModel(**kwargs)

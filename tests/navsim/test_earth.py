@@ -60,9 +60,12 @@ def test_c_en_columns_are_the_position_derivatives():
     assert np.linalg.det(C) == pytest.approx(1.0)
     r_m, r_n = wgs84.radii(lat)
     eps = 1e-7
-    d_lat = (np.array(wgs84.geodetic_to_ecef(lat + eps, lon, h)) - np.array(wgs84.geodetic_to_ecef(lat - eps, lon, h))) / (2 * eps)
-    d_lon = (np.array(wgs84.geodetic_to_ecef(lat, lon + eps, h)) - np.array(wgs84.geodetic_to_ecef(lat, lon - eps, h))) / (2 * eps)
-    d_h = np.array(wgs84.geodetic_to_ecef(lat, lon, h + 1.0)) - np.array(wgs84.geodetic_to_ecef(lat, lon, h))
+    def ecef(*p):
+        return np.array(wgs84.geodetic_to_ecef(*p))
+
+    d_lat = (ecef(lat + eps, lon, h) - ecef(lat - eps, lon, h)) / (2 * eps)
+    d_lon = (ecef(lat, lon + eps, h) - ecef(lat, lon - eps, h)) / (2 * eps)
+    d_h = ecef(lat, lon, h + 1.0) - ecef(lat, lon, h)
     np.testing.assert_allclose(d_lat, (r_m + h) * C[:, 0], rtol=1e-7)
     np.testing.assert_allclose(d_lon, (r_n + h) * np.cos(lat) * C[:, 1], rtol=1e-7)
     np.testing.assert_allclose(d_h, -C[:, 2], atol=1e-7)

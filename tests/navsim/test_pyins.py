@@ -44,7 +44,8 @@ class _Log:
     """A pyins trajectory frame as the (lat, lon, h) rows of a strapdown log [rad, rad, m]."""
 
     def __init__(self, frame):
-        self.lat, self.lon, self.h = np.radians(frame["lat"].to_numpy()), np.radians(frame["lon"].to_numpy()), frame["alt"].to_numpy()
+        self.lat, self.lon = np.radians(frame["lat"].to_numpy()), np.radians(frame["lon"].to_numpy())
+        self.h = frame["alt"].to_numpy()
 
 
 def test_pyins_imu_integrated_by_ours_returns_its_truth():
