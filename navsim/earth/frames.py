@@ -5,7 +5,7 @@ C_ab rotates b-frame vectors into a (v_a = C_ab v_b); ω_ab^c is the rate of fra
 in c axes. Compiled functions of vectors return component tuples (see :mod:`navsim.earth.wgs84`).
 """
 
-from datetime import datetime
+from datetime import datetime, timedelta
 
 import erfa
 import numpy as np
@@ -48,6 +48,8 @@ def utc_epoch(text):
         when = datetime.fromisoformat(text)
     except (TypeError, ValueError):
         raise InputError(f"epoch_utc: expected 'YYYY-MM-DDTHH:MM:SS', got {text!r}") from None
+    if when.utcoffset() not in (None, timedelta(0)):
+        raise InputError(f"epoch_utc: must be UTC (no offset or Z), got {text!r}")
     seconds = when.second + when.microsecond * 1e-6
     return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
 

@@ -115,8 +115,11 @@ def test_c_ei_rotates_at_the_earth_rate():
 def test_bad_epoch_is_named():
     from startrack.errors import InputError
 
-    with pytest.raises(InputError, match="epoch_utc"):
+    with pytest.raises(InputError, match="epoch_utc: expected"):
         frames.c_ei("yesterday")
+    with pytest.raises(InputError, match="epoch_utc: must be UTC"):
+        frames.c_ei("2026-03-01T12:00:00+02:00")
+    np.testing.assert_array_equal(frames.c_ei("2026-03-01T12:00:00Z"), frames.c_ei("2026-03-01T12:00:00"))
 
 
 def test_random_gravity_disturbance_statistics_and_seed():
