@@ -223,7 +223,7 @@ def _gated_update(nav, imu, P, H, R, z, gate):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
         return nis, False
-    dx, P_next = joseph_update(P, H, R, z)
+    dx, P_next = joseph_update(P, H, R, z, np.ones(P.shape[0], dtype=np.bool_))  # every state estimated
     P[:, :] = P_next
     reset(nav, imu, dx, P.shape[0])
     return nis, True
