@@ -43,3 +43,23 @@ def arw_to_si(x):
 def rrw_to_si(x):
     """Rate random walk [deg/h/√h] -> σ_u [rad/s^(3/2)]."""
     return np.asarray(x, dtype=float) * DEG / HOUR / np.sqrt(HOUR)
+
+#: Standard gravity g0 [m/s²] (the datasheet unit of accelerometer errors; not the local gravity).
+STANDARD_GRAVITY = 9.80665
+#: International nautical mile [m].
+NAUTICAL_MILE = 1852.0
+
+
+def micro_g_to_si(x):
+    """Accelerometer bias [µg] -> [m/s²] (1 µg = 1e-6 g0)."""
+    return np.asarray(x, dtype=float) * 1e-6 * STANDARD_GRAVITY
+
+
+def vrw_to_si(x):
+    """Velocity random walk [m/s/√h] -> σ [m/s/√s] = [m/s^(3/2)]."""
+    return np.asarray(x, dtype=float) / np.sqrt(HOUR)
+
+
+def micro_g_per_sqrt_h_to_si(x):
+    """Accelerometer bias random walk [µg/√h] -> σ [m/s²/√s] = [m/s^(5/2)]."""
+    return np.asarray(x, dtype=float) * 1e-6 * STANDARD_GRAVITY / np.sqrt(HOUR)

@@ -24,14 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from navsim.sensors import inertial
+from navsim.sensors.inertial import allan_variance, bias_instability_to_sigma  # noqa: F401  (the gyro's API)
 from startrack import units
-from startrack.jit import njit
-
-#: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
-#: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,
-#: the maximum of :func:`allan_variance` below).
-GAUSS_MARKOV_PEAK_ADEV = 0.6174
-FLICKER_FLOOR_FACTOR = 0.664
 
 
 @dataclass(frozen=True)
@@ -92,92 +87,28 @@ class GyroModel:
         )
 
     @property
+    def white_noise(self):
+        return self.arw
+
+    @property
+    def random_walk(self):
+        return self.rrw
+
+    @property
     def filter_rrw(self):
         """Random-walk σ_u a 6-state filter should assume: RRW plus the Gauss-Markov driving
         noise (2 σ_g²/τ)^½ [rad/s^(3/2)]."""
-        gm = 0.0
-        if self.bias_instability_sigma > 0.0:
-            gm = 2.0 * self.bias_instability_sigma**2 / self.bias_correlation_time
-        return float(np.sqrt(self.rrw**2 + gm))
+        return inertial.filter_random_walk(self)
 
     def draw_errors(self, rng):
         """Constant errors of one unit: (turn-on bias (3,), matrix (I+S)(I+M) (3, 3))."""
-        if self.bias_turn_on is not None:
-            bias = np.asarray(self.bias_turn_on, dtype=float)
-            rng.standard_normal(3)  # keep the stream layout independent of the option
-        else:
-            bias = self.bias_turn_on_sigma * rng.standard_normal(3)
-        scale = self.scale_factor_sigma * rng.standard_normal(3)
-        misalignment = self.misalignment_sigma * rng.standard_normal((3, 3))
-        np.fill_diagonal(misalignment, 0.0)
-        return bias, np.diag(1.0 + scale) @ (np.eye(3) + misalignment)
+        return inertial.draw_errors(self, rng)
 
     def measure(self, omega_mean, seed) -> "GyroRecord":
         """Gyro samples for true interval-mean rates ``omega_mean`` (M, 3) [rad/s].
 
         ``seed`` is a :class:`numpy.random.SeedSequence` (or an int); the constant errors and
-        the noise come from two spawned sub-streams.
+        the noise come from two spawned sub-streams (:func:`navsim.sensors.inertial.synthesize`).
         """
-        omega_mean = np.asarray(omega_mean, dtype=float)
-        m = omega_mean.shape[0]
-        dt = self.dt
-        if not isinstance(seed, np.random.SeedSequence):
-            seed = np.random.SeedSequence(seed)
-        error_rng, noise_rng = (np.random.default_rng(s) for s in seed.spawn(2))
-        bias_c, matrix = self.draw_errors(error_rng)
-        n_white, n_walk, n_gm, gm0 = (
-            noise_rng.standard_normal((m, 3)),
-            noise_rng.standard_normal((m, 3)),
-            noise_rng.standard_normal((m, 3)),
-            noise_rng.standard_normal(3),
-        )
-        walk = np.vstack([np.zeros(3), np.cumsum(self.rrw * np.sqrt(dt) * n_walk, axis=0)])
-        phi = np.exp(-dt / self.bias_correlation_time)
-        drive = self.bias_instability_sigma * np.sqrt(1.0 - phi * phi) * n_gm
-        gm = gauss_markov(self.bias_instability_sigma * gm0, phi, drive)
-        sigma_white = np.sqrt(self.arw**2 / dt + self.rrw**2 * dt / 12.0)
-        omega = (
-            omega_mean @ matrix.T
-            + bias_c
-            + 0.5 * (walk[:-1] + walk[1:])
-            + 0.5 * (gm[:-1] + gm[1:])
-            + sigma_white * n_white
-        )
-        omega = np.clip(omega, -self.saturation, self.saturation)
-        if self.quantization > 0.0:
-            angle = np.cumsum(omega * dt, axis=0)
-            counts = np.round(angle / self.quantization)
-            counts = np.diff(np.vstack([np.zeros(3), counts]), axis=0)
-            omega = counts * self.quantization / dt
-        return GyroRecord(omega=omega, bias=bias_c + walk[1:] + gm[1:], matrix=matrix)
-
-
-@njit
-def gauss_markov(g0, phi, drive):
-    """The first-order Gauss-Markov sequence g_(k+1) = φ g_k + drive_k from g_0 (3,): (M+1, 3)."""
-    g = np.empty((drive.shape[0] + 1, drive.shape[1]))
-    g[0] = g0
-    for k in range(drive.shape[0]):
-        for i in range(drive.shape[1]):
-            g[k + 1, i] = drive[k, i] + phi * g[k, i]
-    return g
-
-
-def bias_instability_to_sigma(bias_instability):
-    """Gauss-Markov σ_g whose peak Allan deviation equals the flicker floor 0.664 B."""
-    return FLICKER_FLOOR_FACTOR * bias_instability / GAUSS_MARKOV_PEAK_ADEV
-
-
-def allan_variance(tau, model):
-    """Theoretical Allan variance [(rad/s)²] of the model's noise terms at cluster times tau [s].
-
-    ARW: σ_v²/τ; RRW: σ_u² τ/3; Gauss-Markov of σ_g, T: with r = τ/T,
-    σ_g² [2(r − 1 + e^(−r))/r² − (1 − e^(−r))²/r²] (IEEE Std 952-1997, annex C).
-    """
-    tau = np.asarray(tau, dtype=float)
-    avar = model.arw**2 / tau + model.rrw**2 * tau / 3.0
-    if model.bias_instability_sigma > 0.0:
-        r = tau / model.bias_correlation_time
-        e = np.exp(-r)
-        avar = avar + model.bias_instability_sigma**2 * (2.0 * (r - 1.0 + e) - (1.0 - e) ** 2) / r**2
-    return avar
+        omega, bias, matrix = inertial.synthesize(self, omega_mean, seed)
+        return GyroRecord(omega=omega, bias=bias, matrix=matrix)

@@ -1,0 +1,70 @@
+"""The frames of the INS (docs/design-ins.md): n (NED at the vehicle), e (ITRS/ECEF, WGS-84) and
+i (the star catalog's ICRS), their rotations and rates.
+
+C_ab rotates b-frame vectors into a (v_a = C_ab v_b); ω_ab^c is the rate of frame b relative to a
+in c axes. Compiled functions of vectors return component tuples (see :mod:`navsim.earth.wgs84`).
+"""
+
+from datetime import datetime, timedelta
+
+import erfa
+import numpy as np
+
+from navsim.earth.wgs84 import OMEGA_IE, radii
+from startrack.errors import InputError
+from startrack.jit import njit
+
+
+def c_en(lat, lon):
+    """C_en (..., 3, 3): NED axes at (L, λ) [rad] into ECEF; its columns are the north, east and down
+    unit vectors in e (the transpose of Groves' C_e^n, 2nd ed. eq. 2.150)."""
+    lat = np.asarray(lat, dtype=float)
+    lon = np.asarray(lon, dtype=float)
+    sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)
+    zero = np.zeros_like(sl)
+    north = np.stack([-sl * co, -sl * so, cl], axis=-1)
+    east = np.stack([-so, co, zero], axis=-1)
+    down = np.stack([-cl * co, -cl * so, -sl], axis=-1)
+    return np.stack([north, east, down], axis=-1)
+
+
+@njit
+def earth_rate_n(lat):
+    """ω_ie^n = ω_ie [cos L, 0, −sin L] [rad/s] as (north, east, down) (Groves eq. 2.123)."""
+    return OMEGA_IE * np.cos(lat), 0.0 * lat, -OMEGA_IE * np.sin(lat)
+
+
+@njit
+def transport_rate_n(lat, h, v_north, v_east):
+    """Transport rate ω_en^n = [v_E/(R_N+h), −v_N/(R_M+h), −v_E tan L/(R_N+h)] [rad/s] as
+    (north, east, down) (Groves eq. 5.44, R_M meridian, R_N prime vertical)."""
+    r_m, r_n = radii(lat)
+    return v_east / (r_n + h), -v_north / (r_m + h), -v_east * np.tan(lat) / (r_n + h)
+
+
+def utc_epoch(text):
+    """Two-part Julian date (jd1, jd2) of a UTC calendar epoch 'YYYY-MM-DDTHH:MM:SS[.ffffff]'."""
+    try:
+        when = datetime.fromisoformat(text)
+    except (TypeError, ValueError):
+        raise InputError(f"epoch_utc: expected 'YYYY-MM-DDTHH:MM:SS', got {text!r}") from None
+    if when.utcoffset() not in (None, timedelta(0)):
+        raise InputError(f"epoch_utc: must be UTC (no offset or Z), got {text!r}")
+    seconds = when.second + when.microsecond * 1e-6
+    return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
+
+
+def c_ei(epoch_utc, t=0.0, dut1=0.0):
+    """C_ei (..., 3, 3): ICRS (GCRS axes) into ITRS at ``t`` [s] (scalar or array) after the UTC
+    epoch ``epoch_utc``, with UT1 − UTC = ``dut1`` [s] and zero polar motion.
+
+    The IAU 2006/2000A celestial-to-terrestrial matrix of pyerfa, ``erfa.c2t06a`` (CIO based: the
+    Earth rotation angle ERA(UT1) between the CIP/CIO precession-nutation-bias matrix and polar
+    motion; IERS Conventions 2010, eq. 5.1). ``t`` is added to UTC as uniform seconds (a leap
+    second inside the span is not inserted).
+    """
+    utc1, utc2 = utc_epoch(epoch_utc)
+    utc2 = utc2 + np.asarray(t, dtype=float) / 86400.0
+    tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
+    ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
+    return erfa.c2t06a(tt1, tt2, ut11, ut12, 0.0, 0.0)

@@ -1,0 +1,242 @@
+"""Navigation error-state filter: F against a numerical linearisation of the nonlinear navigation
+equations (every sign of the φ convention), Φ and Q_d against scipy's expm and Van Loan's integral,
+and the filter's behaviour."""
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from navsim.earth.frames import earth_rate_n, transport_rate_n
+from navsim.earth.gravity import normal_gravity
+from navsim.earth.wgs84 import radii
+from navsim.estimation import nav_kernels
+from startrack import rotation as rot
+
+LAT, LON, H = 0.7, 0.3, 3000.0
+V = np.array([150.0, -80.0, 5.0])
+Q_NB = rot.normalize([0.1, -0.05, 0.6, 0.8])
+OMEGA_B = np.array([0.02, -0.03, 0.05])
+F_B = np.array([1.5, -0.7, -9.9])
+
+
+def _skew(v):
+    return rot.skew(np.asarray(v, dtype=float))
+
+
+def _rates(state, omega_b, f_b):
+    """Nonlinear navigation equations (Groves eqs. 5.46 (rate form), 5.54, 2.111):
+    (L̇, λ̇, ḣ, v̇, Ċ_nb) for a state (L, λ, h, v, C)."""
+    lat, lon, h, v, C = state
+    r_m, r_n = radii(lat)
+    w_ie = np.array(earth_rate_n(lat))
+    w_en = np.array(transport_rate_n(lat, h, v[0], v[1]))
+    v_dot = C @ f_b + np.array([0.0, 0.0, normal_gravity(lat, h)]) - np.cross(2 * w_ie + w_en, v)
+    C_dot = C @ _skew(omega_b) - _skew(w_ie + w_en) @ C
+    return v[0] / (r_m + h), v[1] / ((r_n + h) * np.cos(lat)), -v[2], v_dot, C_dot
+
+
+def _error_rate(dx, n):
+    """Rate of the error state when the estimate differs from the truth by the error dx."""
+    C = rot.to_matrix(Q_NB)
+    truth = (LAT, LON, H, V, C)
+    est = (LAT + dx[6], LON + dx[7], H + dx[8], V + dx[3:6], (np.eye(3) - _skew(dx[0:3])) @ C)
+    omega_est, f_est = OMEGA_B + dx[9:12], F_B + dx[12:15]
+    if n > 15:
+        omega_est = omega_est + OMEGA_B * dx[15:18]
+        f_est = f_est + F_B * dx[18:21]
+    r_true, r_est = _rates(truth, OMEGA_B, F_B), _rates(est, omega_est, f_est)
+    # [φ×] = I − C_est Cᵀ  =>  [φ̇×] = −(Ċ_est Cᵀ + C_est Ċᵀ)
+    M = -(r_est[4] @ C.T + est[4] @ r_true[4].T)
+    rate = np.zeros(n)
+    rate[0:3] = 0.5 * np.array([M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]])
+    rate[3:6] = r_est[3] - r_true[3]
+    rate[6:9] = np.array(r_est[:3]) - np.array(r_true[:3])
+    return rate
+
+
+@pytest.mark.parametrize("n", [15, 21])
+def test_f_is_the_linearisation_of_the_navigation_equations(n):
+    """Each column of F equals the central difference of the nonlinear error rate (all signs of
+    φ, Coriolis, transport rate, gravity gradient, bias and scale-factor columns)."""
+    C = rot.to_matrix(Q_NB)
+    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, n)
+    scale = np.array([1e-6] * 3 + [1e-3] * 3 + [1e-7, 1e-7, 1e-2] + [1e-7] * 3 + [1e-5] * 3 + [1e-5] * (n - 15))
+    numeric = np.empty((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = scale[j]
+        numeric[:, j] = (_error_rate(e, n) - _error_rate(-e, n)) / (2 * scale[j])
+    tolerance = 1e-6 * np.abs(numeric).max(axis=0) + 1e-13
+    assert np.all(np.abs(F - numeric) <= tolerance[None, :]), np.argwhere(np.abs(F - numeric) > tolerance[None, :])
+
+
+def _f_and_q(n=21):
+    C = rot.to_matrix(Q_NB)
+    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, n)
+    q_c = np.array([1e-9] * 3 + [1e-6] * 3 + [0.0] * 3 + [1e-14] * 3 + [1e-10] * 3 + [1e-12] * (n - 15))
+    return F, q_c
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.1, 0.5])
+def test_transition_matches_expm(dt):
+    F, q_c = _f_and_q()
+    Phi, _ = nav_kernels.discretize(F, q_c, dt)
+    exact = expm(F * dt)
+    assert np.max(np.abs(Phi - exact)) <= 1e-6 * dt * np.abs(exact).max()
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.1, 0.5])
+def test_process_noise_matches_van_loan(dt):
+    """Q_d = ∫₀^Δt e^(Fs) Q e^(Fᵀs) ds from the matrix exponential of [[−F, Q], [0, Fᵀ]] Δt
+    (Van Loan 1978): Q_d = Φ · (upper-right block)."""
+    F, q_c = _f_and_q()
+    n = F.shape[0]
+    block = np.zeros((2 * n, 2 * n))
+    block[:n, :n], block[:n, n:], block[n:, n:] = -F, np.diag(q_c), F.T
+    E = expm(block * dt)
+    exact = E[n:, n:].T @ E[:n, n:]
+    _, Q = nav_kernels.discretize(F, q_c, dt)
+    scale = np.sqrt(np.outer(np.diag(exact), np.diag(exact))) + 1e-30
+    assert np.max(np.abs(Q - exact) / scale) < 1e-5
+
+
+# --- the filter at work -------------------------------------------------------------------------
+
+from dataclasses import replace  # noqa: E402
+
+
+from navsim.estimation.consistency import chi2_band  # noqa: E402
+from navsim.estimation.nav_filter import ImuNoise, NavFilter  # noqa: E402
+from navsim.ins import driver  # noqa: E402
+from navsim.sensors.accelerometer import AccelerometerModel  # noqa: E402
+from navsim.sensors.gyro import GyroModel  # noqa: E402
+from navsim.truth import trajectory  # noqa: E402
+from navsim.truth.segments import Profile  # noqa: E402
+from startrack import units  # noqa: E402
+from startrack.errors import InputError  # noqa: E402
+
+TURNS = {"start": {"lat_deg": 40.0, "lon_deg": 10.0, "height_m": 1000.0, "speed_m_per_s": 100.0, "heading_deg": 0.0},
+         "segments": [{"kind": "straight", "duration_s": 60.0},
+                      {"kind": "turn", "heading_change_deg": 90.0, "rate_deg_per_s": 3.0},
+                      {"kind": "straight", "duration_s": 60.0},
+                      {"kind": "turn", "heading_change_deg": -180.0, "rate_deg_per_s": 3.0},
+                      {"kind": "climb", "height_change_m": 300.0, "rate_m_per_s": 5.0},
+                      {"kind": "turn", "heading_change_deg": 90.0, "rate_deg_per_s": 3.0},
+                      {"kind": "accelerate", "speed_m_per_s": 150.0, "acceleration_m_per_s2": 1.0},
+                      {"kind": "straight", "duration_s": 60.0}]}
+
+
+def _tactical_matched(rate_hz):
+    """Tactical gyro and accelerometer whose errors the 15-state filter models exactly: turn-on bias,
+    bias random walk and white noise (no Gauss-Markov, scale factor or misalignment)."""
+    off = {"bias_instability_sigma": 0.0, "scale_factor_sigma": 0.0, "misalignment_sigma": 0.0}
+    return replace(GyroModel.preset("tactical", rate_hz), **off), replace(AccelerometerModel.preset("tactical", rate_hz), **off)
+
+
+def position_aided_campaign(truth, runs, fix_rate_hz=1.0, fix_sigma=3.0):
+    """The Monte Carlo of the position-aided filter: one run per seed 0..runs-1."""
+    gyro, accel = _tactical_matched(truth.rate_hz)
+    P0 = driver.initial_covariance(gyro, accel, np.array([0.05, 0.05, 0.3]) * units.DEG, 0.1, 5.0, truth.lat[0], truth.h[0])
+    return [driver.position_aided_run(truth, gyro, accel, P0, fix_rate_hz, fix_sigma, seed) for seed in range(runs)], P0
+
+
+def _check_campaign(results, P0):
+    """NEES of the run average inside its two-sided 95 % chi-square band (time mean, and at >= 80 %
+    of the fixes), no divergent run, and the accelerometer bias within 3σ at the end (>= 97 % of the
+    run-axis cases, expected 99.7 %) with its horizontal σ reduced by the turns."""
+    runs = len(results)
+    nees = np.array([r.nees for r in results]).mean(axis=0)
+    low, high = chi2_band(15, runs)
+    assert low <= nees.mean() <= high
+    assert np.mean((nees >= low) & (nees <= high)) >= 0.8
+    divergent = [r for r in results if not np.all(np.isfinite(r.error)) or np.any(np.abs(r.error) > 10 * r.sigma)]
+    assert not divergent
+    error = np.array([r.error[-1, 12:15] for r in results])
+    sigma = np.array([r.sigma[-1, 12:15] for r in results])
+    assert np.mean(np.abs(error) <= 3 * sigma) >= 0.97
+    assert np.all(sigma[:, :2] < 0.7 * np.sqrt(P0[12, 12]))
+    return nees, low, high
+
+
+def test_position_aided_campaign_is_consistent():
+    """50 runs of 7 min of turns, climb and acceleration, tactical IMU at 50 Hz, 1 Hz fixes of 3 m."""
+    truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
+    results, P0 = position_aided_campaign(truth, 50)
+    _check_campaign(results, P0)
+
+
+@pytest.mark.slow
+def test_position_aided_campaign_over_an_hour_of_flight():
+    """The same campaign over the first hour of the 2 h aircraft flight, IMU at 100 Hz."""
+    from tests.navsim.ins_helpers import aircraft_first_hour
+
+    truth = trajectory.generate(aircraft_first_hour(), 100.0)
+    results, P0 = position_aided_campaign(truth, 50)
+    _check_campaign(results, P0)
+
+
+def test_perfect_imu_and_perfect_start_stay_on_the_truth():
+    """No sensor error and no initial error: the filter's solution is the truth (to 1 mm) and each
+    fix's NIS is ~ 0."""
+    truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
+    noise = ImuNoise(arw=1e-5, vrw=1e-4, gyro_bias_rw=1e-8, accel_bias_rw=1e-6)
+    P = np.diag([1e-8] * 3 + [1e-4] * 3 + [1e-14, 1e-14, 1.0] + [1e-12] * 3 + [1e-8] * 3)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt)
+    for k0 in range(0, truth.dtheta.shape[0], 50):
+        f.predict(truth.dtheta[k0:k0 + 50], truth.dv[k0:k0 + 50])
+        k1 = min(k0 + 50, truth.dtheta.shape[0])
+        result = f.update_position(truth.lat[k1], truth.lon[k1], truth.h[k1], 3.0)
+        assert result.nis[0] < 1e-6
+    lat, lon, h = f.position
+    assert abs(h - truth.h[-1]) < 1e-3 and abs(lat - truth.lat[-1]) * 6.4e6 < 1e-3
+    assert np.max(np.abs(f.v_n - truth.v_n[-1])) < 1e-4
+
+
+def test_baro_update_pulls_the_height():
+    noise = ImuNoise(arw=1e-5, vrw=1e-3)
+    P = np.diag([1e-6] * 3 + [1e-2] * 3 + [1e-12, 1e-12, 100.0] + [1e-10] * 3 + [1e-6] * 3)
+    f = NavFilter(0.5, 0.1, 120.0, np.zeros(3), [0, 0, 0, 1.0], P, noise, 0.01)
+    result = f.update_baro(100.0, 1.0)
+    assert result.accepted[0] and result.nis[0] == pytest.approx(400.0 / 101.0)
+    assert f.position[2] == pytest.approx(100.0 + 20.0 / 101.0)
+    assert np.sqrt(f.P[8, 8]) == pytest.approx(np.sqrt(100.0 / 101.0))
+    rejected = f.update_baro(0.0, 1.0)
+    assert not rejected.accepted[0] and f.position[2] == pytest.approx(100.0 + 20.0 / 101.0)
+
+
+def test_bad_filter_input_is_named():
+    noise = ImuNoise(arw=1e-5, vrw=1e-3)
+    with pytest.raises(InputError, match="filter.P: must be 15x15"):
+        NavFilter(0.5, 0.1, 0.0, np.zeros(3), [0, 0, 0, 1.0], np.eye(9), noise, 0.01)
+    with pytest.raises(InputError, match="faster than the IMU"):
+        driver.check_aiding_rate(100.0, 200.0, "aiding.rate_hz")
+    with pytest.raises(InputError, match="aiding.rate_hz: must be > 0"):
+        driver.check_aiding_rate(100.0, 0.0, "aiding.rate_hz")
+    with pytest.raises(InputError, match="not a multiple"):
+        driver.check_aiding_rate(100.0, 3.0, "aiding.rate_hz")
+
+
+def test_scale_factor_states_are_estimated_within_three_sigma():
+    """21 states on the 7-min turns with tactical scale factors (gyro 100 ppm, accelerometer 300 ppm)
+    and no misalignment: every scale factor ends within 3σ, no σ grows, and the vertical
+    accelerometer's (sensing g throughout) is the best observed in 7 min."""
+    truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
+    gyro, accel = _tactical_matched(50.0)
+    gyro, accel = replace(gyro, scale_factor_sigma=100e-6), replace(accel, scale_factor_sigma=300e-6)
+    g_seed, a_seed = np.random.SeedSequence(4).spawn(2)
+    g_rec, a_rec = gyro.measure(truth.dtheta / truth.dt, g_seed), accel.measure(truth.dv / truth.dt, a_seed)
+    P15 = driver.initial_covariance(gyro, accel, np.array([0.05, 0.05, 0.3]) * units.DEG, 0.1, 5.0, truth.lat[0], truth.h[0])
+    P = np.zeros((21, 21))
+    P[:15, :15] = P15
+    P[15:18, 15:18], P[18:21, 18:21] = np.eye(3) * 100e-6**2, np.eye(3) * 300e-6**2
+    noise = ImuNoise(gyro.arw, accel.vrw, gyro.filter_rrw, accel.filter_bias_rw)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt,
+                  estimate_scale_factors=True)
+    for k in range(0, truth.dtheta.shape[0], 50):
+        f.predict(g_rec.omega[k:k + 50] * truth.dt, a_rec.force[k:k + 50] * truth.dt)
+        f.update_position(truth.lat[k + 50], truth.lon[k + 50], truth.h[k + 50], 3.0)
+    s_g, s_a = f.scale_factors
+    error = np.concatenate([np.diag(g_rec.matrix) - 1.0 - s_g, np.diag(a_rec.matrix) - 1.0 - s_a])
+    sigma = np.sqrt(np.diag(f.P)[15:21])
+    assert np.all(np.abs(error) <= 3.0 * sigma)
+    assert np.all(sigma <= np.array([100e-6] * 3 + [300e-6] * 3)) and sigma[5] < 0.9 * 300e-6
