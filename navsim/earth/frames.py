@@ -1,4 +1,4 @@
-"""The frames of the INS (docs/design-ins.md): n (NED at the vehicle), e (ITRS/ECEF, WGS-84) and
+"""The frames of the INS (docs/design.md): n (NED at the vehicle), e (ITRS/ECEF, WGS-84) and
 i (the star catalog's ICRS), their rotations and rates.
 
 C_ab rotates b-frame vectors into a (v_a = C_ab v_b); ω_ab^c is the rate of frame b relative to a

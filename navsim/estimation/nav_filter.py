@@ -3,7 +3,7 @@
 The filter owns the nominal navigation state (the strapdown ``nav`` vector of
 :mod:`navsim.ins.strapdown`: L, λ, h, v_n, q_nb), the IMU error estimates (gyro and accelerometer
 biases, optional scale factors) and the covariance P of the error state
-(:mod:`navsim.estimation.nav_kernels`, docs/design-ins.md):
+(:mod:`navsim.estimation.nav_kernels`, docs/design.md):
 
     x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)],   C_nb,est = (I − [φ×]) C_nb,true.
 

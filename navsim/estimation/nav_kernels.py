@@ -1,7 +1,7 @@
 """Compiled kernels of the navigation error-state filter (numba): the continuous error dynamics F,
 their discretisation (Φ, Q_d), propagation over IMU increments, the measurement updates and the reset.
 
-Error state x (zero between updates; docs/design-ins.md):
+Error state x (zero between updates; docs/design.md):
 
     [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) if scale factors]
 

@@ -19,7 +19,7 @@ from startrack.errors import InputError
 @dataclass(frozen=True)
 class AidedRun:
     """One position-aided run logged after each fix: times ``t`` [s], the error state ``error``
-    (K, 15) (est − true, docs/design-ins.md), its covariance diagonal ``sigma`` (K, 15), ``nees`` (K,),
+    (K, 15) (est − true, docs/design.md), its covariance diagonal ``sigma`` (K, 15), ``nees`` (K,),
     the fixes' ``nis`` (K,) and ``accepted`` (K,)."""
 
     t: np.ndarray
