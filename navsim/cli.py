@@ -38,17 +38,18 @@ def _print_summary(summary, out):
 
 def _run(args):
     from navsim.output import write_run, write_study
-    from navsim.places import check_file, check_output, publish
+    from navsim.places import check_output, publish
     from navsim.scenario import resolve_scenario
     from navsim.simulation import run, run_study
     from navsim.studies import STUDIES
+    from startrack.paths import check_file
 
     _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
     kind = "study" if scenario.is_study else "run"
     check_output(args.out, kind)
     if args.report:
-        check_file(args.report, "--report", ".pdf")
+        check_file(args.report, "--report", (".pdf",))
     if scenario.is_study:
         result = run_study(scenario, seed=args.seed, progress=True)
         out = publish(args.out, kind, lambda directory: write_study(directory, result))
@@ -69,10 +70,10 @@ def _run(args):
 
 
 def _report(args):
-    from navsim.places import check_file
     from navsim.report import write_report
+    from startrack.paths import check_file
 
-    check_file(args.output, "-o", ".pdf")
+    check_file(args.output, "-o", (".pdf",))
     print(write_report(args.directory, args.output))
     return 0
 

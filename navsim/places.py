@@ -2,8 +2,8 @@
 
 A directory that navsim writes carries ``navsim-output.json`` naming its kind (run, study or
 campaign). Before a command starts working it checks its ``--out`` (:func:`check_output`): not a
-file, not under a file, writable, and empty or holding an output of the same kind — never another
-kind, never somebody else's files. A run or study is written into a sibling directory and swapped in
+file, not under a file, created and writable, and empty or holding an output of the same kind —
+never another kind, never somebody else's files. A run or study is written into a sibling directory and swapped in
 when complete (:func:`publish`), so nothing is half-written and no file of an earlier run survives.
 A campaign directory is written run by run (:mod:`navsim.campaign.montecarlo`) under a lock
 (:func:`campaign_lock`) so that two campaigns never share it.
@@ -16,6 +16,7 @@ import shutil
 from pathlib import Path
 
 from startrack.errors import InputError
+from startrack.paths import probe_directory
 
 MARKER = "navsim-output.json"
 KINDS = ("run", "study", "campaign")
@@ -51,37 +52,9 @@ def check_output(path, kind, option="--out"):
         if held not in (None, kind):
             what = "files navsim did not write" if held == "foreign" else f"a {held} output"
             raise InputError(f"{option} {path}: holds {what}; give a new or empty directory for this {kind}")
-        _require_writable(path, option)
-        _require_writable(path.resolve().parent, option)
-        return path
-    _require_writable(_existing_ancestor(path, option), option)
+    probe_directory(path, option, path)
+    probe_directory(path.resolve().parent, option, path)  # a run or study is put in place from its parent
     return path
-
-
-def check_file(path, option, suffix):
-    """Raise an InputError now when the file ``path`` (named ``*suffix``) cannot be written; returns the Path."""
-    path = Path(path)
-    if path.suffix.lower() != suffix:
-        raise InputError(f"{option} {path}: the file name must end in {suffix}")
-    if path.is_dir():
-        raise InputError(f"{option} {path}: is a directory, not a file name")
-    _require_writable(path.parent if path.parent.exists() else _existing_ancestor(path, option), option)
-    return path
-
-
-def _existing_ancestor(path, option):
-    """The nearest existing ancestor of a path to be created; it must be a directory."""
-    ancestor = Path(path).resolve().parent
-    while not ancestor.exists():
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise InputError(f"{option} {path}: {ancestor} is a file, so nothing can be created under it")
-    return ancestor
-
-
-def _require_writable(directory, option):
-    if not os.access(directory, os.W_OK | os.X_OK):
-        raise InputError(f"{option}: cannot write in {directory} (permission denied or a read-only file system)")
 
 
 def publish(directory, kind, write):

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from startrack.errors import InputError
+from startrack.paths import check_directory
 from startrack.units import ARCSEC, DEG
 
 #: Option -> (low, high) accepted range, in the option's unit.
@@ -97,9 +98,7 @@ def run(args) -> int:
     if args.plot is not None:
         check_option("--plot-ra-deg", args.plot_ra_deg)
         check_option("--plot-dec-deg", args.plot_dec_deg)
-        plot_dir = Path(args.plot)
-        if plot_dir.exists() and not plot_dir.is_dir():
-            raise InputError(f"option --plot {plot_dir} exists and is not a directory.")
+        plot_dir = check_directory(args.plot, "--plot")
     catalog = load_navigation_catalog(params, rebuild=args.rebuild, progress=True)
     stats = catalog.statistics()
     if plot_dir is not None:

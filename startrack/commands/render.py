@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from startrack.errors import InputError
+from startrack.paths import check_file
 from startrack.units import DEG
 
 
@@ -70,8 +71,7 @@ def run(args):
     for option, value in (("--width", args.width), ("--height", args.height)):
         if not 8 <= value <= 16384:
             raise InputError(f"option {option} = {value} is not an image size in [8, 16384] px")
-    if not args.output.lower().endswith((".png", ".npy")):
-        raise InputError(f"output file {args.output} must end in .png (16-bit) or .npy")
+    check_file(args.output, "-o", (".png", ".npy"))
     omega = _rate(args.rate_deg_s)
 
     camera = Camera.from_fov(args.fov_deg * DEG, args.width, args.height)
