@@ -98,8 +98,10 @@ def _montecarlo(args):
           f"finished, {summary['runs_failed']} failed")
     if summary["failures"]:
         first = summary["failures"][0]
+        again = ("the same command runs them again" if first["cause"] == "environment"
+                 else "add --retry-failed to run them again")
         print(f"first failure       run {first['run']}: {first['error']} (all in {args.out}/runs/*/error.json; "
-              "rerun with --retry-failed once the cause is fixed)")
+              f"once the cause is fixed, {again})")
     if cross:
         print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
     if nees:

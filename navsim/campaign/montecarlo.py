@@ -98,7 +98,7 @@ def _record_failure(run_dir, seed, error):
 
 
 def _prepare(directory, scenario, runs, base_seed, backend):
-    directory = Path(directory)
+    """Write campaign.json (checked against an earlier one for a resume); returns the request."""
     request = {"scenario": scenario.name, "source": scenario.source, "base_seed": base_seed, "backend": backend,
                "runs": runs, "scenario_data": scenario.data}
     path = directory / "campaign.json"
@@ -109,9 +109,8 @@ def _prepare(directory, scenario, runs, base_seed, backend):
                              "use a new --out directory")
         request["runs"] = max(runs, int(previous.get("runs", 0)))
     (directory / "runs").mkdir(parents=True, exist_ok=True)
-    mark(directory, "campaign")
     write_json(path, request)
-    return directory, request
+    return request
 
 
 def _read_request(path):
@@ -161,30 +160,35 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
                          "with different --seed")
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a Monte Carlo campaign")
-    check_output(out, "campaign")
+    directory = check_output(out, "campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)
-    Path(out).mkdir(parents=True, exist_ok=True)
-    with campaign_lock(out):
-        directory, request = _prepare(out, scenario, runs, base_seed, _backend(scheduler, n_workers))
-        todo = pending_runs(directory, request, retry_failed)
-        members = [(run_seed(base_seed, k), str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
-        size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
-        chunks = [members[i : i + size] for i in range(0, len(members), size)]
-        with tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
-                  unit="run", disable=not progress) as bar:
-            _execute(scenario, chunks, n_workers, scheduler, bar)
-        summary = aggregate(directory)
-        write_json(directory / "summary.json", summary.to_json())
+    client = _connect(scheduler) if isinstance(scheduler, str) else scheduler
+    try:
+        mark(directory, "campaign")
+        with campaign_lock(directory):
+            request = _prepare(directory, scenario, runs, base_seed, _backend(scheduler, n_workers))
+            todo = pending_runs(directory, request, retry_failed)
+            members = [(run_seed(base_seed, k), str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
+            size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
+            chunks = [members[i : i + size] for i in range(0, len(members), size)]
+            with tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
+                      unit="run", disable=not progress) as bar:
+                _execute(scenario, chunks, n_workers, client, bar)
+            summary = aggregate(directory)
+            write_json(directory / "summary.json", summary.to_json())
+    finally:
+        if client is not None and client is not scheduler:
+            client.close()
     return summary
 
 
-def _execute(scenario, chunks, n_workers, scheduler, bar):
-    """Run the chunks serially, on local processes or on a Dask cluster."""
+def _execute(scenario, chunks, n_workers, client, bar):
+    """Run the chunks serially, on local processes or on a Dask cluster (``client``)."""
     if not chunks:
         return
-    if scheduler is not None:
-        _run_dask(scenario, chunks, scheduler, bar)
+    if client is not None:
+        _run_dask(scenario, chunks, client, bar)
     elif n_workers == 1:
         for chunk in chunks:
             run_chunk(scenario.data, scenario.source, chunk)
@@ -202,8 +206,9 @@ def _run_pool(scenario, chunks, n_workers, bar):
             future.result()
             bar.update(futures[future])
     except KeyboardInterrupt:
+        workers = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
-        for process in list(getattr(pool, "_processes", {}).values()):
+        for process in workers:
             process.terminate()
         raise
     pool.shutdown()
@@ -220,28 +225,24 @@ def _backend(scheduler, n_workers):
 SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls|ws|wss|ucx|inproc)://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}$")
 
 
-def _run_dask(scenario, chunks, scheduler, bar):
-    from distributed import Client
+def _run_dask(scenario, chunks, client, bar):
     from distributed import as_completed as dask_completed
 
-    client = scheduler if isinstance(scheduler, Client) else _connect(Client, scheduler)
-    try:
-        futures = [client.submit(run_chunk, scenario.data, scenario.source, chunk, pure=False) for chunk in chunks]
-        sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks)}
-        for future in dask_completed(futures):
-            future.result()
-            bar.update(sizes[future.key])
-    finally:
-        if client is not scheduler:
-            client.close()
+    futures = [client.submit(run_chunk, scenario.data, scenario.source, chunk, pure=False) for chunk in chunks]
+    sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks)}
+    for future in dask_completed(futures):
+        future.result()
+        bar.update(sizes[future.key])
 
 
-def _connect(client_class, address, timeout_s=10):
+def _connect(address, timeout_s=10):
     """A Dask client of the scheduler at ``address``, or one InputError within ``timeout_s``."""
     if not SCHEDULER_ADDRESS.match(address):
         raise InputError(f"--scheduler {address}: not a scheduler address (expected tcp://HOST:PORT)")
+    from distributed import Client
+
     try:
-        return client_class(address, timeout=f"{timeout_s}s")
+        return Client(address, timeout=f"{timeout_s}s")
     except (OSError, TimeoutError) as error:
         raise InputError(f"--scheduler {address}: cannot connect within {timeout_s} s ({error})") from None
 
@@ -259,16 +260,17 @@ def _pooled_findings(summaries):
 
 
 def load_runs(directory):
-    """(index, summary, series) of every finished run and (index, error) of every failed one."""
+    """(index, summary, series) of every finished run and (index, error, cause) of every failed one."""
     directory = Path(directory)
-    request = json.loads((directory / "campaign.json").read_text())
+    request = _read_request(directory / "campaign.json")
     finished, failed = [], []
     for k in range(request["runs"]):
         run_dir = directory / "runs" / RUN_DIR.format(k)
         if (run_dir / "summary.json").exists():
             finished.append((k, RunSummary.read(run_dir / "summary.json"), read_npz(run_dir / "timeseries.npz")))
         elif (run_dir / "error.json").exists():
-            failed.append((k, json.loads((run_dir / "error.json").read_text())["error"]))
+            record = json.loads((run_dir / "error.json").read_text())
+            failed.append((k, record["error"], record.get("cause", "scenario")))
     return request, finished, failed
 
 
@@ -277,7 +279,7 @@ def aggregate(directory):
     request, finished, failed = load_runs(directory)
     base = {"scenario": request["scenario"], "base_seed": request["base_seed"], "runs_requested": request["runs"],
             "runs_finished": len(finished), "runs_failed": len(failed),
-            "failures": [{"run": k, "error": message} for k, message in failed]}
+            "failures": [{"run": k, "error": message, "cause": cause} for k, message, cause in failed]}
     if not finished:
         return CampaignSummary(**base)
     summaries = [summary for _, summary, _ in finished]

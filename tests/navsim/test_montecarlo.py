@@ -84,8 +84,30 @@ def test_a_run_that_raises_is_recorded_and_the_others_finish(tmp_path, base_scen
     monkeypatch.setattr(mc, "simulate", flaky)
     summary = mc.run_campaign(base_scenario, 4, tmp_path / "c", base_seed=0, workers=1, progress=False)
     assert summary["runs_finished"] == 3 and summary["runs_failed"] == 1
-    assert summary["failures"] == [{"run": 2, "error": "RuntimeError: sensor model exploded"}]
+    assert summary["failures"] == [{"run": 2, "error": "RuntimeError: sensor model exploded", "cause": "scenario"}]
     assert (tmp_path / "c" / "runs" / "run_00002" / "error.json").exists()
+
+
+def test_failures_outside_the_scenario_are_retried_on_resume(tmp_path, base_scenario, monkeypatch):
+    """A full disk (OSError) is the environment's fault: the next resume runs it again by itself; a
+    failure of the scenario waits for --retry-failed."""
+    real_simulate = mc.simulate
+    failing = {mc.run_seed(0, 1): OSError(28, "No space left on device"), mc.run_seed(0, 2): RuntimeError("bad model")}
+
+    def flaky(prepared, seed):
+        if seed in failing:
+            raise failing[seed]
+        return real_simulate(prepared, seed)
+
+    monkeypatch.setattr(mc, "simulate", flaky)
+    summary = mc.run_campaign(base_scenario, 3, tmp_path / "c", base_seed=0, workers=1, progress=False)
+    assert [(f["run"], f["cause"]) for f in summary["failures"]] == [(1, "environment"), (2, "scenario")]
+    failing.clear()  # the disk has room again, the model is fixed
+    summary = mc.run_campaign(base_scenario, 3, tmp_path / "c", base_seed=0, workers=1, progress=False)
+    assert [f["run"] for f in summary["failures"]] == [2]
+    summary = mc.run_campaign(base_scenario, 3, tmp_path / "c", base_seed=0, workers=1, progress=False,
+                              retry_failed=True)
+    assert summary["runs_finished"] == 3 and summary["failures"] == []
 
 
 def test_pool_and_dask_give_identical_results(tmp_path, base_scenario):
@@ -129,3 +151,28 @@ def test_batch_of_one_equals_a_single_run(base_scenario):
     threaded = run_batch(base_scenario, [11, 12, 13], threads=2)
     np.testing.assert_array_equal(threaded[0].series["q_est"], single.series["q_est"])
     np.testing.assert_array_equal(threaded[2].series["q_est"], run(base_scenario, seed=13).series["q_est"])
+
+
+def test_ctrl_c_cancels_the_pending_runs_and_keeps_the_finished(tmp_path, base_scenario):
+    """SIGINT to the campaign's process group (Ctrl-C in a terminal) with two workers: the pending runs
+    are cancelled, the workers stop, one line says so (exit 130); the finished runs stay and a rerun
+    completes the campaign."""
+    runs = 400
+    base_scenario["star_sensor"].update(measurement="stars", star_sigma_arcsec=5.0)
+    scenario = write_scenario(tmp_path / "s.toml", base_scenario)
+    out = tmp_path / "interrupted"
+    command = [sys.executable, "-m", "navsim.cli", "montecarlo", str(scenario), "--runs", str(runs), "--out", str(out),
+               "--workers", "2"]
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(out.glob("runs/run_*/summary.json"))) < 3:
+        time.sleep(0.01)
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130
+    assert err.strip().splitlines()[-1] == "navsim: interrupted" and "Traceback" not in err
+    assert 3 <= len(list(out.glob("runs/run_*/summary.json"))) < runs
+    assert not (out / "campaign.lock").exists()
+    resumed = mc.run_campaign(scenario, runs, out, workers=1, progress=False)
+    assert resumed["runs_finished"] == runs and not list(out.glob("runs/*.partial"))

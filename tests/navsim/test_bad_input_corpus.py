@@ -1,0 +1,385 @@
+"""The bad-input corpus of the navsim command line: every scenario key kind of the schema with values
+it must refuse, every option of every command, broken files and unusable output places. Each case
+must end with one line that names the culprit, a non-zero exit status, no traceback, and nothing
+written. (The startrack command line has its corpus in tests/startrack.)"""
+
+import json
+import math
+import os
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from navsim import cli
+from navsim.scenario import SCHEMA, study_schema
+from navsim.scenario.schema import ListOfTables, Table, Value
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = Path(__file__).resolve().parent / "data"
+BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid")}
+STUDY = ROOT / "scenarios" / "paper003_precision.toml"
+#: Which base scenario reaches the keys below each table (the first match wins; "constant" otherwise).
+BASE_OF = (("truth.sinusoidal_axis", "image"), ("truth.rate_segments", "segments"), ("truth.rigid_body", "rigid"),
+           ("star_sensor.image", "image"), ("faults.attitude_jumps", "image"), ("faults.false_star_storms", "image"),
+           ("faults.tracking_failure_probes", "image"))
+
+
+def toml(value):
+    """``value`` written as a TOML value for --set."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and math.isnan(value):
+        return "nan"
+    if isinstance(value, float) and math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(toml(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {toml(v)}" for k, v in value.items()) + "}"
+    return repr(value)
+
+
+def bad_values(spec):
+    """(label, value) pairs a Value must refuse."""
+    out = []
+    limits = [("below minimum", spec.minimum, -1), ("at exclusive minimum", spec.exclusive_minimum, 0),
+              ("above maximum", spec.maximum, +1)]
+    if spec.kind in ("float", "int"):
+        out += [("a string", "abc"), ("a boolean", True)]
+        out += [("NaN", math.nan), ("infinite", math.inf)] if spec.kind == "float" else [("a fraction", 1.5)]
+        for label, limit, side in limits:
+            if limit is not None:
+                step = max(1.0, abs(limit)) if side else 0.0
+                value = limit + side * step
+                out.append((label, int(value) if spec.kind == "int" else float(value)))
+    elif spec.kind == "bool":
+        out += [("a string", "yes"), ("a number", 1)]
+    elif spec.kind == "str":
+        out += [("a number", 5)] + ([("an unknown choice", "nonsense")] if spec.choices else [])
+    elif spec.kind in ("vector", "quaternion"):
+        size = 4 if spec.kind == "quaternion" else spec.size
+        out += [("too short", [1.0] * (size - 1)), ("a string entry", ["a"] + [0.0] * (size - 1)),
+                ("a NaN entry", [math.nan] + [0.0] * (size - 1)), ("a scalar", 1.0)]
+        out += [("zero norm", [0.0] * 4)] if spec.kind == "quaternion" else []
+        if spec.maximum is not None:
+            out.append(("an entry above maximum", [spec.maximum * 2 + 1] + [0.0] * (size - 1)))
+    elif spec.kind == "matrix":
+        out += [("one row", [[1.0, 0.0, 0.0]]), ("a string entry", [["a", 0, 0], [0, 1, 0], [0, 0, 1]])]
+    elif spec.kind in ("list", "ints"):
+        out += [("a scalar", 1.0), ("a string entry", ["a"])]
+        if spec.kind == "ints":
+            out.append(("a fraction entry", [1.5]))
+    return out
+
+
+def scenario_cases(schema, prefix="", item_of=None):
+    """(case id, base, key path, --set override) for every leaf of ``schema`` and every table's unknown key."""
+    cases = [(f"{prefix or '<top>'}: an unknown key", prefix, f"{prefix + '.' if prefix else ''}bogus_key", "1")]
+    for key, spec in schema.entries.items():
+        path = f"{prefix}.{key}" if prefix else key
+        if isinstance(spec, Table):
+            cases += scenario_cases(spec, path)
+        elif isinstance(spec, ListOfTables):
+            cases.append((f"{path}: not an array of tables", prefix, path, "5"))
+            cases += [(case_id, base, path, override) for case_id, base, _, override in _item_cases(spec.item, path)]
+        else:
+            cases += [(f"{path}: {label}", prefix, path, toml(value)) for label, value in bad_values(spec)]
+    return cases
+
+
+def _item_cases(item, path):
+    """Cases for each field of a list-of-tables item: the list replaced by one item with that field bad."""
+    valid = _valid_item(item, path)
+    for key, spec in item.entries.items():
+        for label, value in bad_values(spec):
+            yield f"{path}[0].{key}: {label}", path, path, toml([{**valid, key: value}])
+
+
+def _valid_item(item, path):
+    base = tomllib.loads(_base_file(path).read_text())
+    node = base
+    for part in path.split("."):
+        node = node[part]
+    return dict(node[0])
+
+
+def _base_file(path):
+    return BASES[next((base for table, base in BASE_OF if path.startswith(table)), "constant")]
+
+
+SCENARIO_CASES = scenario_cases(SCHEMA)
+
+
+def run_cli(argv, capsys):
+    """(exit status, stderr) of an in-process ``navsim`` call."""
+    try:
+        status = cli.main([str(a) for a in argv])
+    except SystemExit as exit_:
+        status = exit_.code
+    return status, capsys.readouterr().err
+
+
+def assert_one_clear_line(status, err, culprit, out=None):
+    assert status not in (0, None), err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(("navsim: error:", "navsim run: error:", "navsim montecarlo: error:",
+                                "navsim tune: error:", "navsim report: error:")), err
+    assert culprit in lines[0], (culprit, err)
+    if out is not None:
+        assert not Path(out).exists() or not any(Path(out).iterdir()), f"{out} was written"
+
+
+@pytest.mark.parametrize("case_id, table, key, override", SCENARIO_CASES, ids=[c[0] for c in SCENARIO_CASES])
+def test_every_scenario_key_refuses_a_bad_value(tmp_path, capsys, case_id, table, key, override):
+    base = _base_file(table or key)
+    out = tmp_path / "out"
+    status, err = run_cli(["run", base, "--out", out, "--set", f"{key}={override}"], capsys)
+    assert_one_clear_line(status, err, key.split(".")[-1], out)
+
+
+REQUIRED = [("duration_s", "constant"), ("truth.profile", "constant"), ("gyro.rate_hz", "constant"),
+            ("star_sensor.rate_hz", "constant"), ("star_sensor.fov_deg", "constant"),
+            ("truth.sinusoidal_axis.amplitude_deg", "image"), ("truth.rigid_body.inertia_kg_m2", "rigid")]
+
+
+@pytest.mark.parametrize("key, base", REQUIRED)
+def test_a_missing_required_key_is_named(tmp_path, capsys, key, base):
+    data = tomllib.loads(BASES[base].read_text())
+    node = data
+    *parents, last = key.split(".")
+    for part in parents:
+        node = node[part]
+    del node[last]
+    path = tmp_path / "missing.toml"
+    path.write_text(_to_toml(data))
+    status, err = run_cli(["run", path, "--out", tmp_path / "out"], capsys)
+    assert_one_clear_line(status, err, last, tmp_path / "out")
+    assert "missing" in err
+
+
+def _to_toml(data, prefix=""):
+    """A scenario dictionary as TOML (scalars and inline arrays/tables, then sub-tables)."""
+    scalars = [f"{k} = {toml(v)}" for k, v in data.items() if not isinstance(v, dict)]
+    tables = [_to_toml(v, f"{prefix}{k}.") for k, v in data.items() if isinstance(v, dict)]
+    head = [f"[{prefix[:-1]}]"] if prefix else []
+    return "\n".join(head + scalars) + "\n\n" + "\n".join(tables)
+
+
+CROSS_KEY = [
+    ("constant", "star_sensor.rate_hz=3.0", "star_sensor.rate_hz"),          # does not divide the gyro rate
+    ("constant", "truth.rate_hz=15.0", "truth.rate_hz"),                     # not a multiple of the gyro rate
+    ("constant", "duration_s=0.1", "duration_s"),                            # shorter than a frame
+    ("constant", "settle_s=10.0", "settle_s"),                               # after the end
+    ("constant", "truth.profile=\"rigid_body\"", "truth.rigid_body"),        # its table is missing
+    ("image", "truth.constant_rate={rate_deg_per_s = [1.0, 0.0, 0.0]}", "truth.constant_rate"),  # another profile's
+    ("image", "truth.sinusoidal_axis.axis=[0.0, 0.0, 0.0]", "axis"),        # no rotation axis
+    ("image", "star_sensor.measurement=\"attitude\"", "star_sensor.measurement"),
+    ("constant", "faults.attitude_jumps=[{time_s = 1.0, angle_deg = 2.0}]", "faults.attitude_jumps"),
+    ("constant", "faults.outages=[{start_s = 2.0, end_s = 1.0}]", "faults.outages"),
+    ("segments", "duration_s=10.0", "segments"),                             # segments do not cover the run
+    ("rigid", "truth.rigid_body.inertia_kg_m2=[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]", "inertia_kg_m2"),
+    ("constant", "duration_s=1e6", "duration_s"),                            # more than one run holds
+    ("constant", "gyro.rate_hz=10000.0", "gyro.rate_hz"),
+    ("image", "star_sensor.image.sky_hip=[999999]", "sky_hip"),             # not in the catalog
+    ("constant", "filter.estimate_scale_factor=true", "filter.estimate_scale_factor"),  # renamed
+    ("constant", "filter.initial_misalignment_sigma_arcsec=10.0", "initial_misalignment_sigma_arcsec"),
+]
+
+
+@pytest.mark.parametrize("base, override, culprit", CROSS_KEY, ids=[c[1][:40] for c in CROSS_KEY])
+def test_inconsistent_keys_are_named(tmp_path, capsys, base, override, culprit):
+    status, err = run_cli(["run", BASES[base], "--out", tmp_path / "out", "--set", override], capsys)
+    assert_one_clear_line(status, err, culprit, tmp_path / "out")
+
+
+def study_cases():
+    """Every parameter of every static study kind, with the values it must refuse."""
+    schema = study_schema()
+    cases = [("study: an unknown kind", "study.kind", '"nonsense"')]
+    for kind, table in schema.entries["study"].entries.items():
+        if isinstance(table, Table):
+            for key, spec in table.entries.items():
+                if isinstance(spec, Value):
+                    cases += [(f"study.{kind}.{key}: {label}", f"study.{kind}.{key}", toml(value))
+                              for label, value in bad_values(spec)]
+    return cases
+
+
+STUDY_CASES = study_cases()
+
+
+@pytest.mark.parametrize("case_id, key, override", STUDY_CASES, ids=[c[0] for c in STUDY_CASES])
+def test_every_study_parameter_refuses_a_bad_value(tmp_path, capsys, case_id, key, override):
+    base = ROOT / "scenarios" / ("contest_starmap.toml" if ".contest_starmap." in key else "paper003_precision.toml")
+    status, err = run_cli(["run", base, "--out", tmp_path / "out", "--set", f"{key}={override}"], capsys)
+    assert_one_clear_line(status, err, key.split(".")[-1], tmp_path / "out")
+
+
+def _files(tmp_path):
+    """Broken inputs on disk: (name -> path)."""
+    (tmp_path / "dir.toml").mkdir()
+    (tmp_path / "binary.toml").write_bytes(b"\xff\xfe\x00binary")
+    (tmp_path / "invalid.toml").write_text("name = \n")
+    (tmp_path / "deep.toml").write_text("name = " + "[" * 50000 + "]" * 50000 + "\n")
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "foreign").mkdir()
+    (tmp_path / "foreign" / "notes.txt").write_text("mine")
+    return tmp_path
+
+
+def option_cases():
+    """(id, argv with {tmp} and {demo} placeholders, culprit) of every command's options."""
+    demo = "{demo}"
+    return [
+        ("run: missing scenario", ["run", "{tmp}/nope.toml", "--out", "{tmp}/o"], "nope.toml"),
+        ("run: scenario is a directory", ["run", "{tmp}/dir.toml", "--out", "{tmp}/o"], "is a directory"),
+        ("run: binary scenario", ["run", "{tmp}/binary.toml", "--out", "{tmp}/o"], "not a text file"),
+        ("run: invalid TOML", ["run", "{tmp}/invalid.toml", "--out", "{tmp}/o"], "invalid TOML"),
+        ("run: nested 50000 deep", ["run", "{tmp}/deep.toml", "--out", "{tmp}/o"], "nested too deeply"),
+        ("run: --seed -1", ["run", demo, "--out", "{tmp}/o", "--seed", "-1"], "--seed"),
+        ("run: --seed 2**64", ["run", demo, "--out", "{tmp}/o", "--seed", str(2**64)], "--seed"),
+        ("run: --seed abc", ["run", demo, "--out", "{tmp}/o", "--seed", "abc"], "--seed"),
+        ("run: no --out", ["run", demo], "--out"),
+        ("run: --out is a file", ["run", demo, "--out", "{tmp}/a_file"], "a_file"),
+        ("run: --out under a file", ["run", demo, "--out", "{tmp}/a_file/o"], "a_file"),
+        ("run: --out in /proc", ["run", demo, "--out", "/proc/navsim-out"], "/proc"),
+        ("run: --out holds foreign files", ["run", demo, "--out", "{tmp}/foreign"], "foreign"),
+        ("run: --report not a PDF", ["run", demo, "--out", "{tmp}/o", "--report", "{tmp}/r.txt"], "r.txt"),
+        ("run: --report a directory", ["run", demo, "--out", "{tmp}/o", "--report", "{tmp}/dir.toml"], "dir.toml"),
+        ("run: --set without =", ["run", demo, "--out", "{tmp}/o", "--set", "duration_s"], "duration_s"),
+        ("run: --set empty key", ["run", demo, "--out", "{tmp}/o", "--set", "=3"], "empty key"),
+        ("run: --set through a value", ["run", demo, "--out", "{tmp}/o", "--set", "duration_s.x=3"], "duration_s"),
+        ("run: --set deep value", ["run", demo, "--out", "{tmp}/o", "--set", "duration_s=" + "[" * 5000 + "]" * 5000],
+         "duration_s"),
+        ("run: unknown option", ["run", demo, "--out", "{tmp}/o", "--bogus"], "--bogus"),
+        ("montecarlo: --runs 0", ["montecarlo", demo, "--runs", "0", "--out", "{tmp}/o"], "--runs"),
+        ("montecarlo: --runs -1", ["montecarlo", demo, "--runs", "-1", "--out", "{tmp}/o"], "--runs"),
+        ("montecarlo: --runs 1e9", ["montecarlo", demo, "--runs", "1000000000", "--out", "{tmp}/o"], "--runs"),
+        ("montecarlo: --runs x", ["montecarlo", demo, "--runs", "x", "--out", "{tmp}/o"], "--runs"),
+        ("montecarlo: --workers 0", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/o", "--workers", "0"], "--workers"),
+        ("montecarlo: workers and scheduler", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/o", "--workers", "2",
+                                               "--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
+        ("montecarlo: --scheduler notaurl", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/o",
+                                             "--scheduler", "notaurl"], "notaurl"),
+        ("montecarlo: no scheduler there", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/o",
+                                            "--scheduler", "tcp://127.0.0.1:1"], "cannot connect"),
+        ("montecarlo: --seed -5", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/o", "--seed", "-5"], "--seed"),
+        ("montecarlo: --out is a file", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/a_file"], "a_file"),
+        ("montecarlo: --out under a file", ["montecarlo", demo, "--runs", "2", "--out", "{tmp}/a_file/o"], "a_file"),
+        ("montecarlo: --out in /proc", ["montecarlo", demo, "--runs", "2", "--out", "/proc/navsim-mc"], "/proc"),
+        ("montecarlo: a study", ["montecarlo", str(STUDY), "--runs", "2", "--out", "{tmp}/o"], "static study"),
+        ("tune: --runs 0", ["tune", demo, "--runs", "0"], "--runs"),
+        ("tune: --evaluations 0", ["tune", demo, "--evaluations", "0"], "--evaluations"),
+        ("tune: --evaluations -1", ["tune", demo, "--evaluations", "-1"], "--evaluations"),
+        ("tune: --seed -1", ["tune", demo, "--seed", "-1"], "--seed"),
+        ("tune: a study", ["tune", str(STUDY)], "static study"),
+        ("report: missing directory", ["report", "{tmp}/nope", "-o", "{tmp}/r.pdf"], "nope"),
+        ("report: a file", ["report", "{tmp}/a_file", "-o", "{tmp}/r.pdf"], "a_file"),
+        ("report: not an output", ["report", "{tmp}/foreign", "-o", "{tmp}/r.pdf"], "foreign"),
+        ("report: -o not a PDF", ["report", "{tmp}/foreign", "-o", "{tmp}/r.txt"], "r.txt"),
+        ("report: -o under a file", ["report", "{tmp}/foreign", "-o", "{tmp}/a_file/r.pdf"], "a_file"),
+        ("no command", [], "COMMAND"),
+        ("unknown command", ["fly"], "fly"),
+    ]
+
+
+OPTION_CASES = option_cases()
+
+
+@pytest.mark.parametrize("case_id, argv, culprit", OPTION_CASES, ids=[c[0] for c in OPTION_CASES])
+def test_every_option_refuses_a_bad_value(tmp_path, capsys, case_id, argv, culprit):
+    _files(tmp_path)
+    demo = BASES["constant"]
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{demo}", str(demo)) for a in argv]
+    status, err = run_cli(argv, capsys)
+    assert_one_clear_line(status, err, culprit, tmp_path / "o")
+    assert not Path("/proc/navsim-out").exists()
+
+
+def _run_dir(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert run_cli(["run", BASES["constant"], "--out", out], capsys)[0] == 0
+    return out
+
+
+BROKEN_OUTPUTS = [
+    ("summary.json not JSON", "summary.json", b"{", "summary.json"),
+    ("summary.json a list", "summary.json", b"[]", "summary.json"),
+    ("summary.json another format", "summary.json", b'{"format": "other/9"}', "summary.json"),
+    ("timeseries.npz not a zip", "timeseries.npz", b"not a zip", "timeseries.npz"),
+    ("scenario.json not JSON", "scenario.json", b"\xff", "scenario.json"),
+    ("timing.npz not a zip", "timing.npz", b"xx", "timing.npz"),
+]
+
+
+@pytest.mark.parametrize("case_id, name, content, culprit", BROKEN_OUTPUTS, ids=[c[0] for c in BROKEN_OUTPUTS])
+def test_a_broken_run_directory_is_named_by_the_report(tmp_path, capsys, case_id, name, content, culprit):
+    out = _run_dir(tmp_path, capsys)
+    (out / name).write_bytes(content)
+    status, err = run_cli(["report", out, "-o", tmp_path / "r.pdf"], capsys)
+    assert_one_clear_line(status, err, culprit)
+    assert not (tmp_path / "r.pdf").exists()
+
+
+@pytest.mark.parametrize("content", ["[]", "{", '{"runs": "many"}'])
+def test_a_broken_campaign_file_is_named(tmp_path, capsys, content):
+    out = tmp_path / "mc"
+    out.mkdir()
+    (out / "campaign.json").write_text(content)
+    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "2", "--out", out], capsys)
+    assert_one_clear_line(status, err, "campaign.json")
+
+
+def test_an_output_of_one_kind_is_not_reused_for_another(tmp_path, capsys):
+    """A run directory is refused to a campaign and the other way round; a second run into the same
+    directory replaces the first whole (no stale file survives)."""
+    run_dir = _run_dir(tmp_path, capsys)
+    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "2", "--out", run_dir], capsys)
+    assert_one_clear_line(status, err, "a run output")
+    campaign = tmp_path / "mc"
+    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", campaign, "--workers", "1"], capsys)[0] == 0
+    status, err = run_cli(["run", BASES["constant"], "--out", campaign], capsys)
+    assert_one_clear_line(status, err, "a campaign output")
+    (run_dir / "stale.npy").write_bytes(b"old")
+    assert run_cli(["run", BASES["constant"], "--out", run_dir], capsys)[0] == 0
+    assert not (run_dir / "stale.npy").exists()
+
+
+def test_a_second_campaign_on_a_locked_directory_is_refused(tmp_path, capsys):
+    out = tmp_path / "mc"
+    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
+    (out / "campaign.lock").write_text(str(os.getppid()))  # a live process holds it
+    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)
+    assert_one_clear_line(status, err, "another campaign")
+    (out / "campaign.lock").write_text("999999999")  # a stale lock is taken over
+    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path, capsys):
+    scenario = tmp_path / "bom.toml"
+    scenario.write_bytes(b"\xef\xbb\xbf" + BASES["constant"].read_bytes())
+    assert run_cli(["run", scenario, "--out", tmp_path / "o"], capsys)[0] == 0
+
+
+def test_the_corpus_is_large():
+    """The issue's floor: at least 200 bad inputs over every option and scenario key kind."""
+    total = (len(SCENARIO_CASES) + len(REQUIRED) + len(CROSS_KEY) + len(STUDY_CASES) + len(OPTION_CASES)
+             + len(BROKEN_OUTPUTS) + 3 + 2)
+    assert total >= 200
+    kinds = {spec.kind for spec in _leaves(SCHEMA)}
+    assert kinds >= {"float", "int", "bool", "str", "vector", "quaternion", "matrix", "list", "ints"}
+
+
+def _leaves(table):
+    for spec in table.entries.values():
+        if isinstance(spec, Table):
+            yield from _leaves(spec)
+        elif isinstance(spec, ListOfTables):
+            yield from _leaves(spec.item)
+        else:
+            yield spec
