@@ -177,8 +177,8 @@ def run_report(run) -> bytes:
         _sensor_section(doc, run)
         _address_section(doc, run)
         _frame_section(doc, run)
-        _comparison_section(doc, summary.get("paper_comparison"))
-        _notes_section(doc, summary.get("notes"))
+        _comparison_section(doc, *_with_timing(summary, "paper_comparison"))
+        _notes_section(doc, *_with_timing(summary, "notes"))
         _absent_section(doc, run)
         return doc.compile()
 
@@ -367,23 +367,28 @@ def _frame_section(doc, run):
                     "identifications.")
 
 
-def _comparison_section(doc, comparison):
-    if not isinstance(comparison, list) or not comparison:
+def _with_timing(summary, key):
+    """(the summary's ``key`` list, the same list of its wall-clock ``timing``) for a section."""
+    return summary.get(key) or [], (summary.get("timing") or {}).get(key) or []
+
+
+def _comparison_section(doc, comparison, timed=()):
+    """The comparison table; rows of wall-clock figures (``timed``) marked as such."""
+    rows = [tuple(general(row.get(k, "")) for k in ("quantity", "ours", "paper", "source"))
+            for row in [*comparison, *timed] if isinstance(row, dict)]
+    if not rows:
         return
     doc.heading("Comparison with the source documents")
-    doc.paragraph(markup("Our figures beside those reported in the source documents."))
-    rows = []
-    for row in comparison:
-        if isinstance(row, dict):
-            rows.append(tuple(general(row.get(k, "")) for k in ("quantity", "ours", "paper", "source")))
+    doc.paragraph(markup("Our figures beside those reported in the source documents"
+                         + (f"; the last {len(timed)} rows are times measured on this machine." if timed else ".")))
     doc.add(table(("Quantity", "Ours", "Source document", "Source"), rows, ("left", "right", "right", "left")))
 
 
-def _notes_section(doc, notes):
-    if not isinstance(notes, list) or not notes:
+def _notes_section(doc, notes, timed=()):
+    if not notes and not timed:
         return
     doc.heading("What the comparison shows")
-    for note in notes:
+    for note in [*notes, *timed]:
         doc.paragraph(markup(str(note)))
 
 
@@ -426,8 +431,8 @@ def study_report(study) -> bytes:
         doc.heading("Key results")
         doc.add(table(("Quantity", "Value", "Unit"), module.key_results(summary, parameters), ("left", "right", "left")))
         _scenario_section(doc, study.scenario)
-        _comparison_section(doc, summary.get("paper_comparison"))
-        _notes_section(doc, summary.get("notes"))
+        _comparison_section(doc, summary.get("paper_comparison") or [])
+        _notes_section(doc, summary.get("notes") or [])
         doc.heading("Figures")
         for fig, caption in module.figures(summary, study.arrays, parameters):
             doc.figure(fig, caption)
@@ -536,8 +541,8 @@ def campaign_report(campaign) -> bytes:
                 doc.heading("Aggregate summary")
                 doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))
                 doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
-            _comparison_section(doc, campaign.summary.get("paper_comparison"))
-            _notes_section(doc, campaign.summary.get("notes"))
+            _comparison_section(doc, *_with_timing(campaign.summary, "paper_comparison"))
+            _notes_section(doc, *_with_timing(campaign.summary, "notes"))
 
         if campaign.failed:
             doc.heading("Failed runs")
