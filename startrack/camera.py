@@ -24,6 +24,7 @@ Frame convention (docs/design.md, binding):
   intersected with the image; otherwise the image rectangle.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,22 @@ from startrack.rotation import from_rotation_vector, to_matrix
 
 #: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
 _NEWTON_ITERATIONS = 12
+
+
+def fold_radius_squared(k1, k2):
+    """Smallest t = r^2 > 0 with d/dr [r (1 + k1 r^2 + k2 r^4)] = 1 + 3 k1 t + 5 k2 t^2 = 0, or inf: the
+    ideal radius^2 beyond which the distorted radius decreases.  Plain arithmetic, so that the compiled
+    kernels wrap this very function (:data:`startrack.camera_fit.fold_radius_squared_jit`)."""
+    if k2 == 0.0:
+        return -1.0 / (3.0 * k1) if k1 < 0.0 else math.inf
+    disc = 9.0 * k1 * k1 - 20.0 * k2
+    if disc < 0.0:
+        return math.inf
+    best = math.inf
+    for t in ((-3.0 * k1 - math.sqrt(disc)) / (10.0 * k2), (-3.0 * k1 + math.sqrt(disc)) / (10.0 * k2)):
+        if 0.0 < t < best:
+            best = t
+    return best
 
 
 @dataclass(frozen=True)
@@ -199,10 +216,18 @@ class Camera:
         uv, xy_n, front = self._project(self.to_sensor(q_IS, vectors_I))
         return np.flatnonzero(self._visible(uv, xy_n, front, float(margin_px)))
 
+    @property
+    def fold_radius(self):
+        """Ideal normalised radius beyond which the distorted radius r (1 + k1 r^2 + k2 r^4) decreases
+        again (inf if it never does): directions farther off axis fold back into the image under the
+        polynomial but are not imaged by the lens, so they are never visible."""
+        return math.sqrt(fold_radius_squared(self.k1, self.k2))
+
     def _visible(self, uv, xy_n, front, margin_px):
         with np.errstate(invalid="ignore"):
             inside = (
                 front
+                & (np.sum(xy_n * xy_n, axis=1) < self.fold_radius**2)
                 & (uv[:, 0] >= -0.5 - margin_px)
                 & (uv[:, 0] <= self.width - 0.5 + margin_px)
                 & (uv[:, 1] >= -0.5 - margin_px)

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from startrack.camera_fit import fold_radius_squared_jit
 from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
@@ -82,6 +83,35 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
     """
     p = -math.expm1(-density * 2.0 * math.pi * (1.0 - math.cos(gate)))
     return min(1.0, max(n_hypotheses, 1) * binomial_tail(n_other, n_matched_other, p))
+
+
+@njit
+def poisson_tail(mean, k):
+    """P[Poisson(mean) >= k], summed term by term from k upwards (accurate for tiny tails)."""
+    if k <= 0:
+        return 1.0
+    if mean <= 0.0:
+        return 0.0
+    term = math.exp(k * math.log(mean) - mean - math.lgamma(k + 1))
+    total = term
+    j = k
+    while term > 1e-17 * total:
+        j += 1
+        term *= mean / j
+        total += term
+    return min(total, 1.0)
+
+
+@njit
+def chance_match_probability(expected, k, n_hypotheses):
+    """min(1, N_h P[S >= k]): S the number of predicted stars with a detection within the radius d by
+    chance, under a wrong hypothesis, counted as a Poisson variable of mean sum_i (1 - exp(-x_i)),
+    x_i = rho_i pi d^2 the expected detections within d of predicted star i (rho_i the local density
+    of the detections there).  ``expected`` (m,) the x_i, ``k`` the matches beyond the seeds."""
+    mean = 0.0
+    for i in range(expected.size):
+        mean += -math.expm1(-expected[i])
+    return min(1.0, max(n_hypotheses, 1.0) * poisson_tail(mean, k))
 
 
 @njit
@@ -162,6 +192,7 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     :class:`startrack.camera.Camera`.
     """
     focal, cx, cy, width, height, k1, k2, circular = camera_params
+    fold = fold_radius_squared_jit(k1, k2)
     v_S = np.empty_like(stars_I)
     for s in range(stars_I.shape[0]):
         for c in range(3):
@@ -174,6 +205,8 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
         if z <= 0.0:
             continue
         x, y = v_S[s, 0] / z, v_S[s, 1] / z
+        if x * x + y * y >= fold:
+            continue  # beyond the fold of the distortion polynomial: not imaged
         factor = 1.0 + k1 * (x * x + y * y) + k2 * (x * x + y * y) ** 2
         u = cx + focal * x * factor
         v = cy + focal * y * factor

@@ -1,0 +1,208 @@
+"""Least-squares fit of the attitude and the camera's intrinsics to matched stars (compiled).
+
+Model (:mod:`startrack.camera`, docs/design.md): a catalog direction v_I is seen at
+v_S = R_IS^T v_I, x = v_x / v_z, y = v_y / v_z, r^2 = x^2 + y^2, d = 1 + k1 r^2 + k2 r^4 and
+
+    u = cx + f x d,   v = cy + f y d.
+
+Parameters: the attitude error dtheta (rotation vector in S, R_IS <- R_IS exp([dtheta x]), the
+convention of the filter's error state) and the intrinsics p = (f, cx, cy, k1, k2), each free or held.
+The Jacobian: dv_S/d dtheta = [v_S x]; dx/dv_S = (1/v_z, 0, -x/v_z), dy/dv_S = (0, 1/v_z, -y/v_z);
+du/dx = f (d + 2 x^2 (k1 + 2 k2 r^2)), du/dy = dv/dx = 2 f x y (k1 + 2 k2 r^2),
+dv/dy = f (d + 2 y^2 (k1 + 2 k2 r^2)); du/df = x d, du/dcx = 1, du/dk1 = f x r^2, du/dk2 = f x r^4
+(and likewise for v).
+
+Gauss-Newton (Gauss-Markov weights 1/sigma_i^2 per star and axis) with Gaussian priors on the
+intrinsics (maximum a posteriori: a free principal point of a narrow field is held near the image
+centre by its prior instead of drifting along its near-degeneracy with the attitude, Hartley &
+Zisserman §A6, docs/references.md); the normal matrix is scaled to unit diagonal before it is solved.
+The covariance of the estimate is the inverse normal matrix times max(1, chi^2 / dof): the stated
+sigma_i are a lower bound of the real centroid errors of a real camera.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from startrack.attitude_angles import radec_roll_from_matrix
+from startrack.camera import fold_radius_squared
+from startrack.jit import njit
+from startrack.rotation import from_rotation_vector, to_matrix
+from startrack.rotation_jit import quat_from_rotation_vector, quat_to_matrix
+
+#: Positions of the intrinsics (f, cx, cy, k1, k2) in a camera-parameter array (f, cx, cy, W, H, k1, k2,
+#: circular) -- the layout of :class:`startrack.identify.verify.FieldStars.camera_params`.
+INTRINSICS = np.array([0, 1, 2, 5, 6], np.int64)
+#: Compiled twin of :func:`startrack.camera.fold_radius_squared` (the same function).
+fold_radius_squared_jit = njit(fold_radius_squared)
+#: Names of the fitted parameters, in the order of :func:`fit` 's covariance.
+PARAMETERS = ("dtheta_x", "dtheta_y", "dtheta_z", "f", "cx", "cy", "k1", "k2")
+
+
+@njit(_nrt=False)
+def project_one(vx, vy, vz, camera_params):  # pragma: no cover  (compiled)
+    """(u, v) [px] of the direction (vx, vy, vz) in S (in front of the lens): the module's model."""
+    f, cx, cy, _, _, k1, k2, _ = camera_params
+    x, y = vx / vz, vy / vz
+    r2 = x * x + y * y
+    d = 1.0 + k1 * r2 + k2 * r2 * r2
+    return cx + f * x * d, cy + f * y * d
+
+
+@njit
+def project(v_S, camera_params):  # pragma: no cover  (compiled)
+    """(u, v) (m, 2) [px] of the directions v_S (m, 3) in S (in front of the lens)."""
+    uv = np.empty((v_S.shape[0], 2))
+    for i in range(v_S.shape[0]):
+        uv[i, 0], uv[i, 1] = project_one(v_S[i, 0], v_S[i, 1], v_S[i, 2], camera_params)
+    return uv
+
+
+@njit
+def _jacobian_rows(v, camera_params, rows):  # pragma: no cover  (compiled)
+    """rows (2, 8): d(u, v)/d(dtheta, f, cx, cy, k1, k2) at the direction v (3,) in S (module text)."""
+    f, _, _, _, _, k1, k2, _ = camera_params
+    z = v[2]
+    x, y = v[0] / z, v[1] / z
+    r2 = x * x + y * y
+    d = 1.0 + k1 * r2 + k2 * r2 * r2
+    g = 2.0 * (k1 + 2.0 * k2 * r2)
+    du_dx, du_dy = f * (d + x * x * g), f * x * y * g
+    dv_dx, dv_dy = du_dy, f * (d + y * y * g)
+    # d(x, y)/dv_S, then through [v x] (columns: d v_S / d dtheta_k = v x e_k)
+    dx = np.array([1.0 / z, 0.0, -x / z])
+    dy = np.array([0.0, 1.0 / z, -y / z])
+    skew = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    for k in range(3):
+        dxk = dx[0] * skew[0, k] + dx[1] * skew[1, k] + dx[2] * skew[2, k]
+        dyk = dy[0] * skew[0, k] + dy[1] * skew[1, k] + dy[2] * skew[2, k]
+        rows[0, k] = du_dx * dxk + du_dy * dyk
+        rows[1, k] = dv_dx * dxk + dv_dy * dyk
+    rows[0, 3], rows[1, 3] = x * d, y * d
+    rows[0, 4], rows[1, 4] = 1.0, 0.0
+    rows[0, 5], rows[1, 5] = 0.0, 1.0
+    rows[0, 6], rows[1, 6] = f * x * r2, f * y * r2
+    rows[0, 7], rows[1, 7] = f * x * r2 * r2, f * y * r2 * r2
+
+
+@njit
+def _normal_equations(uv, weight, ref_I, R_IS, camera_params, free, prior_mean, prior_sigma):  # pragma: no cover
+    """(N (8, 8), b (8,), chi^2 of the data) of one Gauss-Newton step; held parameters get N_ii = 1, b_i = 0."""
+    N = np.zeros((8, 8))
+    b = np.zeros(8)
+    rows = np.empty((2, 8))
+    chi2 = 0.0
+    v = np.empty(3)
+    for i in range(uv.shape[0]):
+        for c in range(3):
+            v[c] = R_IS[0, c] * ref_I[i, 0] + R_IS[1, c] * ref_I[i, 1] + R_IS[2, c] * ref_I[i, 2]
+        u_model, v_model = project_one(v[0], v[1], v[2], camera_params)
+        res = (uv[i, 0] - u_model, uv[i, 1] - v_model)
+        _jacobian_rows(v, camera_params, rows)
+        for a in range(2):
+            chi2 += weight[i] * res[a] * res[a]
+            for p in range(8):
+                b[p] += weight[i] * rows[a, p] * res[a]
+                for q in range(8):
+                    N[p, q] += weight[i] * rows[a, p] * rows[a, q]
+    for p in range(3, 8):
+        k = INTRINSICS[p - 3]
+        if free[p - 3] and prior_sigma[p - 3] < np.inf:
+            N[p, p] += 1.0 / prior_sigma[p - 3] ** 2
+            b[p] += (prior_mean[p - 3] - camera_params[k]) / prior_sigma[p - 3] ** 2
+    for p in range(3, 8):
+        if not free[p - 3]:
+            N[p, :] = 0.0
+            N[:, p] = 0.0
+            N[p, p] = 1.0
+            b[p] = 0.0
+    return N, b, chi2
+
+
+@njit
+def _solve_scaled(N, b):  # pragma: no cover  (compiled)
+    """(N^-1 b, N^-1) with N scaled to unit diagonal first (conditioning of pixels against k's)."""
+    scale = 1.0 / np.sqrt(np.diag(N))
+    Ns = N * np.outer(scale, scale)
+    inverse = np.linalg.inv(Ns) * np.outer(scale, scale)
+    return inverse @ b, inverse
+
+
+@njit
+def fit(uv, sigma_px, ref_I, R_IS, camera_params, free, prior_mean, prior_sigma, iterations=8):  # pragma: no cover
+    """Gauss-Newton fit of the attitude and the free intrinsics (module text).
+
+    uv (m, 2) [px] observed; sigma_px (m,) per-axis noise [px]; ref_I (m, 3) catalog directions; R_IS
+    and camera_params (f, cx, cy, W, H, k1, k2, circular) the start; free (5,) bool for (f, cx, cy,
+    k1, k2); prior_mean, prior_sigma (5,) (inf: no prior).  Returns (R_IS, camera_params, covariance
+    (8, 8) of (dtheta, f, cx, cy, k1, k2) [rad, px, -], chi^2 / dof) -- zero rows for held parameters.
+    """
+    R = R_IS.copy()
+    params = camera_params.copy()
+    weight = 1.0 / sigma_px**2
+    n_free = 3 + int(np.sum(free))
+    dof = max(2 * uv.shape[0] - n_free, 1)
+    inverse = np.zeros((8, 8))
+    chi2 = 0.0
+    for _ in range(iterations):
+        N, b, chi2 = _normal_equations(uv, weight, ref_I, R, params, free, prior_mean, prior_sigma)
+        step, inverse = _solve_scaled(N, b)
+        R = R @ quat_to_matrix(quat_from_rotation_vector(step[:3]))
+        for p in range(5):
+            params[INTRINSICS[p]] += step[3 + p]
+        if np.abs(step[:3]).max() < 1e-10 and abs(step[3]) < 1e-6 * params[0]:
+            break
+    N, b, chi2 = _normal_equations(uv, weight, ref_I, R, params, free, prior_mean, prior_sigma)
+    _, inverse = _solve_scaled(N, b)
+    for p in range(3, 8):
+        if not free[p - 3]:
+            inverse[p, :] = 0.0
+            inverse[:, p] = 0.0
+    reduced = chi2 / dof
+    return R, params, inverse * max(1.0, reduced), reduced
+
+
+@dataclass(frozen=True, eq=False)
+class CameraCalibration:
+    """The camera a frame's stars calibrated: ``camera`` (:class:`startrack.camera.Camera`) and the
+    ``covariance`` (8, 8) of (dtheta, f, cx, cy, k1, k2) from :func:`fit`, with the fit's
+    ``reduced_chi2``, ``rms_px`` (per-axis residual RMS), ``matched`` and ``predicted`` stars and
+    ``mag_limit`` (the faintest predicted star, V mag)."""
+
+    camera: object
+    covariance: np.ndarray
+    reduced_chi2: float
+    rms_px: float
+    matched: int
+    predicted: int
+    mag_limit: float
+
+    @property
+    def sigma(self) -> dict:
+        """1-sigma of f [px], cx, cy [px], k1, k2 and the field of view across the width [deg]."""
+        spread = np.sqrt(np.clip(np.diag(self.covariance)[3:], 0.0, None))
+        out = dict(zip(("focal_px", "cx", "cy", "k1", "k2"), (float(s) for s in spread)))
+        f, width = self.camera.focal_px, self.camera.width
+        out["fov_deg"] = math.degrees(width / (f * f + 0.25 * width * width) * out["focal_px"])
+        return out
+
+    def center_radec_roll(self, q_IS):
+        """(ra, dec, roll) [rad] of the image centre: the frame whose +z is the direction of the centre pixel
+        ((W-1)/2, (H-1)/2) and whose axes follow S by the smallest rotation (what plate solvers report)."""
+        cam = self.camera
+        c = cam.unproject([[(cam.width - 1) / 2.0, (cam.height - 1) / 2.0]])[0]
+        axis = np.cross([0.0, 0.0, 1.0], c)
+        angle = math.atan2(np.linalg.norm(axis), c[2])
+        turn = to_matrix(from_rotation_vector(axis / max(np.linalg.norm(axis), 1e-300) * angle))
+        return radec_roll_from_matrix(to_matrix(q_IS) @ turn)
+
+    def to_dict(self) -> dict:
+        """JSON-ready camera with 1-sigma (the ``camera`` entry of ``startrack solve --json``)."""
+        cam, sigma = self.camera, self.sigma
+        return {"width": cam.width, "height": cam.height, "fov_deg": math.degrees(cam.fov_x),
+                "focal_px": cam.focal_px, "cx": cam.cx, "cy": cam.cy, "k1": cam.k1, "k2": cam.k2,
+                "sigma": sigma, "rms_px": self.rms_px, "reduced_chi2": self.reduced_chi2,
+                "matched": self.matched, "predicted": self.predicted, "mag_limit": self.mag_limit}
