@@ -112,6 +112,15 @@ class Camera:
         return 2.0 * np.arctan(self.height / (2.0 * self.focal_px))
 
     @property
+    def angular_width(self):
+        """Angle [rad] the image width subtends through its middle row (outer pixel edges, distortion
+        included): the field of view a plate solver measures; fov_x for an undistorted camera with its
+        principal point at the centre."""
+        middle = (self.height - 1) / 2.0
+        left, right = self.unproject([[-0.5, middle], [self.width - 0.5, middle]])
+        return float(np.arctan2(np.linalg.norm(np.cross(left, right)), np.dot(left, right)))
+
+    @property
     def fov_diagonal(self):
         """Full field angle across the diagonal [rad]."""
         return 2.0 * np.arctan(np.hypot(self.width, self.height) / (2.0 * self.focal_px))

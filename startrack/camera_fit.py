@@ -61,26 +61,22 @@ def project(v_S, camera_params):  # pragma: no cover  (compiled)
     return uv
 
 
-@njit
+@njit(_nrt=False)
 def _jacobian_rows(v, camera_params, rows):  # pragma: no cover  (compiled)
-    """rows (2, 8): d(u, v)/d(dtheta, f, cx, cy, k1, k2) at the direction v (3,) in S (module text)."""
-    f, _, _, _, _, k1, k2, _ = camera_params
-    z = v[2]
-    x, y = v[0] / z, v[1] / z
+    """rows (2, 8): d(u, v)/d(dtheta, f, cx, cy, k1, k2) at the direction v (3,) in S (module text); with
+    x = v_x / v_z, y = v_y / v_z, d(x, y)/d dtheta = ((x y, -(1 + x^2), y), (1 + y^2, -x y, -x))."""
+    f, k1, k2 = camera_params[0], camera_params[5], camera_params[6]
+    x, y = v[0] / v[2], v[1] / v[2]
     r2 = x * x + y * y
     d = 1.0 + k1 * r2 + k2 * r2 * r2
     g = 2.0 * (k1 + 2.0 * k2 * r2)
     du_dx, du_dy = f * (d + x * x * g), f * x * y * g
     dv_dx, dv_dy = du_dy, f * (d + y * y * g)
-    # d(x, y)/dv_S, then through [v x] (columns: d v_S / d dtheta_k = v x e_k)
-    dx = np.array([1.0 / z, 0.0, -x / z])
-    dy = np.array([0.0, 1.0 / z, -y / z])
-    skew = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-    for k in range(3):
-        dxk = dx[0] * skew[0, k] + dx[1] * skew[1, k] + dx[2] * skew[2, k]
-        dyk = dy[0] * skew[0, k] + dy[1] * skew[1, k] + dy[2] * skew[2, k]
-        rows[0, k] = du_dx * dxk + du_dy * dyk
-        rows[1, k] = dv_dx * dxk + dv_dy * dyk
+    dx0, dx1, dx2 = x * y, -(1.0 + x * x), y
+    dy0, dy1, dy2 = 1.0 + y * y, -x * y, -x
+    rows[0, 0], rows[1, 0] = du_dx * dx0 + du_dy * dy0, dv_dx * dx0 + dv_dy * dy0
+    rows[0, 1], rows[1, 1] = du_dx * dx1 + du_dy * dy1, dv_dx * dx1 + dv_dy * dy1
+    rows[0, 2], rows[1, 2] = du_dx * dx2 + du_dy * dy2, dv_dx * dx2 + dv_dy * dy2
     rows[0, 3], rows[1, 3] = x * d, y * d
     rows[0, 4], rows[1, 4] = 1.0, 0.0
     rows[0, 5], rows[1, 5] = 0.0, 1.0
@@ -105,9 +101,13 @@ def _normal_equations(uv, weight, ref_I, R_IS, camera_params, free, prior_mean, 
         for a in range(2):
             chi2 += weight[i] * res[a] * res[a]
             for p in range(8):
-                b[p] += weight[i] * rows[a, p] * res[a]
-                for q in range(8):
-                    N[p, q] += weight[i] * rows[a, p] * rows[a, q]
+                wr = weight[i] * rows[a, p]
+                b[p] += wr * res[a]
+                for q in range(p, 8):
+                    N[p, q] += wr * rows[a, q]
+    for p in range(8):
+        for q in range(p):
+            N[p, q] = N[q, p]
     for p in range(3, 8):
         k = INTRINSICS[p - 3]
         if free[p - 3] and prior_sigma[p - 3] < np.inf:
@@ -123,12 +123,40 @@ def _normal_equations(uv, weight, ref_I, R_IS, camera_params, free, prior_mean, 
 
 
 @njit
+def _cholesky_inverse(A):  # pragma: no cover  (compiled)
+    """(ok, A^-1) of a symmetric positive-definite matrix by Cholesky factorisation; ok is False when a
+    pivot is not positive (singular: too few or degenerate stars)."""
+    n = A.shape[0]
+    L = np.zeros((n, n))
+    for j in range(n):
+        d = A[j, j] - np.sum(L[j, :j] ** 2)
+        if not d > 1e-12 * max(A[j, j], 1e-300):
+            return False, np.zeros((n, n))
+        L[j, j] = np.sqrt(d)
+        for i in range(j + 1, n):
+            L[i, j] = (A[i, j] - np.sum(L[i, :j] * L[j, :j])) / L[j, j]
+    inverse_L = np.zeros((n, n))
+    for j in range(n):  # forward substitution for the columns of L^-1
+        inverse_L[j, j] = 1.0 / L[j, j]
+        for i in range(j + 1, n):
+            inverse_L[i, j] = -np.sum(L[i, j:i] * inverse_L[j:i, j]) / L[i, i]
+    return True, inverse_L.T @ inverse_L
+
+
+@njit
 def _solve_scaled(N, b):  # pragma: no cover  (compiled)
-    """(N^-1 b, N^-1) with N scaled to unit diagonal first (conditioning of pixels against k's)."""
-    scale = 1.0 / np.sqrt(np.diag(N))
-    Ns = N * np.outer(scale, scale)
-    inverse = np.linalg.inv(Ns) * np.outer(scale, scale)
-    return inverse @ b, inverse
+    """(ok, N^-1 b, N^-1) with N scaled to unit diagonal first (conditioning of pixels against k's)."""
+    diagonal = np.diag(N)
+    if not np.all(diagonal > 0.0):
+        return False, np.zeros(b.size), np.zeros(N.shape)
+    scale = 1.0 / np.sqrt(diagonal)
+    ok, inverse = _cholesky_inverse(N * np.outer(scale, scale))
+    inverse = inverse * np.outer(scale, scale)
+    return ok, inverse @ b, inverse
+
+
+#: A Gauss-Newton fit has converged when no step exceeds this fraction of its parameter's sigma.
+CONVERGED = 1e-3
 
 
 @njit
@@ -137,32 +165,33 @@ def fit(uv, sigma_px, ref_I, R_IS, camera_params, free, prior_mean, prior_sigma,
 
     uv (m, 2) [px] observed; sigma_px (m,) per-axis noise [px]; ref_I (m, 3) catalog directions; R_IS
     and camera_params (f, cx, cy, W, H, k1, k2, circular) the start; free (5,) bool for (f, cx, cy,
-    k1, k2); prior_mean, prior_sigma (5,) (inf: no prior).  Returns (R_IS, camera_params, covariance
-    (8, 8) of (dtheta, f, cx, cy, k1, k2) [rad, px, -], chi^2 / dof) -- zero rows for held parameters.
+    k1, k2); prior_mean, prior_sigma (5,) (inf: no prior).  Returns (ok, R_IS, camera_params, covariance
+    (8, 8) of (dtheta, f, cx, cy, k1, k2) [rad, px, -], chi^2 / dof) -- zero rows for held parameters;
+    ok is False when the stars do not determine the parameters (singular normal matrix).
     """
     R = R_IS.copy()
     params = camera_params.copy()
     weight = 1.0 / sigma_px**2
     n_free = 3 + int(np.sum(free))
     dof = max(2 * uv.shape[0] - n_free, 1)
-    inverse = np.zeros((8, 8))
-    chi2 = 0.0
     for _ in range(iterations):
         N, b, chi2 = _normal_equations(uv, weight, ref_I, R, params, free, prior_mean, prior_sigma)
-        step, inverse = _solve_scaled(N, b)
+        ok, step, inverse = _solve_scaled(N, b)
+        if not ok:
+            return False, R_IS, camera_params, np.zeros((8, 8)), 0.0
         R = R @ quat_to_matrix(quat_from_rotation_vector(step[:3]))
         for p in range(5):
             params[INTRINSICS[p]] += step[3 + p]
-        if np.abs(step[:3]).max() < 1e-10 and abs(step[3]) < 1e-6 * params[0]:
+        if np.max(np.abs(step) / np.sqrt(np.diag(inverse))) < CONVERGED:
             break
     N, b, chi2 = _normal_equations(uv, weight, ref_I, R, params, free, prior_mean, prior_sigma)
-    _, inverse = _solve_scaled(N, b)
+    ok, _, inverse = _solve_scaled(N, b)
     for p in range(3, 8):
         if not free[p - 3]:
             inverse[p, :] = 0.0
             inverse[:, p] = 0.0
     reduced = chi2 / dof
-    return R, params, inverse * max(1.0, reduced), reduced
+    return ok, R, params, inverse * max(1.0, reduced), reduced
 
 
 @dataclass(frozen=True, eq=False)

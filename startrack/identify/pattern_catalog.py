@@ -127,7 +127,12 @@ def edge_ratios(vectors, stars):  # pragma: no cover  (compiled)
             cz = a[0] * b[1] - a[1] * b[0]
             angles[e] = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
             e += 1
-    order = np.argsort(angles)
+    order = np.arange(6)
+    for k in range(1, 6):  # insertion sort of six angles
+        j = k
+        while j > 0 and angles[order[j - 1]] > angles[order[j]]:
+            order[j - 1], order[j] = order[j], order[j - 1]
+            j -= 1
     largest = angles[order[5]]
     ratios = np.empty(5)
     for k in range(5):
@@ -241,8 +246,14 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
         if len(members) >= 4:
             brightest = np.sort(np.asarray(members, dtype=np.int64))[:params.stars_per_field]  # rank = position
             groups.append(brightest[_COMBINATIONS[brightest.size]])
-    ranked = np.unique(np.sort(np.concatenate(groups), axis=1), axis=0)
-    return stars[ranked].astype(np.int32)
+    ranked = np.sort(np.concatenate(groups), axis=1).astype(np.uint64)
+    if stars.size < 1 << 16:  # four 16-bit ranks in one integer: a 1-D unique, far faster than unique(axis=0)
+        packed = np.sort(((ranked[:, 0] << 48) | (ranked[:, 1] << 32)) | ((ranked[:, 2] << 16) | ranked[:, 3]))
+        packed = packed[np.concatenate([[True], packed[1:] != packed[:-1]])]
+        ranked = np.column_stack([(packed >> np.uint64(s)) & np.uint64(0xFFFF) for s in (48, 32, 16, 0)])
+    else:
+        ranked = np.unique(ranked, axis=0)
+    return stars[ranked.astype(np.int64)].astype(np.int32)
 
 
 @dataclass(frozen=True, eq=False)

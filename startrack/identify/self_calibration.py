@@ -10,8 +10,8 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fi
    pattern's tolerance scaled to the image), attitude and focal length free;
 2. every detection against the ``n_predicted`` brightest stars predicted in the image, gate g_2,
    every intrinsic of ``free`` with its prior;
-3. the same at the final gate r, twice, then matches the last fit puts outside r are dropped and
-   the fit repeated.
+3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars; then
+   matches the last fit puts outside r are dropped and the fit repeated.
 
 Matches are mutual nearest neighbours in the image (one-to-one).  The false-match probability of the
 result is :func:`startrack.identify.verify.chance_match_probability` with the local density of the
@@ -33,6 +33,8 @@ from startrack.jit import njit
 
 #: Seed stars of a pattern hypothesis (matched by construction).
 SEEDS = 4
+#: Passes at the final gate beyond the first, made while they add stars.
+EXTRA_PASSES = 2
 
 
 @njit
@@ -116,23 +118,31 @@ def predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  
 
 
 @njit
-def _residuals(uv, obs_index, pred_uv, pred_index):  # pragma: no cover  (compiled)
+def _residuals(uv, obs_index, model_uv):  # pragma: no cover  (compiled)
+    """Distance [px] of each matched detection from its star's model position (``model_uv`` per match)."""
     out = np.empty(obs_index.size)
     for m in range(obs_index.size):
-        out[m] = math.hypot(uv[obs_index[m], 0] - pred_uv[pred_index[m], 0], uv[obs_index[m], 1] - pred_uv[pred_index[m], 1])
+        out[m] = math.hypot(uv[obs_index[m], 0] - model_uv[m, 0], uv[obs_index[m], 1] - model_uv[m, 1])
     return out
 
 
 @njit
-def _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS, params, free, prior):  # pragma: no cover
+def _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params, free, prior):  # pragma: no cover
+    """:func:`startrack.camera_fit.fit` of the detections ``obs_index`` to the field stars ``star_index``."""
     ref = np.empty((obs_index.size, 3))
     seen = np.empty((obs_index.size, 2))
     weight_sigma = np.empty(obs_index.size)
     for m in range(obs_index.size):
-        ref[m] = vectors[stars[pred_index[m]]]
+        ref[m] = vectors[star_index[m]]
         seen[m] = uv[obs_index[m]]
         weight_sigma[m] = sigma[obs_index[m]]
     return fit(seen, weight_sigma, ref, R_IS, params, free, prior[0], prior[1])
+
+
+@njit
+def _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS, params, free, prior):  # pragma: no cover
+    """:func:`_fit_stars` of the matches (obs_index, pred_index) to the predicted ``stars``."""
+    return _fit_stars(uv, sigma, vectors, obs_index, stars[pred_index], R_IS, params, free, prior)
 
 
 @njit
@@ -168,29 +178,34 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     first_free = np.zeros(5, np.bool_)
     first_free[0] = free[0]
     obs_index, star_index = empty, empty
-    stars, pred_uv = empty, np.zeros((0, 2))
-    for p in range(5):
+    previous = 0
+    for p in range(3 + EXTRA_PASSES):
         gate = gates[min(p, 2)]
-        n_use = min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0]
         if p == 1:
             around = stars_around(R_IS, params, field, vectors.shape[0])
         stars, pred_uv = predicted_stars(R_IS, params, vectors, around, first_stars if p == 0 else n_predicted)
-        obs_index, pred_index = match_pixels(uv, n_use, pred_uv, gate)
+        obs_index, pred_index = match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
+        if p >= 3 and obs_index.size <= previous:
+            break  # the final gate adds no more stars
         if obs_index.size < SEEDS + 1:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
-        if p == 4:  # last pass: drop what the previous fit left outside the final gate, then refit
-            keep = _residuals(uv, obs_index, pred_uv, pred_index) <= gates[2]
-            obs_index, pred_index = obs_index[keep], pred_index[keep]
-            if obs_index.size < SEEDS + 1:
-                return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
-        R_IS, params, covariance, reduced = _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS, params,
-                                                         first_free if p == 0 else free, prior)
-        star_index = stars[pred_index]
+        ok, R_IS, params, covariance, reduced = _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS,
+                                                             params, first_free if p == 0 else free, prior)
+        if not ok:
+            return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
+        star_index, previous = stars[pred_index], obs_index.size
+    # matches the last fit leaves outside the final gate are dropped, and the fit repeated
+    keep = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)) <= gates[2]
+    if not keep.all():
+        obs_index, star_index = obs_index[keep], star_index[keep]
+        if obs_index.size < SEEDS + 1:
+            return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
+        ok, R_IS, params, covariance, reduced = _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params,
+                                                           free, prior)
+        if not ok:
+            return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
     stars, pred_uv = predicted_stars(R_IS, params, vectors, around, n_predicted)
-    final_uv = project(_sensor(vectors, star_index, R_IS), params)
-    reached = 0.0
-    for m in range(obs_index.size):
-        reached = max(reached, math.hypot(uv[obs_index[m], 0] - final_uv[m, 0], uv[obs_index[m], 1] - final_uv[m, 1]))
+    reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
     reached = min(max(reached, np.median(sigma)), gates[2])
     q = local_density(pred_uv, grid) * math.pi * reached * reached
     n_fitted = 3 + int(np.sum(free))
