@@ -92,6 +92,14 @@ class Camera:
         return cls(width, height, (width / 2.0) / np.tan(fov_x_rad / 2.0), **kw)
 
     @classmethod
+    def from_file(cls, path):
+        """The camera of a camera file (:mod:`startrack.camera_file`: TOML written by ``startrack solve
+        --write-camera``); a missing or bad file raises one :class:`InputError`."""
+        from startrack.camera_file import read_camera_file
+
+        return read_camera_file(path).camera
+
+    @classmethod
     def from_pitch(cls, focal_length_m, pixel_pitch_m, width, height, **kw):
         """Camera from the focal length and the pixel pitch [m]: f_px = focal / pitch."""
         if not (focal_length_m > 0 and pixel_pitch_m > 0):
@@ -136,14 +144,15 @@ class Camera:
         return np.hypot(du, dv) / self.focal_px
 
     def _check_distortion_monotonic(self):
+        """The distorted radius must grow out to the farthest corner (with 5 % margin): the corner lies
+        below the distorted radius reached at the fold, r_f (1 + k1 r_f^2 + k2 r_f^4)."""
         if self.k1 == 0.0 and self.k2 == 0.0:
             return
-        rd_max = 1.05 * self._max_distorted_radius()
-        r = np.linspace(0.0, 4.0 * rd_max, 8001)
-        rd = r * self._radial_factor(r * r)
-        slope = 1.0 + 3.0 * self.k1 * r**2 + 5.0 * self.k2 * r**4
-        reached = np.flatnonzero(rd >= rd_max)
-        if reached.size == 0 or np.any(slope[: reached[0] + 1] <= 0.0):
+        fold = fold_radius_squared(self.k1, self.k2)
+        if math.isinf(fold):
+            return
+        r_fold = math.sqrt(fold)
+        if r_fold * self._radial_factor(fold) <= 1.05 * self._max_distorted_radius():
             raise InputError(
                 f"radial distortion k1={self.k1!r}, k2={self.k2!r} is not invertible over the image "
                 "(distorted radius not monotonic out to the corners)"

@@ -22,6 +22,7 @@ sigma_i are a lower bound of the real centroid errors of a real camera.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -211,11 +212,19 @@ class CameraCalibration:
 
     @property
     def sigma(self) -> dict:
-        """1-sigma of f [px], cx, cy [px], k1, k2 and the field of view across the width [deg]."""
-        spread = np.sqrt(np.clip(np.diag(self.covariance)[3:], 0.0, None))
+        """1-sigma of f [px], cx, cy [px], k1, k2 and of the angle the width subtends
+        (:attr:`startrack.camera.Camera.angular_width`) [deg], the latter propagated through the covariance
+        of (f, cx, cy, k1, k2) with its numerical Jacobian."""
+        covariance = self.covariance[3:, 3:]
+        spread = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
         out = dict(zip(("focal_px", "cx", "cy", "k1", "k2"), (float(s) for s in spread)))
-        f, width = self.camera.focal_px, self.camera.width
-        out["fov_deg"] = math.degrees(width / (f * f + 0.25 * width * width) * out["focal_px"])
+        gradient = np.zeros(5)
+        for k, name in enumerate(("focal_px", "cx", "cy", "k1", "k2")):
+            step = 1e-3 * spread[k]
+            if step > 0.0:
+                moved = dataclasses.replace(self.camera, **{name: getattr(self.camera, name) + step})
+                gradient[k] = (moved.angular_width - self.camera.angular_width) / step
+        out["fov_deg"] = math.degrees(math.sqrt(max(gradient @ covariance @ gradient, 0.0)))
         return out
 
     def center_radec_roll(self, q_IS):
@@ -231,7 +240,7 @@ class CameraCalibration:
     def to_dict(self) -> dict:
         """JSON-ready camera with 1-sigma (the ``camera`` entry of ``startrack solve --json``)."""
         cam, sigma = self.camera, self.sigma
-        return {"width": cam.width, "height": cam.height, "fov_deg": math.degrees(cam.fov_x),
+        return {"width": cam.width, "height": cam.height, "fov_deg": math.degrees(cam.angular_width),
                 "focal_px": cam.focal_px, "cx": cam.cx, "cy": cam.cy, "k1": cam.k1, "k2": cam.k2,
                 "sigma": sigma, "rms_px": self.rms_px, "reduced_chi2": self.reduced_chi2,
                 "matched": self.matched, "predicted": self.predicted, "mag_limit": self.mag_limit}

@@ -143,6 +143,10 @@ SCHEMA = Table(
                         "compare_without_stacking": Value("bool", default=False,
                                                           doc="also run a shadow filter that never gets the "
                                                               "stacked star, for the paired comparison of 004"),
+                        "camera_file": Value("str", default=None,
+                                             doc="camera file (startrack solve --write-camera), relative to the "
+                                                 "scenario file: sets the camera's size, focal length, principal "
+                                                 "point and distortion (fov_deg still sizes the catalog)"),
                     },
                     optional=True,
                 ),
@@ -340,6 +344,7 @@ def validate(data, source="<scenario>"):
             raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
         if "image" not in sensor:
             sensor["image"] = SCHEMA.entries["star_sensor"].entries["image"].check("star_sensor.image", {})
+        _apply_camera_file(sensor["image"], source)
     if sensor["fidelity"] == "vector":
         for kind in ("attitude_jumps", "false_star_storms", "tracking_failure_probes"):
             if checked["faults"].get(kind):
@@ -357,6 +362,20 @@ def validate(data, source="<scenario>"):
         if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise InputError(f"{source}: truth.rigid_body.inertia_kg_m2: must be symmetric positive definite")
     return Scenario(data=checked, source=source)
+
+
+def _apply_camera_file(image, source):
+    """A given ``star_sensor.image.camera_file`` is read now (one InputError for a missing or bad file)
+    and sets ``width_px`` and ``height_px``; build.py takes the camera from it."""
+    if image.get("camera_file") is None:
+        return
+    from startrack.camera import Camera
+
+    try:
+        camera = Camera.from_file(image["camera_file"])
+    except InputError as error:
+        raise InputError(f"{source}: star_sensor.image.camera_file: {error}") from None
+    image["width_px"], image["height_px"] = camera.width, camera.height
 
 
 def _checked(schema, data, source):
@@ -413,7 +432,11 @@ def load_scenario(path, overrides=()):
         raise InputError(f"{path}: not a text file") from None
     except tomllib.TOMLDecodeError as error:
         raise InputError(f"{path}: invalid TOML: {error}") from None
-    return validate(apply_overrides(data, overrides, str(path)), source=path.name)
+    data = apply_overrides(data, overrides, str(path))
+    image = data.get("star_sensor", {}).get("image", {}) if isinstance(data.get("star_sensor"), dict) else {}
+    if isinstance(image, dict) and isinstance(image.get("camera_file"), str):  # relative to the scenario file
+        image["camera_file"] = str(path.parent / image["camera_file"])
+    return validate(data, source=path.name)
 
 
 def scenario_from_dict(data, overrides=(), source="<dict>"):

@@ -11,9 +11,12 @@ on the field of view F.  Level l serves frames with F in (F_l / rho, F_l], F_0 =
 F_l = F_0 rho^-l down to the first level below ``fov_min`` (rho = ``level_ratio``).  Its pattern
 stars are the Hipparcos-2 stars with V <= ``mag_limit`` thinned brightest first to a minimum
 separation F_l / 20 (a fainter star that close to a kept one would blend or swap rank with it); its
-patterns are all 4-combinations of the ``stars_per_field`` brightest pattern stars inside each
-circle of diameter 0.6 F_l centred on a Fibonacci lattice of ``fields_per_fov`` x 4 pi / F_l^2
-points (a frame of the level then contains many such circles, tetra3's lattice fields).
+patterns are all 4-combinations of the ``stars_per_field`` (7) brightest pattern stars inside each
+circle of diameter F_l centred on a Fibonacci lattice of ``fields_per_fov`` (20) x 4 pi / F_l^2
+points (tetra3's lattice fields): a frame of the level holds about one such circle, so the brightest
+stars of the frame are those of a nearby circle.  (Circles of 0.6 F_l and 8 stars each, or 0.8 F_l,
+left the brightest stars of wide frames without a pattern more often: measured on rendered frames of
+8-30 deg, the first verified combination of a 28 deg frame came up to 40 combinations later.)
 
 Tolerance.  The observed ratios are computed from unit vectors with the level's focal length f_l
 (the geometric mean of the level's range); the true focal length differs by up to rho^(1/2), and
@@ -58,7 +61,7 @@ _LAYOUT = 2
 #: Minimum separation of a level's pattern stars, per unit of its field of view.
 SEPARATION_PER_FOV = 1.0 / 20.0
 #: Diameter of a lattice field, per unit of the level's field of view.
-FIELD_PER_FOV = 0.6
+FIELD_PER_FOV = 1.0
 
 
 @dataclass(frozen=True)
@@ -74,7 +77,7 @@ class PatternCatalogParams:
     fov_max: float = 40.0 * DEG
     level_ratio: float = math.sqrt(2.0)
     mag_limit: float = 8.0
-    stars_per_field: int = 8
+    stars_per_field: int = 7
     fields_per_fov: int = 20
 
     def __post_init__(self):
@@ -92,7 +95,7 @@ class PatternCatalogParams:
         """F_l [rad] of every level, largest first: the levels whose range (F_l / rho, F_l] meets
         [fov_min, fov_max]."""
         fovs = [self.fov_max]
-        while fovs[-1] / self.level_ratio >= self.fov_min * (1.0 - 1e-12):
+        while fovs[-1] / self.level_ratio > self.fov_min * (1.0 + 1e-12):
             fovs.append(fovs[-1] / self.level_ratio)
         return np.array(fovs)
 
@@ -316,7 +319,7 @@ class PatternCatalog:
         vectors, v_mag = np.asarray(chosen.vectors)[order], np.asarray(chosen.v_mag)[order]
         levels = []
         for fov in tqdm(params.level_fovs(), desc="pattern catalog", unit="level", delay=1.0, file=sys.stderr,
-                        disable=not progress, leave=False):
+                        disable=None if progress else True, leave=False):  # None: only on a terminal
             levels.append(build_level(vectors, v_mag, float(fov), params))
         return cls(params, np.asarray(chosen.hip)[order], levels)
 

@@ -28,6 +28,7 @@ from startrack.camera_fit import CameraCalibration
 from startrack.errors import InputError
 from startrack.identify.pattern_catalog import PatternCatalogParams, load_pattern_catalog
 from startrack.identify.result import IdentificationResult
+from startrack.identify.lost_in_space import SKY, cap
 from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
 from startrack.identify.zones import zone_index
 from startrack.units import DEG
@@ -63,11 +64,12 @@ class PlateSolver:
     time_budget_s: search time per frame before ``no_match``; final_gate_px: match radius of the last
     verification passes [px]; principal_point_sigma: prior sigma of the principal point about the
     image centre, as a fraction of the larger image side; k1_sigma, k2_sigma: prior sigma of the
-    distortion about 0 (k2_sigma = 0 holds k2 at 0); progress: show the pattern catalog's build.
+    distortion about 0 (k2_sigma = 0 holds k2 at 0); mag_limit: faintest star of the verification
+    [V mag] (default: the pattern catalog's, 8); progress: show the pattern catalog's build.
     """
 
     def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
-                 principal_point_sigma=0.02, k1_sigma=0.5, k2_sigma=0.0, progress=False):
+                 principal_point_sigma=0.02, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
         from startrack.star_catalog import load_star_catalog
 
         defaults = PatternCatalogParams()
@@ -93,7 +95,10 @@ class PlateSolver:
         self.hip = np.asarray(self.catalog.hip, np.int64)  # brightest first
         self.vectors = np.ascontiguousarray(stars.vectors[position], dtype=float)
         self.v_mag = np.ascontiguousarray(stars.v_mag[position], dtype=float)
-        self.field = (self.vectors, self.v_mag, zone_index(self.vectors))
+        cap = params.mag_limit if mag_limit is None else float(mag_limit)
+        if not math.isfinite(cap) or not -2.0 <= cap <= params.mag_limit:
+            raise InputError(f"verification magnitude limit {mag_limit!r} must lie in [-2, {params.mag_limit:g}] mag.")
+        self.field = (self.vectors, self.v_mag, zone_index(self.vectors), int(np.searchsorted(self.v_mag, cap, "right")))
         ratio = params.level_ratio
         self.levels = [level for level in self.catalog.levels if level.fov / ratio < high and level.fov >= low]
         self._arrays = tuple(level.arrays for level in self.levels)
@@ -104,10 +109,16 @@ class PlateSolver:
         self.load_ms = 1e3 * (time.perf_counter() - start)
 
     # ------------------------------------------------------------------ public
-    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None) -> IdentificationResult:
+    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None,
+              boresight=None) -> IdentificationResult:
         """Identify the detections ``uv`` (n, 2) [px] of a ``width`` x ``height`` frame; ``flux`` orders them
         (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3);
-        ``fov_hint`` [rad] searches the levels nearest it first.  Never raises for the frame's content."""
+        ``fov_hint`` [rad] searches the levels nearest it first; ``camera`` a
+        :class:`startrack.camera_file.CameraFile` known before (its focal length within 1 % or 3 sigma,
+        its principal point and distortion as the priors' means, within 3 times its sigma; InputError if
+        its size differs); ``boresight`` = (axis (3,) unit vector, radius [rad]): the hypotheses whose
+        pattern starts inside that cap are searched first, then the whole sky.  Never raises for the
+        frame's content."""
         start = time.perf_counter()
         checked = self._checked(uv, width, height, flux, sigma_px)
         if isinstance(checked, str):
@@ -116,34 +127,60 @@ class PlateSolver:
         candidates = pattern_candidates(uv, max(width, height) / 20.0)
         if candidates.size < 4:
             return _failed("too_few", f"{candidates.size} separated detections; at least 4 are needed", start)
-        camera = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0])
+        params, prior, f_range = self._start(width, height, camera)
+        settings = (self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0,
+                    prior, _density_grid(uv, width, height), self.threshold)
+        regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
-        settings = (self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), self.prior_sigma > 0.0,
-                    (camera[[0, 1, 2, 5, 6]].copy(), self._prior(width, height)), _density_grid(uv, width, height),
-                    self.threshold)
-        focal = width / 2.0 / np.tan(self._mid_fov / 2.0)
-        f_range = np.array([width / 2.0 / math.tan(self.fov_range[1] / 2.0), width / 2.0 / math.tan(self.fov_range[0] / 2.0)])
-        n_hypotheses = float(max(n_combinations, 1) * max(self._per_lookup, 1.0))
-        order = self._level_order(fov_hint)
-        next_combination, tried = 0, 0
-        while next_combination < n_combinations:
-            result, count, next_combination = search(uv, sigma, candidates, next_combination, next_combination + CHUNK,
-                                                      self._arrays, order, focal, self.vectors, f_range, camera,
-                                                      self.field, settings, n_hypotheses)
+        frame = (uv, sigma, candidates, self._level_order(fov_hint if camera is None else camera.camera.fov_x),
+                 width / 2.0 / np.tan(self._mid_fov / 2.0), f_range, params, settings,
+                 float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
+        tried = 0
+        for region in regions:
+            result, count, done = self._search(frame, region, start)
             tried += count
             if result[0]:
-                return self._result(result, uv, sigma, index, width, height, tried, start)
-            if time.perf_counter() - start > self.time_budget_s:
-                return _failed("no_match", f"time budget of {self.time_budget_s:g} s spent after {next_combination} of "
+                return self._result(result, uv, sigma, index, width, height, start)
+            if done < n_combinations:
+                return _failed("no_match", f"time budget of {self.time_budget_s:g} s spent after {done} of "
                                f"{n_combinations} patterns ({tried} hypotheses verified)", start)
         return _failed("no_match", f"no pattern of the {candidates.size} brightest separated detections verified "
                        f"({tried} hypotheses)", start)
 
+    def _search(self, frame, region, start):
+        """(verify_calibrate's tuple, hypotheses verified, combinations searched) of the compiled search in
+        chunks of :data:`CHUNK` combinations, stopped by the time budget."""
+        uv, sigma, candidates, order, focal, f_range, params, settings, n_hypotheses = frame
+        n_combinations = int(COMBINATIONS_BELOW[candidates.size])
+        done, tried = 0, 0
+        while done < n_combinations:
+            result, count, done = search(uv, sigma, candidates, done, done + CHUNK, self._arrays, order, focal,
+                                         self.vectors, f_range, params, region, self.field, settings, n_hypotheses)
+            tried += count
+            if result[0] or time.perf_counter() - start > self.time_budget_s:
+                return result, tried, done
+        return result, tried, done
+
     # ------------------------------------------------------------------ internals
-    def _prior(self, width, height):
+    def _start(self, width, height, known):
+        """(camera parameters the hypotheses start from, prior (mean (5,), sigma (5,): inf free without a
+        prior, 0 held) of (f, cx, cy, k1, k2), focal-length range (2,) [px]) for a frame, with or without a
+        known camera (a :class:`startrack.camera_file.CameraFile`)."""
+        params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0])
         sigma = self.prior_sigma.copy()
         sigma[1:3] *= max(width, height)
-        return np.where(sigma > 0.0, sigma, np.inf)
+        f_range = np.array([width / 2.0 / math.tan(self.fov_range[1] / 2.0), width / 2.0 / math.tan(self.fov_range[0] / 2.0)])
+        if known is not None:
+            cam = known.camera
+            if (cam.width, cam.height) != (width, height):
+                raise InputError(f"the camera is {cam.width} x {cam.height} px, the frame {width} x {height} px.")
+            params[[1, 2, 5, 6]] = cam.cx, cam.cy, cam.k1, cam.k2
+            for k, name in enumerate(("cx", "cy", "k1", "k2")):
+                if name in known.sigma:
+                    sigma[k + 1] = 3.0 * known.sigma[name]
+            spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
+            f_range = np.array([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)])
+        return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
 
     def _level_order(self, fov_hint):
         if fov_hint is None:
@@ -169,10 +206,12 @@ class PlateSolver:
             return f"flux and sigma need one value per centroid ({len(uv)})"
         index = np.arange(len(uv)) if flux is None else np.argsort(-flux, kind="stable")
         inside = (uv[index, 0] >= -0.5) & (uv[index, 0] <= width - 0.5) & (uv[index, 1] >= -0.5) & (uv[index, 1] <= height - 0.5)
+        if len(uv) and not inside.any():
+            return f"all {len(uv)} centroids lie outside the {width} x {height} px image"
         index = index[inside]
         return np.ascontiguousarray(uv[index]), np.ascontiguousarray(np.maximum(sigma[index], 0.02)), index
 
-    def _result(self, result, uv, sigma, index, width, height, tried, start):
+    def _result(self, result, uv, sigma, index, width, height, start):
         _, R_IS, params, covariance, obs_index, star_index, probability, n_predicted, _, reduced = result
         camera = Camera(width, height, params[0], cx=params[1], cy=params[2], k1=params[5], k2=params[6])
         order = np.argsort(index[obs_index], kind="stable")

@@ -156,7 +156,7 @@ def _more_stars(uv, candidates, members, R_IS, focal, cx, cy, gate, field, near)
     costly verification."""
     vectors, zones = field[0], field[2]
     params = np.array([focal, cx, cy, 2.0 * cx + 1.0, 2.0 * cy + 1.0])
-    max_star = brightest_in_field(3.0 * (4 + EXTRA_LOOKUPS), params, vectors.shape[0])
+    max_star = brightest_in_field(3.0 * (4 + EXTRA_LOOKUPS), params, field[3])
     direction = np.empty(3)
     looked, found = 0, 0
     for i in range(candidates.size):
@@ -197,10 +197,13 @@ CANDIDATE_BUFFER = 256
 
 
 @njit
-def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors, cx, cy, found):  # pragma: no cover
-    """Catalog patterns matching the observed ``stars`` in every level: rows (level, pattern row) of
+def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors, cx, cy, region,
+            found):  # pragma: no cover  (compiled)
+    """Catalog patterns matching the observed ``stars`` in every level, with their first star inside
+    ``region`` = (axis (3,), cos rho) (cos rho = -2: the whole sky): rows (level, pattern row) of
     ``found`` and their ratio mismatch max_k |r_k - r_k,cat| and tolerance eps; returns
     (count, mismatch, eps) (module text, steps 1-2)."""
+    axis, cos_radius = region
     bins = np.empty(5, np.int64)
     mismatch = np.empty(found.shape[0])
     tolerance_of = np.empty(found.shape[0])
@@ -215,6 +218,10 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
             key = pack_key(bins, base)
             e = run_start(key, keys, slots)
             while 0 <= e < keys.size and keys[e] == key and count < found.shape[0]:
+                first = vectors[cat_stars[e, 0]]
+                if first[0] * axis[0] + first[1] * axis[1] + first[2] * axis[2] < cos_radius:
+                    e += 1
+                    continue
                 cat_ratios, _, _ = edge_ratios(vectors, cat_stars[e])
                 worst = np.abs(cat_ratios - ratios).max()
                 if worst <= eps:
@@ -233,16 +240,17 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
 
 
 @njit
-def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal, vectors, f_range, camera, field,
-           settings, n_hypotheses):  # pragma: no cover  (compiled)
+def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal, vectors, f_range, camera, region,
+           field, settings, n_hypotheses):  # pragma: no cover  (compiled)
     """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text);
     the catalog candidates of a combination are verified in order of their ratio mismatch.
 
     uv (n, 2), sigma (n,): detections brightest first [px]; ``levels``: tuple of
     :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`, looked up in ``level_order`` with
     the focal lengths ``level_focal`` [px]; ``vectors`` the pattern stars' unit vectors; f_range (2,)
-    [px]; ``camera`` (f, cx, cy, W, H, k1, k2, circular) the start of the calibration (f replaced).
-    Returns (verify_calibrate's tuple, hypotheses verified, next combination)."""
+    [px]; ``camera`` (f, cx, cy, W, H, k1, k2, circular) the start of the calibration (f replaced);
+    ``region`` for :func:`_gather`.  Returns (verify_calibrate's tuple, hypotheses verified, next
+    combination)."""
     cx, cy = camera[1], camera[2]
     near = np.empty(field[0].shape[0], np.int64)
     stars = np.empty(4, np.int64)
@@ -258,7 +266,7 @@ def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal,
             for j in range(i + 1, 4):
                 largest_px = max(largest_px, math.hypot(uv[stars[i], 0] - uv[stars[j], 0], uv[stars[i], 1] - uv[stars[j], 1]))
         count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors,
-                                          cx, cy, found)
+                                          cx, cy, region, found)
         for k in np.argsort(mismatch):
             l, eps = found[k, 0], eps_of[k]
             cat = levels[l][0][found[k, 1]]

@@ -81,8 +81,8 @@ def brightest_in_field(expected, params, n_stars):  # pragma: no cover  (compile
 def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
     """Indices below ``max_star`` of the field stars within 1.2 times the image's corner angle of the
     boresight of R_IS for the camera ``params``, brightest first (ascending: the field stars are ordered
-    brightest first); ``field`` = (vectors, v_mag, zones).  Gathered once per depth and hypothesis: the
-    fits move the boresight and the scale by far less."""
+    brightest first); ``field`` = (vectors, v_mag, zones, number of stars within the magnitude cap).
+    Gathered once per depth and hypothesis: the fits move the boresight and the scale by far less."""
     vectors, zones = field[0], field[2]
     f, cx, cy, width, height = params[0], params[1], params[2], params[3], params[4]
     half = math.hypot(max(cx + 0.5, width - 0.5 - cx), max(cy + 0.5, height - 0.5 - cy)) / f
@@ -170,7 +170,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     """
     _, first_stars, n_predicted, free, prior, grid, threshold = settings
     vectors = field[0]
-    bright = stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, vectors.shape[0]))
+    bright = stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, field[3]))
     around = bright
     empty = np.zeros(0, np.int64)
     covariance = np.zeros((8, 8))
@@ -182,7 +182,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     for p in range(3 + EXTRA_PASSES):
         gate = gates[min(p, 2)]
         if p == 1:
-            around = stars_around(R_IS, params, field, vectors.shape[0])
+            around = stars_around(R_IS, params, field, field[3])
         stars, pred_uv = predicted_stars(R_IS, params, vectors, around, first_stars if p == 0 else n_predicted)
         obs_index, pred_index = match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
         if p >= 3 and obs_index.size <= previous:
