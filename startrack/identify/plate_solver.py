@@ -41,6 +41,10 @@ CHUNK = 48
 DENSITY_CELLS = 8
 #: Detections and predicted stars of the first verification pass.
 FIRST_STARS = 40
+#: Centroid error [px] added in quadrature to every detection's sigma: the pixel noise a detection
+#: reports leaves out the PSF's asymmetries, the pixel response and compression, so without a floor the
+#: brightest stars would take nearly all the weight of the fit.
+SIGMA_FLOOR_PX = 0.1
 
 
 def _density_grid(uv, width, height):
@@ -69,7 +73,7 @@ class PlateSolver:
     """
 
     def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
-                 principal_point_sigma=0.02, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
+                 principal_point_sigma=0.005, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
         from startrack.star_catalog import load_star_catalog
 
         defaults = PatternCatalogParams()
@@ -112,7 +116,8 @@ class PlateSolver:
     def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None,
               boresight=None) -> IdentificationResult:
         """Identify the detections ``uv`` (n, 2) [px] of a ``width`` x ``height`` frame; ``flux`` orders them
-        (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3);
+        (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3, with
+        :data:`SIGMA_FLOOR_PX` added in quadrature);
         ``fov_hint`` [rad] searches the levels nearest it first; ``camera`` a
         :class:`startrack.camera_file.CameraFile` known before (its focal length within 1 % or 3 sigma,
         its principal point and distortion as the priors' means, within 3 times its sigma; InputError if
@@ -209,7 +214,7 @@ class PlateSolver:
         if len(uv) and not inside.any():
             return f"all {len(uv)} centroids lie outside the {width} x {height} px image"
         index = index[inside]
-        return np.ascontiguousarray(uv[index]), np.ascontiguousarray(np.maximum(sigma[index], 0.02)), index
+        return np.ascontiguousarray(uv[index]), np.ascontiguousarray(np.hypot(sigma[index], SIGMA_FLOOR_PX)), index
 
     def _result(self, result, uv, sigma, index, width, height, start):
         _, R_IS, params, covariance, obs_index, star_index, probability, n_predicted, _, reduced = result

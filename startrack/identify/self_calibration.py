@@ -10,14 +10,20 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fi
    pattern's tolerance scaled to the image), attitude and focal length free;
 2. every detection against the ``n_predicted`` brightest stars predicted in the image, gate g_2,
    every intrinsic of ``free`` with its prior;
-3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars; then
-   matches the last fit puts outside r are dropped and the fit repeated.
+3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars;
+4. the depth of the catalog the frame shows (:func:`detected_depth`: where the matched fraction of the
+   predicted stars, brightest first, falls to the level of chance): matches of fainter stars are
+   dropped (in a crowd of false detections they are chance neighbours); then matches the fit puts
+   outside r, or beyond OUTLIER (4) times their sigma scaled by the fit's sqrt(chi^2 / dof) (a
+   compression artefact next to a star), are dropped and the fit repeated.
 
 Matches are mutual nearest neighbours in the image (one-to-one).  The false-match probability of the
 result is :func:`startrack.identify.verify.chance_match_probability` with the local density of the
 detections around each predicted star (a density grid of the frame), the four seed stars removed,
 and the Bonferroni factor N_h (g_1 / d)^n of the hypotheses the search and the n fitted parameters
-could have produced (d the radius the matches reached, :mod:`startrack.identify.verify`).
+could have produced (d the radius the matches reached, :mod:`startrack.identify.verify`); the chance
+matches are counted over every predicted star, not only those above the detected depth (the depth is
+chosen from the matches, so the count over all of them keeps the probability an upper bound).
 """
 
 from __future__ import annotations
@@ -35,6 +41,8 @@ from startrack.jit import njit
 SEEDS = 4
 #: Passes at the final gate beyond the first, made while they add stars.
 EXTRA_PASSES = 2
+#: A match whose residual exceeds this many of its sigma (scaled by the fit's sqrt(chi^2 / dof)) is dropped.
+OUTLIER = 4.0
 
 
 @njit
@@ -194,17 +202,24 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
         star_index, previous = stars[pred_index], obs_index.size
-    # matches the last fit leaves outside the final gate are dropped, and the fit repeated
-    keep = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)) <= gates[2]
-    if not keep.all():
-        obs_index, star_index = obs_index[keep], star_index[keep]
+    # the catalog depth the frame shows, then matches the last fit leaves outside the final gate are dropped
+    stars, pred_uv = predicted_stars(R_IS, params, vectors, around, n_predicted)
+    obs_index, pred_index = match_pixels(uv, uv.shape[0], pred_uv, gates[2])
+    chance = -np.expm1(-local_density(pred_uv, grid) * math.pi * gates[2] ** 2)
+    deep = pred_index < detected_depth(pred_index, stars.size, chance)
+    obs_index, star_index = obs_index[deep], stars[pred_index[deep]]
+    for _ in range(2):
         if obs_index.size < SEEDS + 1:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
         ok, R_IS, params, covariance, reduced = _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params,
                                                            free, prior)
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
-    stars, pred_uv = predicted_stars(R_IS, params, vectors, around, n_predicted)
+        residual = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params))
+        keep = (residual <= gates[2]) & (residual <= OUTLIER * math.sqrt(max(reduced, 1.0)) * sigma[obs_index])
+        if keep.all():
+            break
+        obs_index, star_index = obs_index[keep], star_index[keep]
     reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
     reached = min(max(reached, np.median(sigma)), gates[2])
     q = local_density(pred_uv, grid) * math.pi * reached * reached
@@ -213,6 +228,31 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     probability = chance_match_probability(q, obs_index.size - SEEDS, bonferroni)
     return (probability <= threshold, R_IS, params, covariance, obs_index, star_index, probability, stars.size,
             reached, reduced)
+
+
+#: Predicted stars per window of :func:`detected_depth`.
+DEPTH_WINDOW = 20
+
+
+@njit
+def detected_depth(pred_index, n_predicted, chance):  # pragma: no cover  (compiled)
+    """How many of the ``n_predicted`` stars (brightest first) the frame shows: the end of the last
+    window of DEPTH_WINDOW consecutive stars of which at least max(1/4, 4 x the mean chance of a
+    detection within the gate) are matched (``pred_index`` the matched ones); all of them for fewer
+    than DEPTH_WINDOW.  Fainter stars than that are not in the image (its catalog depth): their
+    matches are detections near them by chance."""
+    if n_predicted <= DEPTH_WINDOW:
+        return n_predicted
+    matched = np.zeros(n_predicted, np.int64)
+    matched[pred_index] = 1
+    floor = max(0.25, 4.0 * chance.mean()) * DEPTH_WINDOW
+    running = matched[:DEPTH_WINDOW].sum()
+    depth = DEPTH_WINDOW if running >= floor else 0
+    for end in range(DEPTH_WINDOW, n_predicted):
+        running += matched[end] - matched[end - DEPTH_WINDOW]
+        if running >= floor:
+            depth = end + 1
+    return max(depth, DEPTH_WINDOW)
 
 
 @njit
