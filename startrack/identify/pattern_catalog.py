@@ -44,12 +44,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from startrack.cache import cache_dir
 from startrack.errors import InputError
 from startrack.jit import njit
-from startrack.navigation_catalog import chord
 from startrack.units import DEG
 
 #: Ratio spread per unit r^2 of the level's tolerance model (module text).
@@ -226,6 +224,10 @@ def fibonacci_lattice(n: int) -> np.ndarray:
 
 def pattern_stars(vectors, v_mag, separation: float) -> np.ndarray:
     """Indices of the stars kept by brightest-first thinning to a minimum ``separation`` [rad], brightest first."""
+    from scipy.spatial import cKDTree
+
+    from startrack.navigation_catalog import chord
+
     order = np.argsort(v_mag, kind="stable")
     pairs = cKDTree(vectors).query_pairs(float(chord(separation)), output_type="ndarray")
     first = np.concatenate([pairs[:, 0], pairs[:, 1]])
@@ -241,6 +243,10 @@ _COMBINATIONS = {n: np.array(list(itertools.combinations(range(n), 4)), dtype=np
 
 def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> np.ndarray:
     """(N, 4) int32 star indices of the distinct patterns of the level of field of view ``fov`` [rad]."""
+    from scipy.spatial import cKDTree
+
+    from startrack.navigation_catalog import chord
+
     stars = pattern_stars(vectors, v_mag, SEPARATION_PER_FOV * fov)  # brightest first
     n_fields = int(math.ceil(4.0 * math.pi / fov**2)) * params.fields_per_fov
     fields = cKDTree(vectors[stars]).query_ball_point(fibonacci_lattice(n_fields), float(chord(0.5 * FIELD_PER_FOV * fov)))

@@ -28,9 +28,8 @@ from startrack.camera_fit import CameraCalibration
 from startrack.errors import InputError
 from startrack.identify.pattern_catalog import PatternCatalogParams, load_pattern_catalog
 from startrack.identify.result import IdentificationResult
-from startrack.identify.lost_in_space import SKY, cap
 from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
-from startrack.identify.zones import zone_index
+from startrack.identify.zones import SKY, cap, zone_index
 from startrack.units import DEG
 
 #: Default acceptance threshold of the false-match probability.
@@ -235,11 +234,11 @@ class PlateSolver:
 
     def _warm_up(self):
         """Load (or compile) the kernels: an identifiable frame of catalog stars and an unidentifiable one."""
-        from scipy.spatial.transform import Rotation
+        from startrack.rotation import from_rotation_vector
 
         fov = math.sqrt(self.fov_range[0] * self.fov_range[1])
         camera = Camera.from_fov(fov, 1024, 768)
-        q_IS = Rotation.from_rotvec([0.4, 1.1, 0.3]).as_quat()
+        q_IS = from_rotation_vector(np.array([0.4, 1.1, 0.3]))
         seen = camera.stars_in_field(q_IS, self.vectors)
         seen = seen[np.argsort(self.v_mag[seen], kind="stable")][:30]
         uv, _ = camera.project(q_IS, self.vectors[seen])

@@ -18,10 +18,10 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fi
    compression artefact next to a star), are dropped and the fit repeated.
 
 Matches are mutual nearest neighbours in the image (one-to-one).  The false-match probability of the
-result is :func:`startrack.identify.verify.chance_match_probability` with the local density of the
+result is :func:`startrack.identify.chance.chance_match_probability` with the local density of the
 detections around each predicted star (a density grid of the frame), the four seed stars removed,
 and the Bonferroni factor N_h (g_1 / d)^n of the hypotheses the search and the n fitted parameters
-could have produced (d the radius the matches reached, :mod:`startrack.identify.verify`); the chance
+could have produced (d the radius the matches reached, :mod:`startrack.identify.chance`); the chance
 matches are counted over every predicted star, not only those above the detected depth (the depth is
 chosen from the matches, so the count over all of them keeps the probability an upper bound).
 """
@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from startrack.camera_fit import fit, fold_radius_squared_jit, project, project_one
-from startrack.identify.verify import chance_match_probability
+from startrack.identify.chance import chance_match_probability
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
 

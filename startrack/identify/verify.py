@@ -86,35 +86,6 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
 
 
 @njit
-def poisson_tail(mean, k):
-    """P[Poisson(mean) >= k], summed term by term from k upwards (accurate for tiny tails)."""
-    if k <= 0:
-        return 1.0
-    if mean <= 0.0:
-        return 0.0
-    term = math.exp(k * math.log(mean) - mean - math.lgamma(k + 1))
-    total = term
-    j = k
-    while term > 1e-17 * total:
-        j += 1
-        term *= mean / j
-        total += term
-    return min(total, 1.0)
-
-
-@njit
-def chance_match_probability(expected, k, n_hypotheses):
-    """min(1, N_h P[S >= k]): S the number of predicted stars with a detection within the radius d by
-    chance, under a wrong hypothesis, counted as a Poisson variable of mean sum_i (1 - exp(-x_i)),
-    x_i = rho_i pi d^2 the expected detections within d of predicted star i (rho_i the local density
-    of the detections there).  ``expected`` (m,) the x_i, ``k`` the matches beyond the seeds."""
-    mean = 0.0
-    for i in range(expected.size):
-        mean += -math.expm1(-expected[i])
-    return min(1.0, max(n_hypotheses, 1.0) * poisson_tail(mean, k))
-
-
-@njit
 def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  (compiled)
     """Verification (module text) of the attitude hypothesis R_IS for the centroid directions ``obs_S``
     (n, 3) in one compiled call.  ``field`` = (vectors, zone index (:mod:`startrack.identify.zones`),

@@ -14,11 +14,29 @@ import math
 
 import numpy as np
 
-from startrack.identify.pairs import bisect
 from startrack.jit import njit
 
 #: Height of a zone [rad].
 ZONE_HEIGHT = math.radians(1.0)
+#: ``region`` of the search kernels for the whole sky (cos rho = -2: every star).
+SKY = (np.zeros(3), -2.0)
+
+
+def cap(axis, radius: float):
+    """``region`` of the search kernels: the stars within ``radius`` [rad] of the unit vector ``axis``."""
+    return np.ascontiguousarray(axis, dtype=float), math.cos(min(radius, math.pi))
+
+
+@njit(_nrt=False)
+def bisect(values, start, stop, x, right):  # pragma: no cover  (compiled)
+    """First index p in [start, stop) of the ascending ``values`` with values[p] > x (``right``) or >= x."""
+    while start < stop:
+        mid = (start + stop) >> 1
+        if values[mid] < x or (right and values[mid] == x):
+            start = mid + 1
+        else:
+            stop = mid
+    return start
 
 
 def zone_index(vectors):
