@@ -4,11 +4,14 @@ vignetting, sky gradients and nebulosity (SExtractor's background map, Bertin & 
 Global (:func:`estimate_background`): iterated 3-sigma-clipped mean and standard deviation of a regular
 subsample, started from the median and 1.4826 MAD.
 
-Mesh (:func:`mesh_background`): the frame is cut into square cells of ``cell_px`` (the last row and
-column of cells take the remainder, so every pixel belongs to one cell); in each cell a regular
+Mesh (:func:`mesh_background`): the frame is cut into square cells of ``cell_px`` (a remainder of half
+a cell or more is a last, smaller cell, a smaller one joins the last cell); in each cell a regular
 subsample (at most 256 pixels) gives a clipped level and noise as above, computed for all cells at
-once.  The cell values are median-filtered over 3 x 3 cells (a star or a small cluster that fills a
-cell does not lift the map there) and interpolated bilinearly between cell centres to every pixel.
+once.  A cell whose level lies more than 3 sigma from the median of its 3 x 3 cells, or whose noise is
+over twice theirs (a bright star or a cluster filling it), takes those medians (SExtractor's filter
+with its threshold, so that a smooth gradient -- vignetting -- is kept to the edges); the cell values
+are interpolated bilinearly between cell centres to every pixel, linearly extrapolated beyond the
+outer centres.
 """
 
 from __future__ import annotations
@@ -75,30 +78,38 @@ def estimate_background(image, clip=3.0, iterations=5):
 
 
 def _cell_edges(size, cell_px):
-    """Cell boundaries along one axis: cells of ``cell_px``, the last one taking the remainder."""
-    n = max(1, size // cell_px)
-    return np.concatenate([np.arange(n) * cell_px, [size]])
+    """Cell boundaries along one axis: cells of ``cell_px``; a remainder of half a cell or more is a cell of
+    its own, a smaller one joins the last cell."""
+    n = size // cell_px
+    if n == 0:
+        return np.array([0, size])
+    edges = list(np.arange(n + 1) * cell_px)
+    if size - edges[-1] >= cell_px / 2.0:
+        edges.append(size)
+    edges[-1] = size
+    return np.array(edges)
 
 
 def _cell_samples(array, rows, cols):
-    """(cells, k) regular subsamples of every cell (cells in row-major order, same k for all)."""
+    """(cells_y, cells_x, k) subsamples of every cell: the same ny x nx grid (k <= 256 pixels) spread evenly
+    over each cell, whatever its size."""
     heights, widths = np.diff(rows), np.diff(cols)
-    step = max(1, int(np.ceil(np.sqrt(heights.min() * widths.min() / _CELL_SAMPLE))))
-    ny, nx = int(heights.min() // step), int(widths.min() // step)
-    r = rows[:-1, None] + step * np.arange(ny)[None, :]  # (cells_y, ny)
-    c = cols[:-1, None] + step * np.arange(nx)[None, :]
+    step = max(1.0, np.sqrt(heights.min() * widths.min() / _CELL_SAMPLE))
+    ny, nx = max(1, int(heights.min() / step)), max(1, int(widths.min() / step))
+    r = (rows[:-1, None] + (np.arange(ny)[None, :] + 0.5) * heights[:, None] / ny).astype(np.int64)  # (cells_y, ny)
+    c = (cols[:-1, None] + (np.arange(nx)[None, :] + 0.5) * widths[:, None] / nx).astype(np.int64)
     samples = array[r[:, None, :, None], c[None, :, None, :]]  # (cells_y, cells_x, ny, nx)
     return samples.reshape(len(rows) - 1, len(cols) - 1, ny * nx)
 
 
 def _linear_weights(x, centres):
-    """(low (n,), frac (n,)): x lies between centres[low] and centres[low + 1] at the fraction frac
-    (constant beyond the outer centres; low = 0, frac = 0 for a single centre)."""
+    """(low (n,), frac (n,)): x = centres[low] + frac (centres[low + 1] - centres[low]); frac runs below 0
+    and above 1 beyond the outer centres (linear extrapolation over the last half cell, so a gradient
+    is followed to the image edge); low = 0, frac = 0 for a single centre."""
     if centres.size == 1:
         return np.zeros(x.size, np.int64), np.zeros(x.size)
-    position = np.clip(np.interp(x, centres, np.arange(centres.size)), 0.0, centres.size - 1.0)
-    low = np.minimum(position.astype(np.int64), centres.size - 2)
-    return low, position - low
+    low = np.clip(np.searchsorted(centres, x, side="right") - 1, 0, centres.size - 2)
+    return low, (x - centres[low]) / (centres[low + 1] - centres[low])
 
 
 class Background:
@@ -161,6 +172,9 @@ def mesh_background(image, cell_px=64, clip=3.0, iterations=5):
     samples = _cell_samples(array, rows, cols)
     level, sigma = clipped_level(samples.reshape(-1, samples.shape[-1]), clip, iterations)
     shape = samples.shape[:2]
-    level = ndimage.median_filter(level.reshape(shape), size=3, mode="nearest")
-    sigma = ndimage.median_filter(sigma.reshape(shape), size=3, mode="nearest")
+    level, sigma = level.reshape(shape), sigma.reshape(shape)
+    level_median = ndimage.median_filter(level, size=3, mode="nearest")
+    sigma_median = ndimage.median_filter(sigma, size=3, mode="nearest")
+    odd = (np.abs(level - level_median) > 3.0 * sigma_median) | (sigma > 2.0 * sigma_median)
+    level[odd], sigma[odd] = level_median[odd], sigma_median[odd]
     return Background(level, sigma, rows, cols)
