@@ -209,7 +209,8 @@ def score(frames, results):
         for frame, result in rows:
             if result is None:
                 continue
-            times.append(result["solve_ms"])
+            if result["solve_ms"] is not None:
+                times.append(result["solve_ms"])
             if result["status"] != "ok":
                 continue
             if frame["R_IC"] is None:
@@ -224,8 +225,9 @@ def score(frames, results):
                 fov_errors.append(100.0 * abs(result["fov_deg"] / frame["fov_deg"] - 1.0))
         out[set_name] = {
             "frames": len(rows), "answerable": sum(f["R_IC"] is not None for f, _ in rows), "success": success,
-            "wrong": wrong, "solve_ms": {"median": float(np.median(times)), "p95": float(np.percentile(times, 95)),
-                                         "max": float(np.max(times))},
+            "wrong": wrong, "errors": sum(r is not None and r["status"] == "error" for _, r in rows),
+            "solve_ms": {"median": float(np.median(times)), "p95": float(np.percentile(times, 95)),
+                         "max": float(np.max(times))} if times else None,
             "centre_error_arcsec": {"median": float(np.median(angles)) if angles else None,
                                     "max": float(np.max(angles)) if angles else None},
             "fov_error_percent": {"median": float(np.median(fov_errors)) if fov_errors else None,
@@ -241,7 +243,7 @@ def per_frame(frames, results):
         if frame["set"] != "real":
             continue
         result = by_id[frame["id"]]
-        row = {"status": result["status"], "solve_ms": result["solve_ms"]}
+        row = {"status": result["status"], "solve_ms": result["solve_ms"] or 0.0}
         if result["status"] == "ok":
             row["centre_error_arcsec"] = _angle(frame["R_IC"], result["R_IC"]) / ARCSEC
             row["fov_error_percent"] = 100.0 * (result["fov_deg"] / frame["fov_deg"] - 1.0)
@@ -284,10 +286,11 @@ def _print(scores, one):
     for name, per_set in scores.items():
         for set_name in sets:
             m = per_set[set_name]
-            c, f = m["centre_error_arcsec"], m["fov_error_percent"]
+            c, f, ms = m["centre_error_arcsec"], m["fov_error_percent"], m["solve_ms"] or {"median": None, "p95": None,
+                                                                                             "max": None}
             fmt = (lambda v, s: "-" if v is None else format(v, s))
             print(f"{name:<34} {set_name:<10} {m['answerable']:>3}/{m['frames']:<3} {m['success']:>8} {m['wrong']:>6} "
-                  f"{m['solve_ms']['median']:>8.2f} {m['solve_ms']['p95']:>8.2f} {m['solve_ms']['max']:>9.1f} "
+                  f"{fmt(ms['median'], '.2f'):>8} {fmt(ms['p95'], '.2f'):>8} {fmt(ms['max'], '.1f'):>9} "
                   f"{fmt(c['median'], '.1f'):>9}/{fmt(c['max'], '<9.1f')} {fmt(f['median'], '.4f'):>9}/{fmt(f['max'], '<9.4f')}")
     print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 5): after {one['after_ms']} ms"
           + (f", before (issue 17 code, with --fov-deg/--width/--height) {one['before_ms']} ms" if one["before_ms"] else ""))

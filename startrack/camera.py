@@ -10,11 +10,13 @@ Frame convention (docs/design.md, binding):
   [r - 1/2, r + 1/2]; the principal point defaults to ((W-1)/2, (H-1)/2).
 * Ideal pinhole: x_n = x/z, y_n = y/z (normalised, tangent-plane coordinates),
   u = cx + f x_n, v = cy + f y_n with f the focal length in pixels.
-* Radial distortion (Brown's polynomial, even terms):
+* Radial distortion (Brown's polynomial, even terms; Brown 1971):
   (x_d, y_d) = (x_n, y_n) (1 + k1 r^2 + k2 r^4), r^2 = x_n^2 + y_n^2, and
   u = cx + f x_d, v = cy + f y_d.  The inverse is solved for the radius by
   Newton's method to machine precision; the constructor refuses (k1, k2)
-  whose distorted radius is not monotonic over the image.
+  whose distorted radius is not monotonic over the image, and a direction
+  beyond the fold of the polynomial (where the distorted radius would fall
+  again) is never visible: the polynomial would put it back in the image.
 * Attitude: ``q_IS`` is the scalar-last quaternion (scipy convention) that
   rotates S-frame vectors into the inertial frame I: v_I = R_IS v_S
   (boresight RA/Dec/roll conversions in :mod:`startrack.attitude_angles`).

@@ -14,10 +14,11 @@ dv/dy = f (d + 2 y^2 (k1 + 2 k2 r^2)); du/df = x d, du/dcx = 1, du/dk1 = f x r^2
 
 Gauss-Newton (Gauss-Markov weights 1/sigma_i^2 per star and axis) with Gaussian priors on the
 intrinsics (maximum a posteriori: a free principal point of a narrow field is held near the image
-centre by its prior instead of drifting along its near-degeneracy with the attitude, Hartley &
-Zisserman §A6, docs/references.md); the normal matrix is scaled to unit diagonal before it is solved.
-The covariance of the estimate is the inverse normal matrix times max(1, chi^2 / dof): the stated
-sigma_i are a lower bound of the real centroid errors of a real camera.
+centre by its prior instead of drifting along its near-degeneracy with the attitude; Gauss-Newton as in
+Hartley & Zisserman §A6, docs/references.md); the normal matrix is scaled to unit diagonal before it is
+solved (Cholesky: a singular one -- too few or degenerate stars -- is reported, not raised).
+The covariance of the estimate is the inverse normal matrix (Hartley & Zisserman ch. 5) times
+max(1, chi^2 / dof): the stated sigma_i are a lower bound of the real centroid errors of a real camera.
 """
 
 from __future__ import annotations

@@ -49,11 +49,16 @@ def main():
         for n, frame in enumerate(frames):
             uv = np.array([c[:2] for c in frame["centroids"]], dtype=float).reshape(-1, 2)
             yx = uv[:, ::-1] + 0.5
-            if n == 0:  # warm-up: lazy initialisation is not a solve
-                solver.solve_from_centroids(yx, (frame["height"], frame["width"]), distortion=distortion,
-                                            solve_timeout=args.timeout_ms)
-            result, ms = timed(solver.solve_from_centroids, yx, (frame["height"], frame["width"]), distortion=distortion,
-                               solve_timeout=args.timeout_ms, return_matches=True)
+            size = (frame["height"], frame["width"])
+            try:
+                if n == 0:  # warm-up: lazy initialisation is not a solve
+                    solver.solve_from_centroids(yx, size, distortion=distortion, solve_timeout=args.timeout_ms)
+                result, ms = timed(solver.solve_from_centroids, yx, size, distortion=distortion,
+                                   solve_timeout=args.timeout_ms, return_matches=True)
+            except Exception as error:  # a peer's failure is a measured outcome, not a harness crash
+                out.write(json.dumps({"id": frame["id"], "status": "error", "solve_ms": None,
+                                      "reason": f"{type(error).__name__}: {error}"}) + "\n")
+                continue
             record = {"id": frame["id"], "status": statuses.get(result["status"], "error"), "solve_ms": ms}
             if record["status"] == "ok":
                 index = nearest_indices(yx, result["matched_centroids"])

@@ -7,7 +7,7 @@ detections, the Milky Way or compression noise around bright regions raise it wh
 clustered field the Poisson formula with the local density over-states the chance of a neighbour,
 so the probability stays an upper bound).  The number of predicted stars so matched is a sum of
 independent Bernoulli variables; its tail is taken as that of a Poisson variable of the same mean
-lambda = sum q_i.  A search that could have produced N_h hypotheses could be fooled by any of them
+lambda = sum q_i (Le Cam 1960: the two laws differ by at most sum q_i^2 in total variation).  A search that could have produced N_h hypotheses could be fooled by any of them
 (Bonferroni), so
 
     P_false = min(1, N_h P[Poisson(lambda) >= K]),

@@ -27,7 +27,7 @@ Level l's bin width is twice that model tolerance plus :data:`NOISE_TOLERANCE`; 
 centroid noise of its pattern (4 sqrt 2 sigma / e_6).
 
 Keys map to their runs in the key-sorted pattern table through an open-addressing hash table
-(linear probing, load <= 0.5); each level is stored as ``.npy`` files in the cache directory and
+(multiplicative hashing, linear probing, load <= 0.5: Knuth §6.4); each level is stored as ``.npy`` files in the cache directory and
 memory-mapped on load, so a solve touches only the pages its look-ups read.
 """
 
