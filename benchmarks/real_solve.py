@@ -85,6 +85,7 @@ def _centre_truth(camera, q_IS):
 
 
 def real_frames():
+    """The eight ESA frames, detected, with cedar-solve's reference solutions as truth."""
     reference = json.loads((REALSKY / "reference.json").read_text())
     frames = []
     for name, ref in sorted(reference.items()):
@@ -95,6 +96,7 @@ def real_frames():
 
 
 def synthetic_frames(n, seed, jpeg):
+    """``n`` rendered frames (8-30 deg, |k1| <= 0.2), or JPEG-compressed ones (10-33 deg), detected."""
     from startrack.identify.simulate import as_jpeg, rendered_sky
     from startrack.star_catalog import load_star_catalog
 
@@ -114,6 +116,7 @@ def synthetic_frames(n, seed, jpeg):
 
 
 def crowd_frames(n, seed):
+    """``n`` crowds of 1000-5000 false detections on a 33 deg frame, every other one with its 150 brightest stars."""
     from startrack.identify.simulate import noise_crowd, random_attitude
     from startrack.star_catalog import load_star_catalog
 
@@ -165,6 +168,7 @@ def run_startrack(frames):
 
 
 def run_cedar(frames_path, out_path, database, distortion):
+    """(results, None) of cedar-solve's runner in its venv, or (None, why it could not run)."""
     python = HERE / ".venv-cedar" / "bin" / "python"
     if not python.exists():
         return None, "no virtualenv benchmarks/.venv-cedar: run sh benchmarks/peers/setup_venvs.sh"
@@ -267,6 +271,7 @@ def one_shot_ms(command, env=None, repeats=5):
 
 
 def one_shot(image, baseline):
+    """One-shot wall times of ``startrack solve IMAGE`` now and, with a baseline checkout, before issue 18."""
     startrack = [str(Path(sys.executable).parent / "startrack"), "solve", str(image)]
     after, failure = one_shot_ms(startrack)
     out = {"image": image.name, "after_ms": after, "after_error": failure, "before_ms": None}

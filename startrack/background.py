@@ -131,10 +131,12 @@ class Background:
 
     @property
     def median_level(self) -> float:
+        """Median of the cell levels [DN]."""
         return float(np.median(self.level))
 
     @property
     def median_sigma(self) -> float:
+        """Median of the cell noises [DN]."""
         return float(np.median(self.sigma))
 
     def _along_rows(self, grid, rows):

@@ -313,6 +313,7 @@ class PatternCatalog:
 
     @property
     def n_patterns(self) -> int:
+        """Patterns over all levels."""
         return int(sum(level.keys.size for level in self.levels))
 
     @classmethod

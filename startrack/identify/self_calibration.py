@@ -176,16 +176,14 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     grid, threshold); ``gates`` (3,) [px] g_1, g_2, r.  Returns (ok, R_IS, params, covariance (8, 8), obs
     indices, star indices, P_false, stars predicted, radius reached [px], chi^2 / dof).
     """
-    _, first_stars, n_predicted, free, prior, grid, threshold = settings
+    _, first_stars, n_predicted, free, prior, _, _ = settings
     vectors = field[0]
-    bright = stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, field[3]))
-    around = bright
+    around = stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, field[3]))
     empty = np.zeros(0, np.int64)
     covariance = np.zeros((8, 8))
     reduced = 0.0
     first_free = np.zeros(5, np.bool_)
     first_free[0] = free[0]
-    obs_index, star_index = empty, empty
     previous = 0
     for p in range(3 + EXTRA_PASSES):
         gate = gates[min(p, 2)]
@@ -201,8 +199,17 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
                                                              params, first_free if p == 0 else free, prior)
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
-        star_index, previous = stars[pred_index], obs_index.size
-    # the catalog depth the frame shows, then matches the last fit leaves outside the final gate are dropped
+        previous = obs_index.size
+    return _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypotheses, covariance, reduced)
+
+
+@njit
+def _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypotheses, covariance,
+              reduced):  # pragma: no cover  (compiled)
+    """The last step of :func:`verify_calibrate` (module text, step 4) and its false-match probability;
+    returns verify_calibrate's tuple."""
+    _, _, n_predicted, free, prior, grid, threshold = settings
+    empty = np.zeros(0, np.int64)
     stars, pred_uv = predicted_stars(R_IS, params, vectors, around, n_predicted)
     obs_index, pred_index = match_pixels(uv, uv.shape[0], pred_uv, gates[2])
     chance = -np.expm1(-local_density(pred_uv, grid) * math.pi * gates[2] ** 2)
@@ -223,8 +230,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
     reached = min(max(reached, np.median(sigma)), gates[2])
     q = local_density(pred_uv, grid) * math.pi * reached * reached
-    n_fitted = 3 + int(np.sum(free))
-    bonferroni = n_hypotheses * (gates[0] / reached) ** n_fitted
+    bonferroni = n_hypotheses * (gates[0] / reached) ** (3 + int(np.sum(free)))
     probability = chance_match_probability(q, obs_index.size - SEEDS, bonferroni)
     return (probability <= threshold, R_IS, params, covariance, obs_index, star_index, probability, stars.size,
             reached, reduced)
