@@ -36,7 +36,8 @@ class IdentificationResult:
         :attr:`residuals` and :attr:`covariance` are derived from them when asked.
     false_match_probability: chance that a wrong attitude hypothesis explains as many centroids
         (:func:`startrack.identify.verify.false_match_probability`); NaN when nothing was verified.
-    method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space") or "" if none.
+    method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space"; "pattern" for the
+        plate solver's search without a calibrated camera) or "" if none.
     solve_ms: wall-clock time of the whole call [ms].
     lost_hip / entered_hip: tracking only -- previously tracked stars predicted inside the field but not
         found, and stars identified now that were not tracked before (HIP numbers).
