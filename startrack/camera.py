@@ -10,11 +10,13 @@ Frame convention (docs/design.md, binding):
   [r - 1/2, r + 1/2]; the principal point defaults to ((W-1)/2, (H-1)/2).
 * Ideal pinhole: x_n = x/z, y_n = y/z (normalised, tangent-plane coordinates),
   u = cx + f x_n, v = cy + f y_n with f the focal length in pixels.
-* Radial distortion (Brown's polynomial, even terms):
+* Radial distortion (Brown's polynomial, even terms; Brown 1971):
   (x_d, y_d) = (x_n, y_n) (1 + k1 r^2 + k2 r^4), r^2 = x_n^2 + y_n^2, and
   u = cx + f x_d, v = cy + f y_d.  The inverse is solved for the radius by
   Newton's method to machine precision; the constructor refuses (k1, k2)
-  whose distorted radius is not monotonic over the image.
+  whose distorted radius is not monotonic over the image, and a direction
+  beyond the fold of the polynomial (where the distorted radius would fall
+  again) is never visible: the polynomial would put it back in the image.
 * Attitude: ``q_IS`` is the scalar-last quaternion (scipy convention) that
   rotates S-frame vectors into the inertial frame I: v_I = R_IS v_S
   (boresight RA/Dec/roll conversions in :mod:`startrack.attitude_angles`).
@@ -24,6 +26,7 @@ Frame convention (docs/design.md, binding):
   intersected with the image; otherwise the image rectangle.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +36,22 @@ from startrack.rotation import from_rotation_vector, to_matrix
 
 #: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
 _NEWTON_ITERATIONS = 12
+
+
+def fold_radius_squared(k1, k2):
+    """Smallest t = r^2 > 0 with d/dr [r (1 + k1 r^2 + k2 r^4)] = 1 + 3 k1 t + 5 k2 t^2 = 0, or inf: the
+    ideal radius^2 beyond which the distorted radius decreases.  Plain arithmetic, so that the compiled
+    kernels wrap this very function (:data:`startrack.camera_fit.fold_radius_squared_jit`)."""
+    if k2 == 0.0:
+        return -1.0 / (3.0 * k1) if k1 < 0.0 else math.inf
+    disc = 9.0 * k1 * k1 - 20.0 * k2
+    if disc < 0.0:
+        return math.inf
+    best = math.inf
+    for t in ((-3.0 * k1 - math.sqrt(disc)) / (10.0 * k2), (-3.0 * k1 + math.sqrt(disc)) / (10.0 * k2)):
+        if 0.0 < t < best:
+            best = t
+    return best
 
 
 @dataclass(frozen=True)
@@ -75,6 +94,14 @@ class Camera:
         return cls(width, height, (width / 2.0) / np.tan(fov_x_rad / 2.0), **kw)
 
     @classmethod
+    def from_file(cls, path):
+        """The camera of a camera file (:mod:`startrack.camera_file`: TOML written by ``startrack solve
+        --write-camera``); a missing or bad file raises one :class:`InputError`."""
+        from startrack.camera_file import read_camera_file
+
+        return read_camera_file(path).camera
+
+    @classmethod
     def from_pitch(cls, focal_length_m, pixel_pitch_m, width, height, **kw):
         """Camera from the focal length and the pixel pitch [m]: f_px = focal / pitch."""
         if not (focal_length_m > 0 and pixel_pitch_m > 0):
@@ -95,6 +122,15 @@ class Camera:
         return 2.0 * np.arctan(self.height / (2.0 * self.focal_px))
 
     @property
+    def angular_width(self):
+        """Angle [rad] the image width subtends through its middle row (outer pixel edges, distortion
+        included): the field of view a plate solver measures; fov_x for an undistorted camera with its
+        principal point at the centre."""
+        middle = (self.height - 1) / 2.0
+        left, right = self.unproject([[-0.5, middle], [self.width - 0.5, middle]])
+        return float(np.arctan2(np.linalg.norm(np.cross(left, right)), np.dot(left, right)))
+
+    @property
     def fov_diagonal(self):
         """Full field angle across the diagonal [rad]."""
         return 2.0 * np.arctan(np.hypot(self.width, self.height) / (2.0 * self.focal_px))
@@ -110,14 +146,15 @@ class Camera:
         return np.hypot(du, dv) / self.focal_px
 
     def _check_distortion_monotonic(self):
+        """The distorted radius must grow out to the farthest corner (with 5 % margin): the corner lies
+        below the distorted radius reached at the fold, r_f (1 + k1 r_f^2 + k2 r_f^4)."""
         if self.k1 == 0.0 and self.k2 == 0.0:
             return
-        rd_max = 1.05 * self._max_distorted_radius()
-        r = np.linspace(0.0, 4.0 * rd_max, 8001)
-        rd = r * self._radial_factor(r * r)
-        slope = 1.0 + 3.0 * self.k1 * r**2 + 5.0 * self.k2 * r**4
-        reached = np.flatnonzero(rd >= rd_max)
-        if reached.size == 0 or np.any(slope[: reached[0] + 1] <= 0.0):
+        fold = fold_radius_squared(self.k1, self.k2)
+        if math.isinf(fold):
+            return
+        r_fold = math.sqrt(fold)
+        if r_fold * self._radial_factor(fold) <= 1.05 * self._max_distorted_radius():
             raise InputError(
                 f"radial distortion k1={self.k1!r}, k2={self.k2!r} is not invertible over the image "
                 "(distorted radius not monotonic out to the corners)"
@@ -199,10 +236,18 @@ class Camera:
         uv, xy_n, front = self._project(self.to_sensor(q_IS, vectors_I))
         return np.flatnonzero(self._visible(uv, xy_n, front, float(margin_px)))
 
+    @property
+    def fold_radius(self):
+        """Ideal normalised radius beyond which the distorted radius r (1 + k1 r^2 + k2 r^4) decreases
+        again (inf if it never does): directions farther off axis fold back into the image under the
+        polynomial but are not imaged by the lens, so they are never visible."""
+        return math.sqrt(fold_radius_squared(self.k1, self.k2))
+
     def _visible(self, uv, xy_n, front, margin_px):
         with np.errstate(invalid="ignore"):
             inside = (
                 front
+                & (np.sum(xy_n * xy_n, axis=1) < self.fold_radius**2)
                 & (uv[:, 0] >= -0.5 - margin_px)
                 & (uv[:, 0] <= self.width - 0.5 + margin_px)
                 & (uv[:, 1] >= -0.5 - margin_px)

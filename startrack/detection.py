@@ -2,16 +2,26 @@
 
 Pipeline (one pass, vectorised):
 
-1. background b and noise sigma_n of the frame, given or estimated robustly
-   (iterated 3-sigma-clipped median and MAD of a pixel subsample);
-2. threshold V_th = b + a sigma_n (eq. 4 of 004; a = 5);
+1. background b and noise sigma_n, given, estimated for the whole frame, or on a mesh of cells that
+   follows vignetting and nebulosity (:mod:`startrack.background`);
+2. threshold V_th = b + a sigma_n (eq. 4 of 004; a = 5), per pixel with a mesh;
 3. 8-connected components of the pixels above V_th (scipy.ndimage.label,
    on the rows that hold any such pixel only);
 4. per component, by weighted sums over its pixels (np.bincount):
    centroid (u, v) by the chosen centroider, flux = sum(I - b), peak grey,
    pixel count, SNR = (peak - b)/sigma_n (eq. 1 of 004), and the flags
-   ``saturated`` (peak at the saturation level) and ``edge`` (touches the
-   image or window border, so the centroid is biased).
+   ``saturated`` (peak at the saturation level), ``edge`` (touches the
+   image or window border, so the centroid is biased) and ``single_pixel``;
+5. optionally, components flagged ``single_pixel`` are dropped.
+
+Single-pixel events (hot pixels, cosmic-ray hits, JPEG block noise): the optics spread a star over
+several pixels, so the 8 pixels around a star's peak hold a large fraction of the peak's own excess --
+their sum R (the ring, background removed) is at least ~1.5 times it for a Gaussian PSF of sigma >=
+0.6 px centred on the pixel (more for other pixel phases) and 0.6 times it at sigma = 0.4 px.  The
+frame's own stars set the cut (:func:`_ring_cut`: half the median ratio of its bright detections,
+at least :data:`MIN_RING_RATIO`); a detection whose ring ratio R / (I_peak - b) lies below the cut by
+more than 3 times its noise (sqrt(8) sigma_n / (I_peak - b)) is flagged: at high SNR a hot pixel is
+told from a star with certainty, near the threshold the test keeps the detection.
 
 Centroiders (strategy objects, all over the component's pixels, u = column,
 v = row, image convention of docs/design.md):
@@ -26,16 +36,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from scipy.special import ndtr
 
+from startrack.background import Background, estimate_background, mesh_background
 from startrack.errors import InputError
-from startrack.photometry import detection_threshold
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
-#: Pixels used for the background estimate (regular subsample of the frame).
-_BACKGROUND_SAMPLE = 16384
-#: 1.4826 * MAD is sigma for a normal law.
-_MAD_TO_SIGMA = 1.482602218505602
+#: Smallest ring ratio of a star image (module text).
+MIN_RING_RATIO = 0.4
 
 
 class GreyCentroid:
@@ -76,9 +83,9 @@ class Detections:
     """Detected star images, brightest (largest flux) first.
 
     u, v [px]; flux = sum(I - b) [DN]; peak [DN]; npix; snr (eq. 1 of 004);
-    saturated, edge (bool); the background b, noise sigma_n and threshold [DN]
-    used; sigma_u, sigma_v [px]: the centroid's σ from the pixel noise
-    (:func:`_centroid_sigma`).
+    saturated, edge, single_pixel (bool, module text); the background b, noise
+    sigma_n and threshold [DN] used (medians over the frame for a mesh); sigma_u,
+    sigma_v [px]: the centroid's σ from the pixel noise (:func:`_centroid_sigma`).
     """
 
     u: np.ndarray
@@ -94,6 +101,7 @@ class Detections:
     threshold: float
     sigma_u: np.ndarray
     sigma_v: np.ndarray
+    single_pixel: np.ndarray
 
     def __len__(self):
         return len(self.u)
@@ -107,7 +115,7 @@ class Detections:
         """The detections where ``mask`` (bool or indices) holds, same order."""
         fields = ("u", "v", "flux", "peak", "npix", "snr", "saturated", "edge")
         return Detections(*(getattr(self, f)[mask] for f in fields), self.background, self.sigma_n, self.threshold,
-                          self.sigma_u[mask], self.sigma_v[mask])
+                          self.sigma_u[mask], self.sigma_v[mask], self.single_pixel[mask])
 
     def to_dict(self):
         """Plain dict (lists) for JSON output."""
@@ -120,6 +128,7 @@ class Detections:
                     "u": float(self.u[i]), "v": float(self.v[i]), "flux_dn": float(self.flux[i]),
                     "peak_dn": float(self.peak[i]), "npix": int(self.npix[i]), "snr": float(self.snr[i]),
                     "saturated": bool(self.saturated[i]), "edge": bool(self.edge[i]),
+                    "single_pixel": bool(self.single_pixel[i]),
                     "sigma_u": float(self.sigma_u[i]), "sigma_v": float(self.sigma_v[i]),
                 }
                 for i in range(len(self))
@@ -130,7 +139,7 @@ class Detections:
 def _empty(background, sigma_n, threshold):
     f = np.zeros(0)
     b = np.zeros(0, dtype=bool)
-    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f)
+    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f, b)
 
 
 def _validate(image, name="image"):
@@ -144,39 +153,6 @@ def _validate(image, name="image"):
     if np.issubdtype(array.dtype, np.floating) and not np.all(np.isfinite(array)):
         raise InputError(f"{name} contains NaN or infinite pixel values")
     return array
-
-
-def estimate_background(image, clip=3.0, iterations=5):
-    """Robust (b, sigma_n) [DN] of a frame by iterated sigma clipping.
-
-    Starts from the median and 1.4826 MAD of a regular subsample of at most
-    16384 pixels, then keeps the pixels within ``clip`` sigma of the level
-    and takes their mean and standard deviation (divided by the standard
-    deviation of a normal law truncated at +-clip sigma), until the kept set
-    stops changing.  Stars and hot pixels are clipped away; the mean and
-    standard deviation are not quantised like the median and MAD of integer
-    grey levels.  A flat frame gives sigma_n = 0.
-    """
-    array = _validate(image)
-    step = max(1, int(np.ceil(np.sqrt(array.size / _BACKGROUND_SAMPLE))))
-    sample = np.asarray(array[::step, ::step], dtype=float).ravel()
-    level = float(np.median(sample))
-    sigma = _MAD_TO_SIGMA * float(np.median(np.abs(sample - level)))
-    if sigma == 0.0:
-        sigma = float(np.std(sample))
-    if sigma == 0.0:
-        return level, 0.0
-    density = np.exp(-0.5 * clip * clip) / np.sqrt(2.0 * np.pi)  # standard normal pdf at the clip
-    truncation = np.sqrt(1.0 - 2.0 * clip * density / (2.0 * ndtr(clip) - 1.0))
-    n_kept = -1
-    for _ in range(iterations):
-        kept = sample[np.abs(sample - level) <= clip * sigma]
-        if kept.size == n_kept or kept.size < 2:
-            break
-        n_kept = kept.size
-        level = float(np.mean(kept))
-        sigma = float(np.std(kept)) / truncation
-    return level, sigma
 
 
 def _label_pixels(mask):
@@ -196,8 +172,25 @@ def _label_pixels(mask):
     return rows_kept[sub_rows], cols, labels.reshape(-1)[flat], n
 
 
-def _measure(values, rows, cols, labels, n, on_border, background, sigma_n, threshold, centroider,
-             saturation_dn, min_pixels, u_coord, v_coord):
+def _peak_pixels(values, index, n):
+    """Position in ``values`` of the brightest pixel of each of the n components (last of equal ones)."""
+    order = np.lexsort((values, index))
+    last = np.flatnonzero(np.r_[index[order][1:] != index[order][:-1], True])
+    peaks = np.empty(n, np.int64)
+    peaks[index[order][last]] = order[last]
+    return peaks
+
+
+def _at(level, positions):
+    """A per-pixel level at ``positions`` (a uniform level is one number)."""
+    return level if np.ndim(level) == 0 else level[positions]
+
+
+def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, min_pixels, u_coord, v_coord,
+             ring=None):
+    """Detections of the n labelled components; ``levels`` = (b, sigma_n, V_th), each one number or one
+    value per pixel of ``values``; ``ring(peak positions)`` gives the ring sums of the peaks (full frames)."""
+    background, sigma_n, threshold = levels
     index = labels - 1
     weights = centroider.weights(values, background, threshold)
     npix = np.bincount(index, minlength=n)
@@ -207,36 +200,71 @@ def _measure(values, rows, cols, labels, n, on_border, background, sigma_n, thre
     sigma_u = _centroid_sigma(index, n, u_coord, u, npix, wsum, sigma_n)
     sigma_v = _centroid_sigma(index, n, v_coord, v, npix, wsum, sigma_n)
     flux = np.bincount(index, weights=values - background, minlength=n)
-    peak = np.full(n, -np.inf)
-    np.maximum.at(peak, index, values)
+    peaks = _peak_pixels(values, index, n)
+    peak = values[peaks]
+    b_peak, s_peak = _at(background, peaks), _at(sigma_n, peaks)
     edge = np.bincount(index, weights=on_border, minlength=n) > 0
     saturated = peak >= saturation_dn if saturation_dn is not None else np.zeros(n, dtype=bool)
-    snr = (peak - background) / sigma_n if sigma_n > 0 else np.full(n, np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        snr = np.where(s_peak > 0, (peak - b_peak) / s_peak, np.inf)
+        single = np.zeros(n, dtype=bool)
+        if ring is not None:
+            excess = peak - b_peak
+            ratio = (ring(peaks) - 8.0 * b_peak) / excess
+            single = ratio < _ring_cut(ratio, snr, npix, saturated) - 3.0 * np.sqrt(8.0) * s_peak / excess
     keep = np.flatnonzero(npix >= min_pixels)
     keep = keep[np.argsort(-flux[keep], kind="stable")]
+    summary = (float(np.median(level)) for level in levels)
     return Detections(u[keep], v[keep], flux[keep], peak[keep], npix[keep], snr[keep], saturated[keep],
-                      edge[keep], float(background), float(sigma_n), float(threshold), sigma_u[keep], sigma_v[keep])
+                      edge[keep], *summary, sigma_u[keep], sigma_v[keep], single[keep])
+
+
+def _ring_cut(ratio, snr, npix, saturated):
+    """Smallest ring ratio of a star in this frame: half the median ratio of its bright (SNR >= 20),
+    unsaturated detections of 2 pixels or more when there are 5 of them -- a star centred on a pixel has
+    the smallest ratio, about 0.8 times the median over pixel phases -- within [MIN_RING_RATIO, 1.5]."""
+    bright = (snr >= 20.0) & (npix >= 2) & ~saturated
+    if np.count_nonzero(bright) < 5:
+        return MIN_RING_RATIO
+    return float(np.clip(0.5 * np.median(ratio[bright]), MIN_RING_RATIO, 1.5))
 
 
 def _centroid_sigma(index, n, coord, centre, npix, wsum, sigma_n):
     """σ [px] of a weighted centroid c = Σ wᵢ xᵢ / Σ wᵢ over a component of N pixels: the pixel noise
-    σ_n propagated (∂c/∂Iᵢ = (xᵢ − c)/W, so σ_n² Σ (xᵢ − c)² / W²) plus the sampling of the image on the
-    pixel grid, 1/(12 N) px² (the rounding of each coordinate to its pixel; 1/12 px² for one pixel)."""
-    spread = np.bincount(index, weights=coord * coord, minlength=n) - 2.0 * centre * np.bincount(
-        index, weights=coord, minlength=n) + npix * centre * centre
-    return np.sqrt(sigma_n**2 * np.maximum(spread, 0.0) / wsum**2 + 1.0 / (12.0 * npix * npix))
+    σ_n propagated (∂c/∂Iᵢ = (xᵢ − c)/W, so Σ σ_n,ᵢ² (xᵢ − c)² / W²) plus the sampling of the image on
+    the pixel grid, 1/(12 N) px² (the rounding of each coordinate to its pixel; 1/12 px² for one pixel).
+    ``sigma_n`` one number or one per pixel (mesh background)."""
+    weight = 1.0 if np.ndim(sigma_n) == 0 else sigma_n**2
+    spread = np.bincount(index, weights=weight * coord * coord, minlength=n) - 2.0 * centre * np.bincount(
+        index, weights=weight * coord, minlength=n) + np.bincount(index, weights=np.broadcast_to(weight, coord.shape),
+                                                                  minlength=n) * centre * centre
+    scale = sigma_n**2 if np.ndim(sigma_n) == 0 else 1.0
+    return np.sqrt(scale * np.maximum(spread, 0.0) / wsum**2 + 1.0 / (12.0 * npix * npix))
 
 
-def _levels(array, background, sigma_n, a, threshold):
+def _background(array, background, sigma_n, mesh_px):
+    """The :class:`~startrack.background.Background` of a frame: the given level and noise (the missing one
+    estimated over the frame), a mesh of ``mesh_px`` cells, or one estimate for the whole frame."""
+    if background is None and sigma_n is None and mesh_px is not None:
+        if isinstance(mesh_px, bool) or not isinstance(mesh_px, (int, np.integer)) or not 8 <= mesh_px <= 4096:
+            raise InputError(f"mesh_px = {mesh_px!r} must be an integer number of pixels in [8, 4096]")
+        return mesh_background(array, int(mesh_px))
     if background is None or sigma_n is None:
         b_est, s_est = estimate_background(array)
         background = b_est if background is None else background
         sigma_n = s_est if sigma_n is None else sigma_n
     if not (np.isfinite(background) and np.isfinite(sigma_n) and sigma_n >= 0):
         raise InputError(f"background {background!r} and sigma_n {sigma_n!r} must be finite, sigma_n >= 0")
-    if threshold is None:
-        threshold = detection_threshold(background, sigma_n, a)
-    return float(background), float(sigma_n), float(threshold)
+    return Background.uniform(float(background), float(sigma_n), array.shape)
+
+
+def _levels(found, a, threshold, rows, cols):
+    """(b, sigma_n, V_th) at the pixels (rows, cols): numbers for a uniform background."""
+    if found.level.size == 1:
+        b, s = found.median_level, found.median_sigma
+        return b, s, float(b + a * s) if threshold is None else float(threshold)
+    b, s = found.at(rows, cols)
+    return b, s, (b + a * s) if threshold is None else np.full(b.shape, float(threshold))
 
 
 def _centroider(centroider):
@@ -247,30 +275,53 @@ def _centroider(centroider):
     return centroider
 
 
+def _ring_sums(array):
+    """ring(peaks_rc) -> sum of the (up to) 8 pixels around each peak (row, col), scaled to 8 at the border."""
+    height, width = array.shape
+
+    def ring(rows, cols):
+        total, count = np.zeros(rows.size), np.zeros(rows.size)
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                if dr == 0 and dc == 0:
+                    continue
+                r, c = rows + dr, cols + dc
+                inside = (r >= 0) & (r < height) & (c >= 0) & (c < width)
+                total[inside] += array[r[inside], c[inside]].astype(float)
+                count += inside
+        return total * 8.0 / np.maximum(count, 1.0)
+
+    return ring
+
+
 def detect(image, background=None, sigma_n=None, a=5.0, threshold=None, centroider="threshold",
-           saturation_dn=None, min_pixels=1):
+           saturation_dn=None, min_pixels=1, mesh_px=None, reject_single_pixels=False):
     """Detect and centroid the star images of a frame (module docstring).
 
-    image: 2-D array [DN].  background, sigma_n [DN]: estimated from the
-    frame when None.  threshold: V_th, default b + a sigma_n (eq. 4 of 004).
-    centroider: "grey", "threshold", "square" or an object with
-    ``weights(values, background, threshold)``.  saturation_dn: grey level
-    at which a pixel is saturated (None: no flag).  min_pixels: smallest
-    component kept.  Returns :class:`Detections` (empty when nothing
-    exceeds the threshold).  NaN pixels raise InputError.
+    image: 2-D array [DN].  background, sigma_n [DN]: estimated from the frame when None -- on a mesh of
+    ``mesh_px`` cells if given, else one level for the frame.  threshold: V_th, default b + a sigma_n
+    (eq. 4 of 004).  centroider: "grey", "threshold", "square" or an object with
+    ``weights(values, background, threshold)``.  saturation_dn: grey level at which a pixel is saturated
+    (None: no flag).  min_pixels: smallest component kept.  reject_single_pixels: drop the detections
+    flagged ``single_pixel``.  Returns :class:`Detections` (empty when nothing exceeds the threshold).
+    NaN pixels raise InputError.
     """
     array = _validate(image)
-    background, sigma_n, threshold = _levels(array, background, sigma_n, a, threshold)
+    found = _background(array, background, sigma_n, mesh_px)
     centroider = _centroider(centroider)
-    mask = array > threshold
+    mask = array > (found.threshold(a) if threshold is None else float(threshold))
     if not mask.any():
-        return _empty(background, sigma_n, threshold)
+        b, s = found.median_level, found.median_sigma
+        return _empty(b, s, b + a * s if threshold is None else float(threshold))
     rows, cols, labels, n = _label_pixels(mask)
     height, width = array.shape
     values = array[rows, cols].astype(float)
     on_border = ((rows == 0) | (rows == height - 1) | (cols == 0) | (cols == width - 1)).astype(float)
-    return _measure(values, rows, cols, labels, n, on_border, background, sigma_n, threshold, centroider,
-                    saturation_dn, min_pixels, cols.astype(float), rows.astype(float))
+    ring_of = _ring_sums(array)
+    detections = _measure(values, labels, n, on_border, _levels(found, a, threshold, rows, cols), centroider,
+                          saturation_dn, min_pixels, cols.astype(float), rows.astype(float),
+                          ring=lambda peaks: ring_of(rows[peaks], cols[peaks]))
+    return detections.select(~detections.single_pixel) if reject_single_pixels else detections
 
 
 def detect_windows(window_images, row0, col0, background, sigma_n, a=5.0, threshold=None,
@@ -290,19 +341,19 @@ def detect_windows(window_images, row0, col0, background, sigma_n, a=5.0, thresh
     col0 = np.asarray(col0, dtype=np.int64)
     if row0.shape != (stack.shape[0],) or col0.shape != (stack.shape[0],):
         raise InputError(f"need one window origin per window: {stack.shape[0]} windows, origins {row0.shape}")
-    background, sigma_n, threshold = _levels(stack.reshape(-1, stack.shape[2]), background, sigma_n, a, threshold)
+    found = _background(stack.reshape(-1, stack.shape[2]), background, sigma_n, None)
+    levels = _levels(found, a, threshold, None, None)
     centroider = _centroider(centroider)
     m, h, w = stack.shape
     mask = np.zeros((m, h + 1, w), dtype=bool)
-    mask[:, :h] = stack > threshold
+    mask[:, :h] = stack > levels[2]
     mask = mask.reshape(m * (h + 1), w)
     if not mask.any():
-        return _empty(background, sigma_n, threshold)
+        return _empty(*levels)
     rows, cols, labels, n = _label_pixels(mask)
     window, local_rows = np.divmod(rows, h + 1)
     values = stack[window, local_rows, cols].astype(float)
     on_border = ((local_rows == 0) | (local_rows == h - 1) | (cols == 0) | (cols == w - 1)).astype(float)
     u = (col0[window] + cols).astype(float)
     v = (row0[window] + local_rows).astype(float)
-    return _measure(values, rows, cols, labels, n, on_border, background, sigma_n, threshold, centroider,
-                    saturation_dn, min_pixels, u, v)
+    return _measure(values, labels, n, on_border, levels, centroider, saturation_dn, min_pixels, u, v)

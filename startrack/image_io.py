@@ -1,10 +1,19 @@
-"""Read and write star-sensor frames: PNG/TIFF (pillow) and NumPy .npy.
+"""Read and write star-sensor frames: PNG/TIFF/JPEG (pillow) and NumPy .npy.
 
-Frames are 2-D greyscale arrays [DN].  Integer images come back as
-uint16 (8-bit files are widened), floating images as float64; colour,
-multi-channel or non-2-D data are refused with one clear message.
+Frames are 2-D arrays [DN].  Integer greyscale images come back as uint16 (8-bit files are widened),
+floating ones as float64.  Colour images (RGB, RGBA, palette, CMYK, YCbCr: colour JPEGs from ordinary
+cameras) are converted to their luminance Y = 0.299 R + 0.587 G + 0.114 B (ITU-R BT.601, the weights
+of pillow's own "L" conversion) in float64, without rounding to 8 bits.  A .npy file must hold a 2-D
+array.
+
+:func:`read_frame` also gives the full scale of the data, from the file's bit depth: 255 for 8-bit
+files (colour included); for 16-bit files the smallest of 2^8, 2^10, 2^12, 2^14, 2^16 above the
+largest value, less the step of the data -- 12-bit data scaled by 16 (every value but a clipped
+65535 a multiple of 16) saturates at 65520, not at each of its values; none for floating data.
+A pixel at or above the full scale is saturated (:func:`startrack.detection.detect`).
 """
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -12,11 +21,28 @@ from PIL import Image, UnidentifiedImageError
 
 from startrack.errors import InputError
 
-IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".npy")
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy")
+#: Greyscale pillow modes read as they are.
+_GREY_MODES = ("L", "I;16", "I;16B", "I;16L", "I", "F", "1")
+#: ITU-R BT.601 luma weights of R, G, B.
+LUMA_WEIGHTS = np.array([0.299, 0.587, 0.114])
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A frame read from a file: ``image`` (H, W) [DN] and its ``full_scale`` [DN] (None: unknown)."""
+
+    image: np.ndarray
+    full_scale: float | None
 
 
 def read_image(path):
-    """2-D frame from a PNG, TIFF or .npy file (uint16 for integer data, float64 otherwise)."""
+    """2-D frame from a PNG, TIFF, JPEG or .npy file (uint16 for integer data, float64 otherwise)."""
+    return read_frame(path).image
+
+
+def read_frame(path) -> Frame:
+    """The :class:`Frame` of a PNG, TIFF, JPEG or .npy file (module text)."""
     path = Path(path)
     if not path.is_file():
         raise InputError(f"image file {path} does not exist")
@@ -28,19 +54,32 @@ def read_image(path):
             array = np.load(path, allow_pickle=False)
         except (ValueError, OSError) as error:
             raise InputError(f"image file {path} is not a readable .npy array ({error})") from None
+        colour = False
     else:
-        try:
-            with Image.open(path) as image:
-                if image.mode not in ("L", "I;16", "I;16B", "I;16L", "I", "F", "1"):
-                    raise InputError(
-                        f"image file {path} has mode {image.mode} ({len(image.getbands())} channels); "
-                        "a star-sensor frame must be single-channel greyscale"
-                    )
-                array = np.array(image)
-        except (UnidentifiedImageError, OSError, SyntaxError) as error:
-            raise InputError(f"image file {path} could not be read as an image ({error})") from None
+        array, colour = _read_picture(path)
+    image = _checked(path, array)
+    if colour:
+        return Frame(image, 255.0)
+    return Frame(image, full_scale(image))
+
+
+def _read_picture(path):
+    """(array, is colour) of an image file read by pillow; colour as luminance (module text)."""
+    try:
+        with Image.open(path) as image:
+            if image.mode in _GREY_MODES:
+                return np.array(image), False
+            if image.mode == "LA":
+                return np.array(image.getchannel("L")), False
+            rgb = np.asarray(image.convert("RGB"), dtype=float)
+            return rgb @ LUMA_WEIGHTS, True
+    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
+        raise InputError(f"image file {path} could not be read as an image ({error})") from None
+
+
+def _checked(path, array):
     if array.ndim != 2:
-        raise InputError(f"image file {path} holds an array of shape {array.shape}; expected a 2-D greyscale frame")
+        raise InputError(f"image file {path} holds an array of shape {array.shape}; expected a 2-D frame")
     if array.size == 0:
         raise InputError(f"image file {path} holds an empty frame (shape {array.shape})")
     if array.dtype == bool:
@@ -55,6 +94,20 @@ def read_image(path):
             raise InputError(f"image file {path} contains NaN or infinite pixel values")
         return array
     raise InputError(f"image file {path} holds {array.dtype} data; expected integer or floating grey levels")
+
+
+def full_scale(image):
+    """Full scale [DN] of integer data (module text), None for floating data."""
+    if image.dtype != np.uint16:
+        return None
+    top = int(image.max())
+    below = image[image < 65535]
+    step = 1
+    if below.size and np.any(below):
+        common = int(np.bitwise_or.reduce(below.ravel()))
+        step = common & -common  # lowest set bit over all values: the data's step
+    bits = next(b for b in (8, 10, 12, 14, 16) if top < 1 << b or b == 16)
+    return float((1 << bits) - step)
 
 
 def write_image(path, image):

@@ -148,6 +148,10 @@ SCHEMA = Table(
                         "compare_without_stacking": Value("bool", default=False,
                                                           doc="also run a shadow filter that never gets the "
                                                               "stacked star, for the paired comparison of 004"),
+                        "camera_file": Value("str", default=None,
+                                             doc="camera file (startrack solve --write-camera), relative to the "
+                                                 "scenario file: sets the camera's size, focal length, principal "
+                                                 "point and distortion (fov_deg still sizes the catalog)"),
                     },
                     optional=True,
                 ),
@@ -350,6 +354,7 @@ def validate(data, source="<scenario>"):
             raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
         if "image" not in sensor:
             sensor["image"] = SCHEMA.entries["star_sensor"].entries["image"].check("star_sensor.image", {})
+        _apply_camera_file(sensor["image"], source)
     if sensor["fidelity"] == "vector":
         for kind in ("attitude_jumps", "false_star_storms", "tracking_failure_probes"):
             if checked["faults"].get(kind):
@@ -380,6 +385,20 @@ def _check_run_size(checked, source):
             raise InputError(f"{source}: duration_s: {duration:g} s at {key} = {checked[key.split('.')[0]]['rate_hz']:g} Hz "
                              f"is {count:.3g} {what}, more than the {limit:.0e} one run holds in memory; shorten the "
                              "run (a campaign of shorter runs covers more) or lower the rate")
+
+
+def _apply_camera_file(image, source):
+    """A given ``star_sensor.image.camera_file`` is read now (one InputError for a missing or bad file)
+    and sets ``width_px`` and ``height_px``; build.py takes the camera from it."""
+    if image.get("camera_file") is None:
+        return
+    from startrack.camera import Camera
+
+    try:
+        camera = Camera.from_file(image["camera_file"])
+    except InputError as error:
+        raise InputError(f"{source}: star_sensor.image.camera_file: {error}") from None
+    image["width_px"], image["height_px"] = camera.width, camera.height
 
 
 def _checked(schema, data, source):
@@ -438,7 +457,11 @@ def load_scenario(path, overrides=()):
         raise InputError(f"{path}: invalid TOML: {error}") from None
     except RecursionError:
         raise InputError(f"{path}: invalid TOML: arrays or tables nested too deeply") from None
-    return validate(apply_overrides(data, overrides, str(path)), source=path.name)
+    data = apply_overrides(data, overrides, str(path))
+    image = data.get("star_sensor", {}).get("image", {}) if isinstance(data.get("star_sensor"), dict) else {}
+    if isinstance(image, dict) and isinstance(image.get("camera_file"), str):  # relative to the scenario file
+        image["camera_file"] = str(path.parent / image["camera_file"])
+    return validate(data, source=path.name)
 
 
 def scenario_from_dict(data, overrides=(), source="<dict>"):

@@ -1,5 +1,7 @@
 """From a validated scenario (units in key names) to model objects in SI units."""
 
+import dataclasses
+
 import numpy as np
 import scipy.linalg
 
@@ -113,6 +115,8 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults):
     sensor, image = scenario["star_sensor"], scenario["star_sensor"]["image"]
     fov = float(units.deg_to_rad(sensor["fov_deg"]))
     camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
+    if image["camera_file"] is not None:  # a calibrated camera (startrack solve --write-camera)
+        camera = dataclasses.replace(Camera.from_file(image["camera_file"]), circular_fov=image["field"] == "circular")
     model = SensorModel(psf_sigma_px=image["psf_sigma_px"], exposure_s=image["exposure_s"],
                         zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"])
     params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],

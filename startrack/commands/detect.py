@@ -1,9 +1,10 @@
-"""``startrack detect IMAGE``: star centroids of a frame (PNG/TIFF/NPY).
+"""``startrack detect IMAGE``: star centroids of a frame (PNG/TIFF/JPEG/NPY).
 
-Threshold V_th = b + a sigma_n (eq. 4 of 004, b and sigma_n estimated from
-the frame unless given), 8-connected components and a centre-of-gravity
-centroider; prints one line per star, brightest first, or JSON.  This is the
-image front end of ``startrack solve IMAGE``.
+Background and noise on a mesh of cells (or given), threshold V_th = b + a sigma_n (eq. 4 of 004),
+8-connected components and a centre-of-gravity centroider, single-pixel events (hot pixels) dropped,
+saturation at the full scale of the file's bit depth (:mod:`startrack.image_io`); prints one line
+per star, brightest first, or JSON.  The same detection, with the same options
+(:func:`add_detection_options`), is the image front end of ``startrack solve``.
 """
 
 import json
@@ -13,42 +14,75 @@ import time
 from startrack.errors import InputError
 
 
+def add_detection_options(parser):
+    """The detection options shared by ``detect`` and ``solve``."""
+    group = parser.add_argument_group("detection")
+    group.add_argument("--a", type=float, default=5.0, help="threshold factor a of V_th = b + a sigma_n (5)")
+    group.add_argument("--background-dn", type=float, default=None, help="background level b [DN] (estimated)")
+    group.add_argument("--sigma-n-dn", type=float, default=None, help="background noise sigma_n [DN] (estimated)")
+    group.add_argument("--mesh-px", type=int, default=64,
+                       help="cell size of the background mesh [px] (64); 0: one level for the whole frame")
+    group.add_argument("--centroider", choices=("threshold", "grey", "square"), default="threshold",
+                       help="thresholded (004), grey-level or square-weighted centre of gravity (threshold)")
+    group.add_argument("--min-pixels", type=int, default=1, help="smallest star image kept [px] (1)")
+    group.add_argument("--keep-single-pixels", action="store_true",
+                       help="keep single-pixel events (hot pixels, cosmic rays), which are dropped by default")
+    group.add_argument("--saturation-dn", type=float, default=None,
+                       help="grey level of a saturated pixel [DN] (default: the full scale of the file's bit depth)")
+
+
+def detection_options(args) -> dict:
+    """Keyword arguments of :func:`startrack.detection.detect` from the parsed options (checked)."""
+    for option, value in (("--a", args.a), ("--saturation-dn", args.saturation_dn)):
+        if value is not None and (not math.isfinite(value) or value <= 0):
+            raise InputError(f"option {option} = {value} must be a positive finite number")
+    for option, value in (("--background-dn", args.background_dn), ("--sigma-n-dn", args.sigma_n_dn)):
+        if value is not None and (not math.isfinite(value) or value < 0):
+            raise InputError(f"option {option} = {value} must be a finite number >= 0")
+    if args.min_pixels < 1:
+        raise InputError(f"option --min-pixels = {args.min_pixels} must be >= 1")
+    if args.mesh_px != 0 and not 8 <= args.mesh_px <= 4096:
+        raise InputError(f"option --mesh-px = {args.mesh_px} must be 0 or a cell size in [8, 4096] px")
+    return {"background": args.background_dn, "sigma_n": args.sigma_n_dn, "a": args.a, "centroider": args.centroider,
+            "min_pixels": args.min_pixels, "mesh_px": args.mesh_px or None,
+            "reject_single_pixels": not args.keep_single_pixels, "saturation_dn": args.saturation_dn}
+
+
+def detect_frame(frame, options):
+    """:func:`startrack.detection.detect` of a :class:`startrack.image_io.Frame` with ``options``
+    (:func:`detection_options`; saturation at the frame's full scale unless given)."""
+    from startrack.detection import detect
+
+    if options["saturation_dn"] is None:
+        options = {**options, "saturation_dn": frame.full_scale}
+    return detect(frame.image, **options)
+
+
 def register(subparsers):
     parser = subparsers.add_parser(
         "detect",
         help="detect stars in an image and print their centroids",
         description="Detect and centroid star images (threshold, connected components, centre of gravity).",
     )
-    parser.add_argument("image", help="frame: .png, .tif/.tiff or .npy")
-    parser.add_argument("--a", type=float, default=5.0, help="threshold factor a of V_th = b + a sigma_n (5)")
-    parser.add_argument("--background-dn", type=float, default=None, help="background level b [DN] (estimated)")
-    parser.add_argument("--sigma-n-dn", type=float, default=None, help="background noise sigma_n [DN] (estimated)")
-    parser.add_argument("--centroider", choices=("threshold", "grey", "square"), default="threshold",
-                        help="thresholded (004), grey-level or square-weighted centre of gravity (threshold)")
-    parser.add_argument("--min-pixels", type=int, default=1, help="smallest star image kept [px] (1)")
-    parser.add_argument("--saturation-dn", type=float, default=4095.0,
-                        help="grey level of a saturated pixel [DN] (4095: 12-bit full scale)")
+    parser.add_argument("image", help="frame: .png, .tif/.tiff, .jpg/.jpeg or .npy")
+    add_detection_options(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=run)
 
 
 def run(args):
-    from startrack.detection import detect
-    from startrack.image_io import read_image
+    from startrack.image_io import read_frame
 
-    for option, value in (("--a", args.a), ("--saturation-dn", args.saturation_dn)):
-        if not math.isfinite(value) or value <= 0:
-            raise InputError(f"option {option} = {value} must be a positive finite number")
-    if args.min_pixels < 1:
-        raise InputError(f"option --min-pixels = {args.min_pixels} must be >= 1")
-    image = read_image(args.image)
+    options = detection_options(args)
+    frame = read_frame(args.image)
+    image = frame.image
     start = time.perf_counter()
-    found = detect(image, background=args.background_dn, sigma_n=args.sigma_n_dn, a=args.a,
-                   centroider=args.centroider, saturation_dn=args.saturation_dn, min_pixels=args.min_pixels)
+    found = detect_frame(frame, options)
     elapsed_ms = 1000.0 * (time.perf_counter() - start)
     if args.json:
         result = {"image": args.image, "height": image.shape[0], "width": image.shape[1],
-                  "centroider": args.centroider, "detect_ms": elapsed_ms, **found.to_dict()}
+                  "centroider": args.centroider, "full_scale_dn": frame.full_scale, "detect_ms": elapsed_ms,
+                  **found.to_dict()}
         print(json.dumps(result))
         return 0
     print(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, b = {found.background:.2f} DN, "

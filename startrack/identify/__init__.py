@@ -10,9 +10,19 @@ sub-catalogs' pairs), :mod:`~startrack.identify.pyramid` (the compiled triangle/
 :mod:`~startrack.identify.warmup` (kernels loaded at construction), :mod:`~startrack.identify.result`
 (the result record) and :mod:`~startrack.identify.identifier` (:class:`StarIdentifier`, the one call
 per frame; each strategy is one compiled call).
+
+Without a calibrated camera (issue 18): :mod:`~startrack.identify.pattern_catalog` (four-star patterns
+keyed by edge ratios, by scale level), :mod:`~startrack.identify.scale_free` (the compiled pattern
+search), :mod:`~startrack.identify.self_calibration` (verification that fits the camera),
+:mod:`~startrack.identify.chance` (the false-match probability from the local density of the
+detections) and :mod:`~startrack.identify.plate_solver` (:class:`PlateSolver`).  Names are imported
+on first use (PEP 562), so a plate solve loads none of the calibrated identifier's tables.
 """
 
-from startrack.identify.identifier import METHODS, Prior, StarIdentifier
-from startrack.identify.result import IdentificationResult
+from startrack.lazy import lazy_exports
 
-__all__ = ["METHODS", "IdentificationResult", "Prior", "StarIdentifier"]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "startrack.identify.identifier": ("METHODS", "Prior", "StarIdentifier"),
+    "startrack.identify.plate_solver": ("PlateSolver",),
+    "startrack.identify.result": ("IdentificationResult",),
+})

@@ -14,17 +14,13 @@ fourth star extended) and returns the first verified hypothesis.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from startrack.identify.features import fill_features
 from startrack.identify.pyramid import TRIANGLE_BUFFER, gate_cosines, no_result, search, verify_triangles
+from startrack.identify.zones import SKY
 from startrack.jit import njit
-
-#: ``region`` of the kernels for the whole sky (cos rho = -2: every star).
-SKY = (np.zeros(3), -2.0)
-
 
 @njit
 def search_tables(frame, widths, tables, stars, region, field):  # pragma: no cover  (compiled)
@@ -74,7 +70,3 @@ class LostInSpace:
         return ctx.verified(search_tables(frame.arrays, ctx.widths, self.tables, self.stars,
                                           SKY, ctx.field_arrays))
 
-
-def cap(axis, radius: float):
-    """``region`` of the kernels: the stars within ``radius`` [rad] of the unit vector ``axis``."""
-    return np.ascontiguousarray(axis, dtype=float), math.cos(min(radius, math.pi))

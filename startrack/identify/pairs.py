@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from startrack.identify.zones import bisect
 from startrack.jit import njit
 from startrack.kvector import KVector
 from startrack.navigation_catalog import pattern_pairs
@@ -104,18 +105,6 @@ class SubCatalogPairs:
         start, stop = self.offsets[b], self.offsets[b + 1]
         return (self.theta[start:stop], self.first[start:stop], self.second[start:stop], _NO_INDEX, 1.0, 0.0,
                 _NO_COUNTS, 0.0, 1.0)
-
-
-@njit(_nrt=False)
-def bisect(values, start, stop, x, right):  # pragma: no cover  (compiled)
-    """First index p in [start, stop) of the ascending ``values`` with values[p] > x (``right``) or >= x."""
-    while start < stop:
-        mid = (start + stop) >> 1
-        if values[mid] < x or (right and values[mid] == x):
-            start = mid + 1
-        else:
-            stop = mid
-    return start
 
 
 @njit(_nrt=False)

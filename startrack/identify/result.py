@@ -36,10 +36,14 @@ class IdentificationResult:
         :attr:`residuals` and :attr:`covariance` are derived from them when asked.
     false_match_probability: chance that a wrong attitude hypothesis explains as many centroids
         (:func:`startrack.identify.verify.false_match_probability`); NaN when nothing was verified.
-    method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space") or "" if none.
+    method: strategy that produced the answer ("tracking", "subcatalog", "lost_in_space"; "pattern" for the
+        plate solver's search without a calibrated camera) or "" if none.
     solve_ms: wall-clock time of the whole call [ms].
     lost_hip / entered_hip: tracking only -- previously tracked stars predicted inside the field but not
         found, and stars identified now that were not tracked before (HIP numbers).
+    calibration: the camera the frame calibrated (:class:`startrack.camera_fit.CameraCalibration`), when
+        the camera was not known (:class:`startrack.identify.plate_solver.PlateSolver`); then
+        :attr:`covariance` is the fit's, which includes the intrinsics' uncertainty.
     """
 
     status: str
@@ -54,6 +58,7 @@ class IdentificationResult:
     solve_ms: float = math.nan
     lost_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     entered_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    calibration: object = None
 
     def __post_init__(self):
         if self.status not in STATUSES:
@@ -96,10 +101,12 @@ class IdentificationResult:
         """(3, 3) attitude-error covariance in sensor axes [rad^2] (x, y cross-boresight, z roll).
 
         The Cramer-Rao bound of the matched stars, which the SVD solution of Wahba's problem attains
-        (:func:`startrack.attitude.cramer_rao_covariance`); NaN unless ok.
+        (:func:`startrack.attitude.cramer_rao_covariance`), or the calibration fit's; NaN unless ok.
         """
         if not self.ok:
             return np.full((3, 3), np.nan)
+        if self.calibration is not None:
+            return self.calibration.covariance[:3, :3].copy()
         return cramer_rao_covariance(self.obs_S, self.sigma)
 
     @property
@@ -124,6 +131,10 @@ class IdentificationResult:
                 sigma_arcsec=[float(s) for s in sigma],
                 false_match_probability=float(self.false_match_probability),
             )
+            if self.calibration is not None:
+                ra, dec, roll = (math.degrees(float(x)) for x in self.calibration.center_radec_roll(self.q_IS))
+                out["center"] = {"ra_deg": ra, "dec_deg": dec, "roll_deg": roll}
+                out["camera"] = self.calibration.to_dict()
             if self.method == "tracking":
                 out["lost_hip"] = [int(h) for h in self.lost_hip]
                 out["entered_hip"] = [int(h) for h in self.entered_hip]

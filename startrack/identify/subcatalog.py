@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import math
 
-from startrack.identify.lost_in_space import SKY, cap, search_tables
+from startrack.identify.lost_in_space import search_tables
+from startrack.identify.zones import SKY, cap
 from startrack.sphere import radec_to_vector
 
 

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from startrack.camera_fit import fold_radius_squared_jit
 from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
@@ -162,6 +163,7 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     :class:`startrack.camera.Camera`.
     """
     focal, cx, cy, width, height, k1, k2, circular = camera_params
+    fold = fold_radius_squared_jit(k1, k2)
     v_S = np.empty_like(stars_I)
     for s in range(stars_I.shape[0]):
         for c in range(3):
@@ -174,6 +176,8 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
         if z <= 0.0:
             continue
         x, y = v_S[s, 0] / z, v_S[s, 1] / z
+        if x * x + y * y >= fold:
+            continue  # beyond the fold of the distortion polynomial: not imaged
         factor = 1.0 + k1 * (x * x + y * y) + k2 * (x * x + y * y) ** 2
         u = cx + focal * x * factor
         v = cy + focal * y * factor

@@ -14,11 +14,29 @@ import math
 
 import numpy as np
 
-from startrack.identify.pairs import bisect
 from startrack.jit import njit
 
 #: Height of a zone [rad].
 ZONE_HEIGHT = math.radians(1.0)
+#: ``region`` of the search kernels for the whole sky (cos rho = -2: every star).
+SKY = (np.zeros(3), -2.0)
+
+
+def cap(axis, radius: float):
+    """``region`` of the search kernels: the stars within ``radius`` [rad] of the unit vector ``axis``."""
+    return np.ascontiguousarray(axis, dtype=float), math.cos(min(radius, math.pi))
+
+
+@njit(_nrt=False)
+def bisect(values, start, stop, x, right):  # pragma: no cover  (compiled)
+    """First index p in [start, stop) of the ascending ``values`` with values[p] > x (``right``) or >= x."""
+    while start < stop:
+        mid = (start + stop) >> 1
+        if values[mid] < x or (right and values[mid] == x):
+            start = mid + 1
+        else:
+            stop = mid
+    return start
 
 
 def zone_index(vectors):
@@ -35,23 +53,27 @@ def zone_index(vectors):
 
 
 @njit(_nrt=False)
-def _collect(zones, vectors, center, cos_radius, z, ra_low, ra_high, out, count):  # pragma: no cover
-    """Append to ``out`` the stars of zone z with RA in [ra_low, ra_high] within the radius; new count."""
+def _collect(zones, vectors, center, cos_radius, z, ra_low, ra_high, out, count, max_star):  # pragma: no cover
+    """Append to ``out`` the stars (index < max_star) of zone z with RA in [ra_low, ra_high] within the
+    radius; new count."""
     offsets, ra, star, _ = zones
     start = bisect(ra, offsets[z], offsets[z + 1], ra_low, False)
     stop = bisect(ra, start, offsets[z + 1], ra_high, True)
     for e in range(start, stop):
         s = star[e]
-        if vectors[s, 0] * center[0] + vectors[s, 1] * center[1] + vectors[s, 2] * center[2] >= cos_radius:
+        if s < max_star and vectors[s, 0] * center[0] + vectors[s, 1] * center[1] + vectors[s, 2] * center[2] >= cos_radius:
             out[count] = s
             count += 1
     return count
 
 
 @njit(_nrt=False)
-def stars_near(zones, vectors, center, radius, out):  # pragma: no cover  (compiled)
+def stars_near(zones, vectors, center, radius, out, max_star=-1):  # pragma: no cover  (compiled)
     """Indices of the unit ``vectors`` within ``radius`` [rad] of the unit vector ``center``, written to
-    ``out`` (module text); returns their number."""
+    ``out`` (module text); returns their number.  ``max_star`` >= 0 keeps only indices below it (the
+    brightest stars of vectors ordered brightest first)."""
+    if max_star < 0:
+        max_star = vectors.shape[0]
     height = zones[3]
     n_zones = zones[0].size - 1
     dec = math.asin(min(1.0, max(-1.0, center[2])))
@@ -65,14 +87,14 @@ def stars_near(zones, vectors, center, radius, out):  # pragma: no cover  (compi
     count = 0
     for z in range(z0, z1 + 1):
         if half >= math.pi:
-            count = _collect(zones, vectors, center, cos_radius, z, 0.0, 2.0 * math.pi, out, count)
+            count = _collect(zones, vectors, center, cos_radius, z, 0.0, 2.0 * math.pi, out, count, max_star)
             continue
         low, high = ra - half, ra + half
         if low < 0.0:
-            count = _collect(zones, vectors, center, cos_radius, z, low + 2.0 * math.pi, 2.0 * math.pi, out, count)
+            count = _collect(zones, vectors, center, cos_radius, z, low + 2.0 * math.pi, 2.0 * math.pi, out, count, max_star)
             low = 0.0
         if high > 2.0 * math.pi:
-            count = _collect(zones, vectors, center, cos_radius, z, 0.0, high - 2.0 * math.pi, out, count)
+            count = _collect(zones, vectors, center, cos_radius, z, 0.0, high - 2.0 * math.pi, out, count, max_star)
             high = 2.0 * math.pi
-        count = _collect(zones, vectors, center, cos_radius, z, low, high, out, count)
+        count = _collect(zones, vectors, center, cos_radius, z, low, high, out, count, max_star)
     return count

@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 from startrack.cli import main
 from startrack.errors import InputError
-from startrack.image_io import read_image, write_image
+from startrack.image_io import full_scale, read_frame, read_image, write_image
 
 
 def _frame():
@@ -42,9 +42,6 @@ def test_bad_image_files(tmp_path):
     (tmp_path / "junk.png").write_text("not a png")
     with pytest.raises(InputError, match="could not be read"):
         read_image(tmp_path / "junk.png")
-    Image.fromarray(np.zeros((4, 4, 3), np.uint8)).save(tmp_path / "rgb.png")
-    with pytest.raises(InputError, match="single-channel"):
-        read_image(tmp_path / "rgb.png")
     np.save(tmp_path / "cube.npy", np.zeros((2, 3, 4)))
     with pytest.raises(InputError, match="2-D"):
         read_image(tmp_path / "cube.npy")
@@ -57,8 +54,11 @@ def test_bad_image_files(tmp_path):
     with pytest.raises(InputError, match="not a readable"):
         read_image(tmp_path / "obj.npy")
     (tmp_path / "f.jpg").write_text("x")
-    with pytest.raises(InputError, match="suffix"):
+    with pytest.raises(InputError, match="could not be read"):
         read_image(tmp_path / "f.jpg")
+    (tmp_path / "f.bmp").write_text("x")
+    with pytest.raises(InputError, match="suffix"):
+        read_image(tmp_path / "f.bmp")
     with pytest.raises(InputError, match=".png"):
         write_image(tmp_path / "f.bmp", _frame())
 
@@ -92,3 +92,33 @@ def test_command_line_bad_input_exits_2(tmp_path, capsys):
     assert main(["render", "--ra-deg", "10", "--dec-deg", "0", "--rate-deg-s", "1,2", "-o",
                  str(tmp_path / "x.png")]) == 2
     assert "--rate-deg-s" in capsys.readouterr().err
+
+
+def test_colour_and_jpeg_frames_are_read_as_luminance(tmp_path):
+    rng = np.random.default_rng(21)
+    rgb = rng.integers(0, 256, (24, 32, 3), dtype=np.uint8)
+    Image.fromarray(rgb).save(tmp_path / "c.png")
+    frame = read_frame(tmp_path / "c.png")
+    expected = rgb.astype(float) @ [0.299, 0.587, 0.114]  # ITU-R BT.601 luma
+    np.testing.assert_allclose(frame.image, expected, atol=1e-9)
+    assert frame.full_scale == 255.0
+    grey = np.full((40, 48), 30, np.uint8)
+    grey[20, 24] = 250
+    Image.fromarray(grey).save(tmp_path / "g.jpg", quality=95)
+    jpeg = read_frame(tmp_path / "g.jpg")
+    assert jpeg.image.shape == (40, 48) and jpeg.full_scale == 255.0
+    assert np.unravel_index(np.argmax(jpeg.image), jpeg.image.shape) == (20, 24)
+    Image.fromarray(rgb).save(tmp_path / "c.jpg", quality=90)
+    assert read_frame(tmp_path / "c.jpg").image.dtype == np.float64
+
+
+@pytest.mark.parametrize("values, scale", [
+    ([0, 17, 4095], 4095.0),                       # 12-bit
+    ([0, 16 * 3, 16 * 4095, 65535], 65520.0),      # 12-bit data scaled by 16, a clipped 65535
+    ([1, 255], 255.0),                             # 8-bit widened
+    ([3, 40000], 65535.0),                         # 16-bit
+    ([5, 1000], 1023.0),                           # 10-bit
+])
+def test_full_scale_from_the_bit_depth(values, scale):
+    assert full_scale(np.array(values, dtype=np.uint16).reshape(1, -1)) == scale
+    assert full_scale(np.array([[0.5, 2.0]])) is None

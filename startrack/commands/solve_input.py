@@ -1,0 +1,169 @@
+"""The frames of ``startrack solve``: images, centroid CSV files, JSON Lines batches, folders and lists.
+
+Every source yields :class:`SolveFrame` records; a frame that cannot be read in a batch becomes a record
+with a reason (its status is "error"), so the other frames are still solved.  A single INPUT that
+cannot be read is bad input (one line, exit 2).
+
+* image (.png/.tif/.tiff/.jpg/.jpeg/.npy): detected and centroided (:mod:`startrack.commands.detect`);
+  its size is the file's;
+* centroid CSV: ``u,v[,flux]`` per line [px], header line optional; ``--width``/``--height`` give
+  the image size;
+* JSON Lines (``--batch FILE.jsonl``): ``{"id": ..., "centroids": [[u, v, flux], ...]}`` per line;
+* folder (``--batch DIR``): its image files, sorted by name;
+* list (``--batch FILE.txt``): one image path per line (relative to the list's folder; # comments).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from startrack.errors import InputError
+from startrack.image_io import IMAGE_SUFFIXES
+
+
+@dataclass(frozen=True)
+class SolveFrame:
+    """One frame to solve: ``uv`` (n, 2) [px], ``flux`` (n,) or None, ``sigma`` (n,) centroid sigma [px]
+    or None, image ``width`` x ``height`` [px]; ``reason`` when it could not be read; ``detection`` a
+    summary of the detection (images)."""
+
+    frame_id: object
+    uv: np.ndarray | None = None
+    flux: np.ndarray | None = None
+    sigma: np.ndarray | None = None
+    width: int | None = None
+    height: int | None = None
+    reason: str | None = None
+    detection: dict | None = None
+
+
+def read_centroid_csv(path):
+    """(uv (n, 2), flux (n,) or None) from a CSV of u,v[,flux] rows; a first non-numeric line is a header."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputError(f"centroid file {path} cannot be read ({error}).") from None
+    rows = [(number, line) for number, line in enumerate(lines, 1) if line.strip() and not line.lstrip().startswith("#")]
+    columns = None
+    if rows:
+        fields = [f.strip().lower() for f in rows[0][1].split(",")]
+        try:
+            [float(f) for f in fields]
+        except ValueError:
+            columns = fields
+            rows = rows[1:]
+            if fields[:2] != ["u", "v"] or fields[2:] not in ([], ["flux"]):
+                raise InputError(f"centroid file {path} has header {','.join(fields)!r}; expected u,v or u,v,flux.")
+    values = []
+    for number, line in rows:
+        try:
+            values.append([float(f) for f in line.split(",")])
+        except ValueError:
+            raise InputError(f"centroid file {path} line {number} is not numbers: {line.strip()!r}.") from None
+    widths = {len(v) for v in values}
+    if len(widths) > 1 or widths - {2, 3} or (columns is not None and widths and widths != {len(columns)}):
+        raise InputError(f"centroid file {path} must have 2 (u,v) or 3 (u,v,flux) columns on every line.")
+    array = np.array(values, dtype=float).reshape(-1, widths.pop() if widths else 2)
+    return array[:, :2], (array[:, 2] if array.shape[1] == 3 else None)
+
+
+def _centroid_rows(rows):
+    """(uv, flux or None) of a JSON "centroids" value, or ValueError."""
+    if not isinstance(rows, list) or any(
+            not isinstance(r, list) or len(r) not in (2, 3)
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in r) for r in rows):
+        raise ValueError('"centroids" must be a list of [u, v] or [u, v, flux] numbers')
+    widths = {len(r) for r in rows}
+    if len(widths) > 1:
+        raise ValueError('"centroids" rows must all have the same length')
+    array = np.array(rows, dtype=float).reshape(-1, widths.pop() if widths else 2)
+    return array[:, :2], (array[:, 2] if array.shape[1] == 3 else None)
+
+
+def batch_jsonl(path, width, height):
+    """SolveFrame records of a JSON Lines file (one per non-empty line)."""
+    try:
+        handle = path.open()
+    except OSError as error:
+        raise InputError(f"batch file {path} cannot be read ({error}).") from None
+    with handle:
+        for number, line in enumerate(handle, 1):
+            if not line.strip():
+                continue
+            frame_id = number
+            try:
+                record = json.loads(line)
+                if not isinstance(record, dict):
+                    raise ValueError("the line is not a JSON object")
+                frame_id = record.get("id", number)
+                unknown = set(record) - {"id", "centroids"}
+                if unknown:
+                    raise ValueError(f"unknown key(s) {', '.join(sorted(unknown))}")
+                if "centroids" not in record:
+                    raise ValueError('the key "centroids" is missing')
+                uv, flux = _centroid_rows(record["centroids"])
+                yield SolveFrame(frame_id, uv, flux, None, width, height)
+            except ValueError as error:  # json.JSONDecodeError is a ValueError
+                yield SolveFrame(frame_id, reason=f"batch file {path.name} line {number}: {error}")
+
+
+def image_frame(path, options, width=None, height=None):
+    """The SolveFrame of an image file: read, size checked against --width/--height, detected."""
+    from startrack.commands.detect import detect_frame
+    from startrack.image_io import read_frame
+
+    frame = read_frame(path)
+    rows, cols = frame.image.shape
+    if (width is not None and width != cols) or (height is not None and height != rows):
+        raise InputError(f"image {path} is {cols} x {rows} px, not --width {width} x --height {height}.")
+    found = detect_frame(frame, options)
+    summary = {"detections": len(found), "background_dn": found.background, "sigma_n_dn": found.sigma_n,
+               "threshold_dn": found.threshold, "full_scale_dn": frame.full_scale}
+    sigma = np.hypot(found.sigma_u, found.sigma_v) / np.sqrt(2.0)
+    sigma = np.where(found.saturated, 3.0 * sigma, sigma)  # a clipped peak biases the centroid
+    return SolveFrame(str(path), found.uv, found.flux, sigma, cols, rows, detection=summary)
+
+
+def _listed_images(path):
+    """Image paths of a folder (sorted) or of a list file (one per line, relative to the list)."""
+    if path.is_dir():
+        images = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
+        if not images:
+            raise InputError(f"batch folder {path} holds no image ({', '.join(IMAGE_SUFFIXES)}).")
+        return images
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputError(f"batch list {path} cannot be read ({error}).") from None
+    return [path.parent / line.strip() for line in lines if line.strip() and not line.lstrip().startswith("#")]
+
+
+def batch_frames(path, options, width, height):
+    """SolveFrame records of ``--batch PATH``: JSON Lines, a folder of images or a list of images."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"batch input {path} does not exist.")
+    if path.is_file() and path.suffix.lower() == ".jsonl":
+        yield from batch_jsonl(path, width, height)
+        return
+    for image in _listed_images(path):
+        try:
+            yield image_frame(image, options)
+        except InputError as error:
+            yield SolveFrame(str(image), reason=str(error))
+
+
+def input_frame(path, options, width, height):
+    """The SolveFrame of one INPUT: an image or a centroid CSV."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"input file {path} does not exist.")
+    if path.suffix.lower() in IMAGE_SUFFIXES:
+        return image_frame(path, options, width, height)
+    uv, flux = read_centroid_csv(path)
+    return SolveFrame(str(path), uv, flux, None, width, height)

@@ -1,0 +1,251 @@
+"""Identification of frames from an unknown camera: field of view, principal point and distortion found
+from the stars (a plate solver).
+
+:class:`PlateSolver` holds the pattern catalog (:mod:`startrack.identify.pattern_catalog`) and the
+verification stars (the same Hipparcos-2 stars, V <= its magnitude limit, at the frames' epoch, in a
+declination-zone index).  ``solve`` orders the detections brightest first, thins them into pattern
+candidates, measures the local density of the detections (a grid of the frame, the false-match
+model of :mod:`startrack.identify.self_calibration`), and runs the compiled search
+(:func:`startrack.identify.scale_free.search`) in chunks of combinations until a hypothesis is
+accepted, the combinations are exhausted or the time budget is spent.  The answer carries the
+calibrated camera (:class:`startrack.camera_fit.CameraCalibration`) with its sigma.
+
+Verification depth: the ``n_predicted`` brightest catalog stars imaged in the frame, twice the
+number of detections within [30, 1000]; the faintest of them is the frame's catalog depth
+(reported as ``mag_limit``), so a rich frame is checked against a deep catalog and a sparse one
+against its brightest stars.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from startrack.camera import Camera
+from startrack.camera_fit import CameraCalibration
+from startrack.errors import InputError
+from startrack.identify.pattern_catalog import PatternCatalogParams, load_pattern_catalog
+from startrack.identify.result import IdentificationResult
+from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
+from startrack.identify.zones import SKY, cap, zone_index
+from startrack.units import DEG
+
+#: Default acceptance threshold of the false-match probability.
+DEFAULT_THRESHOLD = 1e-6
+#: Combinations searched per compiled call between two looks at the clock.
+CHUNK = 48
+#: Cells of the detection-density grid along each image axis.
+DENSITY_CELLS = 8
+#: Detections and predicted stars of the first verification pass.
+FIRST_STARS = 40
+#: Centroid error [px] added in quadrature to every detection's sigma: the pixel noise a detection
+#: reports leaves out the PSF's asymmetries, the pixel response and compression, so without a floor the
+#: brightest stars would take nearly all the weight of the fit.
+SIGMA_FLOOR_PX = 0.1
+
+
+def _density_grid(uv, width, height):
+    """(detections per px^2 on a DENSITY_CELLS^2 grid, box-smoothed over 3 x 3 cells and never below the
+    frame's mean, cell width, cell height)."""
+    counts, _, _ = np.histogram2d(uv[:, 1], uv[:, 0], bins=DENSITY_CELLS, range=[[-0.5, height - 0.5], [-0.5, width - 0.5]])
+    padded = np.pad(counts, 1)
+    cells = np.pad(np.ones_like(counts), 1)
+    window = sum(padded[i:i + DENSITY_CELLS, j:j + DENSITY_CELLS] for i in range(3) for j in range(3))
+    area = sum(cells[i:i + DENSITY_CELLS, j:j + DENSITY_CELLS] for i in range(3) for j in range(3))
+    cell_w, cell_h = width / DENSITY_CELLS, height / DENSITY_CELLS
+    density = np.maximum(window / (area * cell_w * cell_h), len(uv) / (width * height))
+    return np.ascontiguousarray(density), float(cell_w), float(cell_h)
+
+
+class PlateSolver:
+    """Star identification and camera calibration of frames whose field of view is unknown.
+
+    fov_range: (min, max) field of view across the image width [rad] (default: the pattern catalog's);
+    epoch: of the star positions [Julian year]; threshold: largest accepted false-match probability;
+    time_budget_s: search time per frame before ``no_match``; final_gate_px: match radius of the last
+    verification passes [px]; principal_point_sigma: prior sigma of the principal point about the
+    image centre, as a fraction of the larger image side; k1_sigma, k2_sigma: prior sigma of the
+    distortion about 0 (k2_sigma = 0 holds k2 at 0); mag_limit: faintest star of the verification
+    [V mag] (default: the pattern catalog's, 8); progress: show the pattern catalog's build.
+    """
+
+    def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
+                 principal_point_sigma=0.005, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
+        from startrack.star_catalog import load_star_catalog
+
+        defaults = PatternCatalogParams()
+        low, high = (defaults.fov_min, defaults.fov_max) if fov_range is None else (float(fov_range[0]), float(fov_range[1]))
+        if not (0.5 * DEG <= low <= high <= 90.0 * DEG):
+            raise InputError(f"field of view range [{low / DEG:g}, {high / DEG:g}] deg must lie within [0.5, 90] deg.")
+        for name, value, top in (("threshold", threshold, 1.0), ("time_budget_s", time_budget_s, 3600.0),
+                                 ("final_gate_px", final_gate_px, 100.0), ("principal_point_sigma", principal_point_sigma, 1.0)):
+            if not (math.isfinite(value) and 0.0 < value <= top):
+                raise InputError(f"plate solver option {name} = {value!r} must lie in (0, {top:g}].")
+        if not (0.0 <= k1_sigma < math.inf and 0.0 <= k2_sigma < math.inf):
+            raise InputError("plate solver options k1_sigma and k2_sigma must be finite and >= 0.")
+        inside = defaults.fov_min <= low and high <= defaults.fov_max
+        params = defaults if inside else PatternCatalogParams(fov_min=min(low, defaults.fov_min), fov_max=max(high, defaults.fov_max))
+        self.fov_range = (low, high)
+        self.threshold, self.time_budget_s, self.final_gate_px = float(threshold), float(time_budget_s), float(final_gate_px)
+        self.prior_sigma = np.array([math.inf, principal_point_sigma, principal_point_sigma, k1_sigma, k2_sigma])
+        self.catalog = load_pattern_catalog(params, progress=progress)
+        stars = load_star_catalog(epoch).brighter_than(params.mag_limit)
+        position = np.searchsorted(stars.hip, self.catalog.hip)
+        if stars.hip.size != self.catalog.hip.size or not np.array_equal(stars.hip[position], self.catalog.hip):
+            raise InputError("pattern catalog and star catalog disagree (stale cache): remove the patterns-* cache folder.")
+        self.hip = np.asarray(self.catalog.hip, np.int64)  # brightest first
+        self.vectors = np.ascontiguousarray(stars.vectors[position], dtype=float)
+        self.v_mag = np.ascontiguousarray(stars.v_mag[position], dtype=float)
+        cap = params.mag_limit if mag_limit is None else float(mag_limit)
+        if not math.isfinite(cap) or not -2.0 <= cap <= params.mag_limit:
+            raise InputError(f"verification magnitude limit {mag_limit!r} must lie in [-2, {params.mag_limit:g}] mag.")
+        self.field = (self.vectors, self.v_mag, zone_index(self.vectors), int(np.searchsorted(self.v_mag, cap, "right")))
+        ratio = params.level_ratio
+        self.levels = [level for level in self.catalog.levels if level.fov / ratio < high and level.fov >= low]
+        self._arrays = tuple(level.arrays for level in self.levels)
+        self._mid_fov = np.array([level.fov / math.sqrt(ratio) for level in self.levels])
+        self._per_lookup = sum(expected_candidates(level) for level in self.levels)
+        start = time.perf_counter()
+        self._warm_up()
+        self.load_ms = 1e3 * (time.perf_counter() - start)
+
+    # ------------------------------------------------------------------ public
+    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None,
+              boresight=None) -> IdentificationResult:
+        """Identify the detections ``uv`` (n, 2) [px] of a ``width`` x ``height`` frame; ``flux`` orders them
+        (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3, with
+        :data:`SIGMA_FLOOR_PX` added in quadrature);
+        ``fov_hint`` [rad] searches the levels nearest it first; ``camera`` a
+        :class:`startrack.camera_file.CameraFile` known before (its focal length within 1 % or 3 sigma,
+        its principal point and distortion as the priors' means, within 3 times its sigma; InputError if
+        its size differs); ``boresight`` = (axis (3,) unit vector, radius [rad]): the hypotheses whose
+        pattern starts inside that cap are searched first, then the whole sky.  Never raises for the
+        frame's content."""
+        start = time.perf_counter()
+        checked = self._checked(uv, width, height, flux, sigma_px)
+        if isinstance(checked, str):
+            return _failed("error", checked, start)
+        uv, sigma, index = checked
+        candidates = pattern_candidates(uv, max(width, height) / 20.0)
+        if candidates.size < 4:
+            return _failed("too_few", f"{candidates.size} separated detections; at least 4 are needed", start)
+        params, prior, f_range = self._start(width, height, camera)
+        settings = (self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0,
+                    prior, _density_grid(uv, width, height), self.threshold)
+        regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
+        n_combinations = int(COMBINATIONS_BELOW[candidates.size])
+        frame = (uv, sigma, candidates, self._level_order(fov_hint if camera is None else camera.camera.fov_x),
+                 width / 2.0 / np.tan(self._mid_fov / 2.0), f_range, params, settings,
+                 float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
+        tried = 0
+        for region in regions:
+            result, count, done = self._search(frame, region, start)
+            tried += count
+            if result[0]:
+                return self._result(result, uv, sigma, index, width, height, start)
+            if done < n_combinations:
+                return _failed("no_match", f"time budget of {self.time_budget_s:g} s spent after {done} of "
+                               f"{n_combinations} patterns ({tried} hypotheses verified)", start)
+        return _failed("no_match", f"no pattern of the {candidates.size} brightest separated detections verified "
+                       f"({tried} hypotheses)", start)
+
+    def _search(self, frame, region, start):
+        """(verify_calibrate's tuple, hypotheses verified, combinations searched) of the compiled search in
+        chunks of :data:`CHUNK` combinations, stopped by the time budget."""
+        uv, sigma, candidates, order, focal, f_range, params, settings, n_hypotheses = frame
+        n_combinations = int(COMBINATIONS_BELOW[candidates.size])
+        done, tried = 0, 0
+        while done < n_combinations:
+            result, count, done = search(uv, sigma, candidates, done, done + CHUNK, self._arrays, order, focal,
+                                         self.vectors, f_range, params, region, self.field, settings, n_hypotheses)
+            tried += count
+            if result[0] or time.perf_counter() - start > self.time_budget_s:
+                return result, tried, done
+        return result, tried, done
+
+    # ------------------------------------------------------------------ internals
+    def _start(self, width, height, known):
+        """(camera parameters the hypotheses start from, prior (mean (5,), sigma (5,): inf free without a
+        prior, 0 held) of (f, cx, cy, k1, k2), focal-length range (2,) [px]) for a frame, with or without a
+        known camera (a :class:`startrack.camera_file.CameraFile`)."""
+        params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0])
+        sigma = self.prior_sigma.copy()
+        sigma[1:3] *= max(width, height)
+        f_range = np.array([width / 2.0 / math.tan(self.fov_range[1] / 2.0), width / 2.0 / math.tan(self.fov_range[0] / 2.0)])
+        if known is not None:
+            cam = known.camera
+            if (cam.width, cam.height) != (width, height):
+                raise InputError(f"the camera is {cam.width} x {cam.height} px, the frame {width} x {height} px.")
+            params[[1, 2, 5, 6]] = cam.cx, cam.cy, cam.k1, cam.k2
+            for k, name in enumerate(("cx", "cy", "k1", "k2")):
+                if name in known.sigma:
+                    sigma[k + 1] = 3.0 * known.sigma[name]
+            spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
+            f_range = np.array([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)])
+        return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
+
+    def _level_order(self, fov_hint):
+        if fov_hint is None:
+            return np.arange(len(self.levels), dtype=np.int64)
+        return np.argsort(np.abs(np.log(self._mid_fov / float(fov_hint))), kind="stable").astype(np.int64)
+
+    @staticmethod
+    def _checked(uv, width, height, flux, sigma_px):
+        """(uv brightest first, sigma, their input positions) or the reason the input cannot be solved."""
+        for name, value in (("width", width), ("height", height)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 16 <= value <= 100_000:
+                return f"image {name} must be an integer number of pixels in [16, 100000], got {value!r}"
+        try:
+            uv = np.asarray(uv, dtype=float).reshape(-1, 2)
+            flux = None if flux is None else np.asarray(flux, dtype=float).reshape(-1)
+            sigma = np.full(len(uv), 0.3) if sigma_px is None else np.asarray(sigma_px, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            return "centroids, flux and sigma must be numbers (uv of shape (n, 2))"
+        if not np.all(np.isfinite(uv)) or (flux is not None and not np.all(np.isfinite(flux))) \
+                or not np.all(np.isfinite(sigma)):
+            return "a centroid, flux or sigma is NaN or infinite"
+        if (flux is not None and flux.shape != (len(uv),)) or sigma.shape != (len(uv),):
+            return f"flux and sigma need one value per centroid ({len(uv)})"
+        index = np.arange(len(uv)) if flux is None else np.argsort(-flux, kind="stable")
+        inside = (uv[index, 0] >= -0.5) & (uv[index, 0] <= width - 0.5) & (uv[index, 1] >= -0.5) & (uv[index, 1] <= height - 0.5)
+        if len(uv) and not inside.any():
+            return f"all {len(uv)} centroids lie outside the {width} x {height} px image"
+        index = index[inside]
+        return np.ascontiguousarray(uv[index]), np.ascontiguousarray(np.hypot(sigma[index], SIGMA_FLOOR_PX)), index
+
+    def _result(self, result, uv, sigma, index, width, height, start):
+        _, R_IS, params, covariance, obs_index, star_index, probability, n_predicted, _, reduced = result
+        camera = Camera(width, height, params[0], cx=params[1], cy=params[2], k1=params[5], k2=params[6])
+        order = np.argsort(index[obs_index], kind="stable")
+        obs_index, star_index = obs_index[order], star_index[order]
+        residual = uv[obs_index] - camera.project_body(self.vectors[star_index] @ R_IS)[0]
+        rms = float(np.sqrt(np.mean(residual**2)))
+        calibration = CameraCalibration(camera, covariance, float(reduced), rms, int(obs_index.size), int(n_predicted),
+                                        float(self.v_mag[star_index].max()))
+        from startrack.rotation import from_matrix
+
+        return IdentificationResult(
+            status="ok", q_IS=from_matrix(R_IS), matches=np.column_stack([index[obs_index], self.hip[star_index]]),
+            obs_S=camera.unproject(uv[obs_index]), ref_I=self.vectors[star_index], sigma=rms / camera.focal_px,
+            false_match_probability=float(probability), method="pattern", calibration=calibration,
+            solve_ms=1e3 * (time.perf_counter() - start))
+
+    def _warm_up(self):
+        """Load (or compile) the kernels: an identifiable frame of catalog stars and an unidentifiable one."""
+        from startrack.rotation import from_rotation_vector
+
+        fov = math.sqrt(self.fov_range[0] * self.fov_range[1])
+        camera = Camera.from_fov(fov, 1024, 768)
+        q_IS = from_rotation_vector(np.array([0.4, 1.1, 0.3]))
+        seen = camera.stars_in_field(q_IS, self.vectors)
+        seen = seen[np.argsort(self.v_mag[seen], kind="stable")][:30]
+        uv, _ = camera.project(q_IS, self.vectors[seen])
+        self.solve(uv, 1024, 768, fov_hint=fov)
+        phase = np.linspace(0.0, 2.0 * math.pi, 9)[:-1]
+        self.solve(np.column_stack([511.5 + 200 * np.cos(phase), 383.5 + 200 * np.sin(phase)]), 1024, 768)
+
+
+def _failed(status, reason, start):
+    return IdentificationResult(status=status, reason=reason + ".", solve_ms=1e3 * (time.perf_counter() - start))

@@ -1,0 +1,291 @@
+"""Field-of-view-free star identification: observed four-star patterns looked up by their edge ratios.
+
+For the brightest detections (thinned to a minimum separation, :func:`pattern_candidates`), the
+four-star combinations are taken breadth first -- every combination of the first n stars before any
+with star n + 1 (:data:`COMBINATIONS`) -- and each is looked up in every level of the pattern catalog
+(:mod:`startrack.identify.pattern_catalog`), the levels nearest a field-of-view hint first:
+
+1. unit vectors with the level's focal length f_l (principal point at the image centre), the five
+   edge ratios and their tolerance eps = level tolerance + 4 sqrt 2 sigma / e_6 (e_6 the largest edge
+   [px], sigma the largest centroid sigma of the four);
+2. every key of the bins within +-eps of the ratios; each catalog pattern of those keys whose ratios
+   all lie within eps is a candidate;
+3. the star correspondence: of the 24 assignments of the catalog stars to the observed ones, the one
+   with the smallest sum of squared ratio differences over the six edges;
+4. the focal length f with the observed angles' sum equal to the catalog's (fixed-point iteration
+   f <- f S(f) / S_cat, S the sum of the six angles: the angles scale as 1/f to first order), kept
+   when the field of view lies in the allowed range;
+5. the attitude by SVD (Wahba's problem, Markley 1988) of the four stars; a mirror image of the
+   pattern (same edges, other handedness) leaves residuals of the pattern's own size and is dropped;
+6. :func:`startrack.identify.self_calibration.verify_calibrate`; the first accepted hypothesis ends
+   the search.
+
+One compiled call searches the combinations [start, stop); the caller checks the time budget between
+calls.  N_h, the hypotheses the search can make, counts every combination of the candidates times
+the expected catalog candidates per look-up of each level (:func:`expected_candidates`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from startrack.identify.pattern_catalog import edge_ratios, pack_key, run_start
+from startrack.identify.self_calibration import brightest_in_field, verify_calibrate
+from startrack.identify.zones import stars_near
+from startrack.jit import njit
+from startrack.rotation_jit import wahba_svd
+
+#: Most detections whose combinations are searched.
+MAX_CANDIDATES = 24
+#: Four-star combinations of range(MAX_CANDIDATES), breadth first (largest member ascending, then lexical).
+COMBINATIONS = np.array(sorted(itertools.combinations(range(MAX_CANDIDATES), 4), key=lambda c: (c[3], c)), np.int64)
+#: The 24 assignments of four catalog stars to four observed ones.
+PERMUTATIONS = np.array(list(itertools.permutations(range(4))), np.int64)
+#: Combinations whose largest member is below n, for n = 0 .. MAX_CANDIDATES.
+COMBINATIONS_BELOW = np.searchsorted(COMBINATIONS[:, 3], np.arange(MAX_CANDIDATES + 1)).astype(np.int64)
+
+
+def pattern_candidates(uv, separation_px: float, limit: int = MAX_CANDIDATES) -> np.ndarray:
+    """Indices of the first ``limit`` detections (brightest first) kept by thinning to a minimum
+    separation [px] (the pattern catalog's thinning in the image)."""
+    kept = []
+    for i in range(len(uv)):
+        if all((uv[i, 0] - uv[j, 0]) ** 2 + (uv[i, 1] - uv[j, 1]) ** 2 >= separation_px**2 for j in kept):
+            kept.append(i)
+            if len(kept) == limit:
+                break
+    return np.array(kept, np.int64)
+
+
+def expected_candidates(level) -> float:
+    """Expected catalog patterns per look-up of ``level``: the 2^5 keys visited times the mean number of
+    patterns that share a key with a pattern (sum of squared run lengths over the patterns)."""
+    if level.keys.size == 0:
+        return 0.0
+    runs = np.diff(np.flatnonzero(np.r_[True, np.diff(level.keys) != 0, True]))
+    return 32.0 * float(np.sum(runs.astype(float) ** 2) / level.keys.size)
+
+
+@njit
+def _unit_vectors(uv, stars, focal, cx, cy):  # pragma: no cover  (compiled)
+    out = np.empty((4, 3))
+    for i in range(4):
+        x, y = (uv[stars[i], 0] - cx) / focal, (uv[stars[i], 1] - cy) / focal
+        norm = math.sqrt(x * x + y * y + 1.0)
+        out[i, 0], out[i, 1], out[i, 2] = x / norm, y / norm, 1.0 / norm
+    return out
+
+
+@njit
+def _angle_matrix(vectors, stars):  # pragma: no cover  (compiled)
+    """(4, 4) angular distances [rad] of the four unit vectors ``vectors[stars]``."""
+    out = np.zeros((4, 4))
+    for i in range(4):
+        for j in range(i + 1, 4):
+            a, b = vectors[stars[i]], vectors[stars[j]]
+            c = min(1.0, max(-1.0, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]))
+            out[i, j] = out[j, i] = math.acos(c)
+    return out
+
+
+@njit
+def _correspondence(observed, catalog):  # pragma: no cover  (compiled)
+    """(permutation p, cost): catalog star p[i] for observed star i minimising the sum of squared
+    differences of the six normalised angles (``observed``, ``catalog``: (4, 4) angle matrices)."""
+    scale_o, scale_c = observed.max(), catalog.max()
+    best, best_cost = 0, np.inf
+    for k in range(PERMUTATIONS.shape[0]):
+        p = PERMUTATIONS[k]
+        cost = 0.0
+        for i in range(4):
+            for j in range(i + 1, 4):
+                cost += (observed[i, j] / scale_o - catalog[p[i], p[j]] / scale_c) ** 2
+        if cost < best_cost:
+            best, best_cost = k, cost
+    return PERMUTATIONS[best], best_cost
+
+
+@njit
+def _focal_length(uv, stars, cx, cy, focal, catalog_sum):  # pragma: no cover  (compiled)
+    """f [px] with the six observed angles summing to ``catalog_sum`` (module text, step 4)."""
+    index = np.arange(4)
+    for _ in range(4):
+        vectors = _unit_vectors(uv, stars, focal, cx, cy)
+        focal *= _angle_matrix(vectors, index).sum() / (2.0 * catalog_sum)
+    return focal
+
+
+@njit
+def _hypothesis(uv, stars, cat, vectors, cx, cy, f_start, f_range, eps):  # pragma: no cover  (compiled)
+    """(ok, R_IS, f) of the observed pattern ``stars`` (indices into uv) matched to the catalog pattern
+    ``cat`` (indices into vectors): correspondence, focal length, attitude and the mirror check."""
+    catalog = _angle_matrix(vectors, cat)
+    observed = _angle_matrix(_unit_vectors(uv, stars, f_start, cx, cy), np.arange(4))
+    perm, cost = _correspondence(observed, catalog)
+    if cost > 6.0 * eps * eps:
+        return False, np.eye(3), 0.0
+    focal = _focal_length(uv, stars, cx, cy, f_start, catalog.sum() / 2.0)
+    if not f_range[0] <= focal <= f_range[1]:
+        return False, np.eye(3), 0.0
+    seen = _unit_vectors(uv, stars, focal, cx, cy)
+    ref = np.empty((4, 3))
+    for i in range(4):
+        ref[i] = vectors[cat[perm[i]]]
+    R_IS = wahba_svd(ref, seen)
+    worst = 0.0
+    for i in range(4):
+        c = 0.0
+        for k in range(3):
+            c += (ref[i, 0] * R_IS[0, k] + ref[i, 1] * R_IS[1, k] + ref[i, 2] * R_IS[2, k]) * seen[i, k]
+        worst = max(worst, math.acos(min(1.0, c)))
+    return worst <= 3.0 * eps * catalog.max(), R_IS, focal
+
+
+#: Brightest candidates beyond a pattern's four that :func:`_more_stars` looks up, and how many must be found.
+EXTRA_LOOKUPS, EXTRA_FOUND = 8, 2
+
+
+@njit
+def _more_stars(uv, candidates, members, R_IS, focal, cx, cy, gate, field, near):  # pragma: no cover  (compiled)
+    """Whether at least EXTRA_FOUND (or all, if fewer remain) of the next EXTRA_LOOKUPS brightest
+    candidates outside the pattern ``members`` fall within ``gate`` [rad] of a field star under the
+    hypothesis (R_IS, pinhole f): the fifth-star check of the pyramid search (001 §4.4.3) before the
+    costly verification."""
+    vectors, zones = field[0], field[2]
+    params = np.array([focal, cx, cy, 2.0 * cx + 1.0, 2.0 * cy + 1.0])
+    max_star = brightest_in_field(3.0 * (4 + EXTRA_LOOKUPS), params, field[3])
+    direction = np.empty(3)
+    looked, found = 0, 0
+    for i in range(candidates.size):
+        if looked == EXTRA_LOOKUPS or found == EXTRA_FOUND:
+            break
+        if i == members[0] or i == members[1] or i == members[2] or i == members[3]:
+            continue
+        looked += 1
+        x, y = (uv[candidates[i], 0] - cx) / focal, (uv[candidates[i], 1] - cy) / focal
+        norm = math.sqrt(x * x + y * y + 1.0)
+        for k in range(3):
+            direction[k] = (R_IS[k, 0] * x + R_IS[k, 1] * y + R_IS[k, 2]) / norm
+        if stars_near(zones, vectors, direction, gate, near, max_star) > 0:
+            found += 1
+    return found >= min(EXTRA_FOUND, looked)
+
+
+@njit
+def _gates(eps, width, final):  # pragma: no cover  (compiled)
+    """(g_1, g_2, r) [px]: the first gate covers the pattern's relative error eps across the image width
+    (twice over), within [4 r, width / 20]; the second is a quarter of it, at least 2 r."""
+    first = min(max(2.0 * eps * width, 4.0 * final), max(width / 20.0, 4.0 * final))
+    return np.array([first, max(first / 4.0, 2.0 * final), final])
+
+
+@njit
+def _bin_ranges(ratios, eps, width, base):  # pragma: no cover  (compiled)
+    low = np.empty(5, np.int64)
+    high = np.empty(5, np.int64)
+    for k in range(5):
+        low[k] = min(max(int((ratios[k] - eps) / width), 0), base - 1)
+        high[k] = min(max(int((ratios[k] + eps) / width), 0), base - 1)
+    return low, high
+
+
+#: Catalog candidates gathered per observed pattern (over every level) before they are verified.
+CANDIDATE_BUFFER = 256
+
+
+@njit
+def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors, cx, cy, region,
+            found):  # pragma: no cover  (compiled)
+    """Catalog patterns matching the observed ``stars`` in every level, with their first star inside
+    ``region`` = (axis (3,), cos rho) (cos rho = -2: the whole sky): rows (level, pattern row) of
+    ``found`` and their ratio mismatch max_k |r_k - r_k,cat| and tolerance eps; returns
+    (count, mismatch, eps) (module text, steps 1-2)."""
+    axis, cos_radius = region
+    bins = np.empty(5, np.int64)
+    mismatch = np.empty(found.shape[0])
+    tolerance_of = np.empty(found.shape[0])
+    count = 0
+    for l in level_order:
+        cat_stars, keys, slots, width, base, tolerance = levels[l]
+        ratios, _, _ = edge_ratios(_unit_vectors(uv, stars, level_focal[l], cx, cy), np.arange(4))
+        eps = tolerance + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
+        low, high = _bin_ranges(ratios, eps, width, base)
+        bins[:] = low
+        while True:
+            key = pack_key(bins, base)
+            e = run_start(key, keys, slots)
+            while 0 <= e < keys.size and keys[e] == key and count < found.shape[0]:
+                first = vectors[cat_stars[e, 0]]
+                if first[0] * axis[0] + first[1] * axis[1] + first[2] * axis[2] < cos_radius:
+                    e += 1
+                    continue
+                cat_ratios, _, _ = edge_ratios(vectors, cat_stars[e])
+                worst = np.abs(cat_ratios - ratios).max()
+                if worst <= eps:
+                    found[count, 0], found[count, 1] = l, e
+                    mismatch[count], tolerance_of[count] = worst, eps
+                    count += 1
+                e += 1
+            k = 0  # next bin combination (odometer over the five ranges)
+            while k < 5 and bins[k] == high[k]:
+                bins[k] = low[k]
+                k += 1
+            if k == 5:
+                break
+            bins[k] += 1
+    return count, mismatch[:count], tolerance_of[:count]
+
+
+@njit
+def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal, vectors, f_range, camera, region,
+           field, settings, n_hypotheses):  # pragma: no cover  (compiled)
+    """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text);
+    the catalog candidates of a combination are verified in order of their ratio mismatch.
+
+    uv (n, 2), sigma (n,): detections brightest first [px]; ``levels``: tuple of
+    :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`, looked up in ``level_order`` with
+    the focal lengths ``level_focal`` [px]; ``vectors`` the pattern stars' unit vectors; f_range (2,)
+    [px]; ``camera`` (f, cx, cy, W, H, k1, k2, circular) the start of the calibration (f replaced);
+    ``region`` for :func:`_gather`.  Returns (verify_calibrate's tuple, hypotheses verified, next
+    combination)."""
+    cx, cy = camera[1], camera[2]
+    near = np.empty(field[0].shape[0], np.int64)
+    stars = np.empty(4, np.int64)
+    found = np.empty((CANDIDATE_BUFFER, 2), np.int64)
+    tried = 0
+    stop = min(stop, COMBINATIONS_BELOW[candidates.size])
+    for c in range(start, stop):
+        for i in range(4):
+            stars[i] = candidates[COMBINATIONS[c, i]]
+        largest_px, worst_sigma = 0.0, 0.0
+        for i in range(4):
+            worst_sigma = max(worst_sigma, sigma[stars[i]])
+            for j in range(i + 1, 4):
+                largest_px = max(largest_px, math.hypot(uv[stars[i], 0] - uv[stars[j], 0], uv[stars[i], 1] - uv[stars[j], 1]))
+        count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors,
+                                          cx, cy, region, found)
+        for k in np.argsort(mismatch):
+            l, eps = found[k, 0], eps_of[k]
+            cat = levels[l][0][found[k, 1]]
+            ok, R_IS, focal = _hypothesis(uv, stars, cat, vectors, cx, cy, level_focal[l], f_range, eps)
+            if not ok:
+                continue
+            gates = _gates(eps, camera[3], settings[0])
+            if not _more_stars(uv, candidates, COMBINATIONS[c], R_IS, focal, cx, cy, gates[0] / focal, field, near):
+                continue
+            tried += 1
+            params = camera.copy()
+            params[0] = focal
+            result = verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypotheses)
+            if result[0]:
+                return result, tried, c + 1
+    return _nothing(camera), tried, stop
+
+
+@njit
+def _nothing(camera):  # pragma: no cover  (compiled)
+    empty = np.zeros(0, np.int64)
+    return False, np.eye(3), camera.copy(), np.zeros((8, 8)), empty, empty, 1.0, 0, 0.0, 0.0

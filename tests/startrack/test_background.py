@@ -1,0 +1,72 @@
+"""Mesh background (startrack.background) and the detection of real-frame features: vignetting and
+nebulosity, hot pixels (single-pixel events), full scale."""
+
+import numpy as np
+import pytest
+
+from startrack.background import estimate_background, mesh_background
+from startrack.detection import detect
+from startrack.render import SensorModel, Sources, render
+
+
+def _vignetted(rng, shape=(480, 640), sigma=7.0):
+    """A background falling from 150 DN at the centre to ~90 DN in the corners, Gaussian noise ``sigma``."""
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+    r2 = ((rows - shape[0] / 2) / shape[0]) ** 2 + ((cols - shape[1] / 2) / shape[1]) ** 2
+    level = 150.0 - 120.0 * r2
+    return level, level + rng.normal(0.0, sigma, shape)
+
+
+def test_mesh_follows_vignetting_the_global_level_does_not():
+    rng = np.random.default_rng(31)
+    level, frame = _vignetted(rng)
+    background = mesh_background(frame, 64)
+    rows, cols = np.mgrid[0:480:7, 0:640:7]
+    b, s = background.at(rows.ravel(), cols.ravel())
+    error = np.abs(b - level[rows, cols].ravel())
+    assert np.median(error) < 0.15 * 7.0 and error.max() < 7.0  # within sigma up to the corners
+    assert np.median(s) == pytest.approx(7.0, rel=0.12)  # the gradient across a 64 px cell adds a little
+    _, global_sigma = estimate_background(frame)
+    assert global_sigma > 1.3 * 7.0  # the gradient inflates one level's noise
+
+
+def test_nebulous_8_bit_frame_keeps_its_stars_with_a_mesh():
+    """A bright nebula near the 8-bit full scale: one level puts the threshold out of reach (no star),
+    the mesh follows the nebula and finds the stars on both sides of it."""
+    rng = np.random.default_rng(32)
+    rows, cols = np.mgrid[0:300, 0:400]
+    nebula = 140.0 + 90.0 * np.sin(cols / 100.0) * np.cos(rows / 120.0)
+    stars = [(63.0, 120.0), (250.0, 150.0), (330.0, 40.0), (190.0, 260.0), (20.0, 20.0)]
+    frame = nebula + rng.normal(0.0, 2.0, nebula.shape)
+    for u, v in stars:
+        frame += 40.0 * np.exp(-((cols - u) ** 2 + (rows - v) ** 2) / (2 * 0.8**2))
+    frame = np.clip(np.rint(frame), 0, 255)
+    assert len(detect(frame, saturation_dn=255)) == 0
+    found = detect(frame, mesh_px=32, saturation_dn=255)
+    near = [np.min(np.hypot(found.u - u, found.v - v)) < 1.0 for u, v in stars]
+    assert all(near)
+
+
+def test_hot_pixels_are_single_pixel_events_stars_are_not():
+    sensor = SensorModel(hot_pixel_count=40, hot_pixel_e_per_s=3.0e5)
+    rng = np.random.default_rng(33)
+    uv = rng.uniform(20, 492, (60, 2))
+    frame = render(sensor, 512, 512, [Sources(uv, rng.uniform(2e3, 5e4, 60), sensor.psf_sigma_px)], rng)
+    found = detect(frame, mesh_px=64, saturation_dn=sensor.saturation_dn)
+    hot_r, hot_c = sensor.hot_pixels(512, 512)
+    is_hot = np.array([np.min(np.hypot(hot_c - u, hot_r - v)) < 0.5 for u, v in found.uv])
+    is_star = np.array([np.min(np.hypot(*(uv - p).T)) < 1.0 for p in found.uv])
+    assert found.single_pixel[is_hot & ~is_star].mean() > 0.9  # bright hot pixels are told apart
+    assert not found.single_pixel[is_star & ~is_hot].any()
+    kept = detect(frame, mesh_px=64, reject_single_pixels=True)
+    assert len(kept) == int(np.count_nonzero(~found.single_pixel))
+
+
+def test_uniform_background_detection_is_unchanged_by_a_given_level():
+    rng = np.random.default_rng(34)
+    sensor = SensorModel()
+    frame = render(sensor, 256, 256, [Sources(rng.uniform(10, 246, (20, 2)), rng.uniform(5e3, 5e4, 20),
+                                              sensor.psf_sigma_px)], rng)
+    given = detect(frame, background=sensor.background_dn, sigma_n=sensor.noise_dn)
+    assert given.background == sensor.background_dn and given.sigma_n == sensor.noise_dn
+    assert len(given) >= 15

@@ -1,0 +1,106 @@
+"""``startrack solve`` on images: batches of folders and lists in one process, JPEG and colour input,
+bad input (missing, corrupt, empty, all-dark, NaN frames; wrong options) answered with one line."""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from startrack.cli import main
+from startrack.image_io import read_image
+
+FRAMES = sorted((Path(__file__).resolve().parents[1] / "data" / "realsky").glob("*.tiff"))
+
+
+def _run(capsys, argv):
+    status = main(argv)
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def _as_8_bit(path):
+    """The 16-bit (12-bit data scaled by 16) frame stretched to 8 bits between its 0.5 and 99.95 percentiles."""
+    image = read_image(path).astype(float)
+    low, high = np.percentile(image, [0.5, 99.95])
+    return np.clip((image - low) / (high - low) * 255.0, 0, 255).astype(np.uint8)
+
+
+def test_batch_folder_solves_every_image_and_reports_a_broken_one(tmp_path, capsys):
+    folder = tmp_path / "night"
+    folder.mkdir()
+    for frame in FRAMES[:2]:
+        shutil.copy(frame, folder / frame.name)
+    (folder / "zz-broken.png").write_bytes(b"not an image")
+    (folder / "notes.txt").write_text("not a frame")
+    status, out, err = _run(capsys, ["solve", "--batch", str(folder), "--json"])
+    records = [json.loads(line) for line in out.splitlines()]
+    assert status == 1 and err == ""
+    assert [r["status"] for r in records] == ["ok", "ok", "error"]
+    assert "could not be read" in records[2]["reason"]
+    assert all(r["camera"]["width"] == 1024 and r["detection"]["detections"] > 50 for r in records[:2])
+
+
+def test_batch_list_of_images_and_several_inputs(tmp_path, capsys):
+    listing = tmp_path / "frames.txt"
+    listing.write_text("# two frames\n" + "\n".join(str(f) for f in FRAMES[:2]) + "\n")
+    status, out, _ = _run(capsys, ["solve", "--batch", str(listing)])
+    assert status == 0 and out.count(": ok  RA") == 2 and out.count("camera: FOV") == 2
+    status, out, _ = _run(capsys, ["solve", str(FRAMES[0]), str(tmp_path / "missing.tiff"), "--json"])
+    records = [json.loads(line) for line in out.splitlines()]
+    assert status == 1 and [r["status"] for r in records] == ["ok", "error"]
+
+
+@pytest.mark.parametrize("mode, quality", [("L", 90), ("RGB", 85)])
+def test_jpeg_and_colour_frames_are_solved(tmp_path, capsys, mode, quality):
+    grey = _as_8_bit(FRAMES[-1])
+    picture = Image.fromarray(grey) if mode == "L" else Image.fromarray(np.dstack([grey, grey, grey]))
+    path = tmp_path / "frame.jpg"
+    picture.save(path, quality=quality)
+    status, out, _ = _run(capsys, ["solve", str(path), "--json"])
+    record = json.loads(out)
+    assert status == 0 and record["status"] == "ok" and abs(record["camera"]["fov_deg"] - 11.42) < 0.02
+    assert record["detection"]["full_scale_dn"] == 255.0
+
+
+def test_all_dark_and_empty_frames_say_why(tmp_path, capsys):
+    np.save(tmp_path / "dark.npy", np.zeros((480, 640), np.uint16))
+    status, out, err = _run(capsys, ["solve", str(tmp_path / "dark.npy")])
+    assert status == 1 and "too_few" in out and "0 detections" in out and "flat" in out and err == ""
+    np.save(tmp_path / "empty.npy", np.zeros((0, 5)))
+    status, out, err = _run(capsys, ["solve", str(tmp_path / "empty.npy")])
+    assert status == 2 and out == "" and err.count("\n") == 1 and "empty" in err
+
+
+@pytest.mark.parametrize("setup, argv_tail, message", [
+    ("nan", [], "NaN"),
+    ("corrupt", [], "could not be read"),
+    ("missing", [], "does not exist"),
+    ("good", ["--fov-range-deg", "5"], "--fov-range-deg"),
+    ("good", ["--mag", "9.5"], "--mag"),
+    ("good", ["--width", "1000"], "not --width 1000"),
+    ("good", ["--batch", "x"], "not both"),
+])
+def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, setup, argv_tail, message):
+    path = tmp_path / ("frame.npy" if setup == "nan" else "frame.png")
+    if setup == "nan":
+        frame = np.ones((64, 64))
+        frame[3, 3] = np.nan
+        np.save(path, frame)
+    elif setup == "corrupt":
+        path.write_bytes(b"\x89PNG broken")
+    elif setup == "good":
+        path = FRAMES[0]
+    status, out, err = _run(capsys, ["solve", str(path), *argv_tail])
+    assert status == 2 and out == "" and err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+def test_time_budget_ends_a_frame_of_noise_with_its_reason(tmp_path, capsys):
+    rng = np.random.default_rng(41)
+    path = tmp_path / "noise.csv"
+    np.savetxt(path, np.column_stack([rng.uniform(0, 1023, (400, 2)), rng.uniform(1, 2, 400)]), delimiter=",",
+               header="u,v,flux", comments="")
+    status, out, _ = _run(capsys, ["solve", str(path), "--width", "1024", "--height", "768", "--time-budget-s", "0.05"])
+    assert status == 1 and "no_match" in out and "time budget of 0.05 s" in out
