@@ -7,6 +7,7 @@ error (exit 70, with the traceback only when ``STARTRACK_DEBUG`` is set) into on
 """
 
 import argparse
+import math
 import os
 import sys
 import traceback
@@ -14,6 +15,13 @@ import traceback
 
 class InputError(ValueError):
     """Bad input named in one clear sentence (file, key, value and what is wrong)."""
+
+
+def check_range(option: str, value, low: float, high: float):
+    """``value`` of ``option`` if it is a finite number in [low, high], else InputError naming both."""
+    if value is None or not math.isfinite(value) or not low <= value <= high:
+        raise InputError(f"option {option} = {value} is not a finite number in [{low:g}, {high:g}].")
+    return value
 
 
 class ArgumentParser(argparse.ArgumentParser):

@@ -44,6 +44,8 @@ def read_image(path):
 def read_frame(path) -> Frame:
     """The :class:`Frame` of a PNG, TIFF, JPEG or .npy file (module text)."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"image file {path} is a directory")
     if not path.is_file():
         raise InputError(f"image file {path} does not exist")
     suffix = path.suffix.lower()

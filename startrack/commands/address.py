@@ -8,12 +8,11 @@ s_max), ``--fov-deg`` and ``--max-delta-deg``. No star catalog is needed.
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
 from startrack.commands.catalog import check_option
-from startrack.errors import InputError
+from startrack.errors import check_range
 from startrack.units import DEG
 
 
@@ -73,10 +72,8 @@ def address_report(ra_deg: float, dec_deg: float, n_d: int, fov_deg: float, max_
 
 
 def run(args) -> int:
-    if not math.isfinite(args.ra_deg):
-        raise InputError(f"option --ra-deg = {args.ra_deg} is not a finite number.")
-    if not math.isfinite(args.dec_deg) or not -90.0 <= args.dec_deg <= 90.0:
-        raise InputError(f"option --dec-deg = {args.dec_deg} is not a finite number in [-90, 90].")
+    check_range("--ra-deg", args.ra_deg, -360.0, 720.0)
+    check_range("--dec-deg", args.dec_deg, -90.0, 90.0)
     check_option("--nd", args.nd)
     check_option("--fov-deg", args.fov_deg)
     check_option("--max-delta-deg", args.max_delta_deg)

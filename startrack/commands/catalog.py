@@ -10,12 +10,11 @@ stars per 6 x 6 deg RA/Dec window) and ``DIR/catalog_subcatalogs.png``
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack.errors import InputError, check_range
 from startrack.paths import check_directory
 from startrack.units import ARCSEC, DEG
 
@@ -34,11 +33,8 @@ _RANGES = {
 
 
 def check_option(option: str, value):
-    """Raise InputError unless ``value`` of ``option`` is finite and inside its range."""
-    low, high = _RANGES[option]
-    if not math.isfinite(value) or not low <= value <= high:
-        raise InputError(f"option {option} = {value} is not a finite number in [{low}, {high}].")
-    return value
+    """``value`` of ``option`` if it is finite and inside the option's range in ``_RANGES``."""
+    return check_range(option, value, *_RANGES[option])
 
 
 def register(subparsers):
@@ -94,11 +90,9 @@ def run(args) -> int:
     from startrack.navigation_catalog import load_navigation_catalog
 
     params = params_from_args(args)
-    plot_dir = None
-    if args.plot is not None:
-        check_option("--plot-ra-deg", args.plot_ra_deg)
-        check_option("--plot-dec-deg", args.plot_dec_deg)
-        plot_dir = check_directory(args.plot, "--plot")
+    check_option("--plot-ra-deg", args.plot_ra_deg)
+    check_option("--plot-dec-deg", args.plot_dec_deg)
+    plot_dir = None if args.plot is None else check_directory(args.plot, "--plot")
     catalog = load_navigation_catalog(params, rebuild=args.rebuild, progress=True)
     stats = catalog.statistics()
     if plot_dir is not None:

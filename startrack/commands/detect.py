@@ -8,10 +8,12 @@ per star, brightest first, or JSON.  The same detection, with the same options
 """
 
 import json
-import math
 import time
 
-from startrack.errors import InputError
+from startrack.errors import InputError, check_range
+
+#: Largest grey level accepted on the command line [DN] (a 32-bit float frame's useful range).
+MAX_DN = 1e9
 
 
 def add_detection_options(parser):
@@ -33,12 +35,11 @@ def add_detection_options(parser):
 
 def detection_options(args) -> dict:
     """Keyword arguments of :func:`startrack.detection.detect` from the parsed options (checked)."""
-    for option, value in (("--a", args.a), ("--saturation-dn", args.saturation_dn)):
-        if value is not None and (not math.isfinite(value) or value <= 0):
-            raise InputError(f"option {option} = {value} must be a positive finite number")
-    for option, value in (("--background-dn", args.background_dn), ("--sigma-n-dn", args.sigma_n_dn)):
-        if value is not None and (not math.isfinite(value) or value < 0):
-            raise InputError(f"option {option} = {value} must be a finite number >= 0")
+    check_range("--a", args.a, 0.1, 1000.0)
+    for option, value, low in (("--saturation-dn", args.saturation_dn, 1.0), ("--background-dn", args.background_dn, 0.0),
+                               ("--sigma-n-dn", args.sigma_n_dn, 1e-6)):
+        if value is not None:
+            check_range(option, value, low, MAX_DN)
     if args.min_pixels < 1:
         raise InputError(f"option --min-pixels = {args.min_pixels} must be >= 1")
     if args.mesh_px != 0 and not 8 <= args.mesh_px <= 4096:

@@ -12,15 +12,9 @@ import math
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack.errors import InputError, check_range
 from startrack.paths import check_file
 from startrack.units import DEG
-
-
-def _finite(option, value, low, high):
-    if not math.isfinite(value) or not low <= value <= high:
-        raise InputError(f"option {option} = {value} is not a finite number in [{low}, {high}]")
-    return value
 
 
 def _rate(text):
@@ -62,12 +56,13 @@ def run(args):
     from startrack.render import SensorModel, render_star_field
     from startrack.star_catalog import load_star_catalog
 
-    _finite("--ra-deg", args.ra_deg, -360.0, 720.0)
-    _finite("--dec-deg", args.dec_deg, -90.0, 90.0)
-    _finite("--roll-deg", args.roll_deg, -360.0, 720.0)
-    _finite("--fov-deg", args.fov_deg, 0.1, 120.0)
-    _finite("--mag-limit", args.mag_limit, -2.0, 14.0)
-    _finite("--exposure-ms", args.exposure_ms, 0.0, 60000.0)
+    check_range("--ra-deg", args.ra_deg, -360.0, 720.0)
+    check_range("--dec-deg", args.dec_deg, -90.0, 90.0)
+    check_range("--roll-deg", args.roll_deg, -360.0, 720.0)
+    check_range("--fov-deg", args.fov_deg, 0.1, 120.0)
+    check_range("--mag-limit", args.mag_limit, -2.0, 14.0)
+    check_range("--exposure-ms", args.exposure_ms, 0.0, 60000.0)
+    check_range("--epoch", args.epoch, 1000.0, 3000.0)
     for option, value in (("--width", args.width), ("--height", args.height)):
         if not 8 <= value <= 16384:
             raise InputError(f"option {option} = {value} is not an image size in [8, 16384] px")

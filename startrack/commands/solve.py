@@ -34,7 +34,7 @@ import numpy as np
 
 from startrack.commands.detect import add_detection_options, detection_options
 from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame
-from startrack.errors import InputError
+from startrack.errors import InputError, check_range
 from startrack.units import DEG
 
 
@@ -67,12 +67,6 @@ def register(subparsers):
     parser.set_defaults(func=run)
 
 
-def _check(option, value, low, high):
-    if value is None or not math.isfinite(value) or not low <= value <= high:
-        raise InputError(f"option {option} = {value} is not a finite number in [{low:g}, {high:g}].")
-    return value
-
-
 def _pair(option, text):
     try:
         first, second = (float(p) for p in text.split(","))
@@ -86,16 +80,16 @@ def parse_boresight(text, error_deg):
     from startrack.sphere import radec_to_vector
 
     ra_deg, dec_deg = _pair("--boresight-deg", text)
-    _check("--boresight-deg RA", ra_deg, -360.0, 720.0)
-    _check("--boresight-deg DEC", dec_deg, -90.0, 90.0)
-    _check("--boresight-error-deg", error_deg, 0.0, 180.0)
+    check_range("--boresight-deg RA", ra_deg, -360.0, 720.0)
+    check_range("--boresight-deg DEC", dec_deg, -90.0, 90.0)
+    check_range("--boresight-error-deg", error_deg, 0.0, 180.0)
     return radec_to_vector(ra_deg * DEG, dec_deg * DEG), error_deg * DEG
 
 
 def _fov_range(args):
     """(low, high) [rad] of the field of view searched, or None for the default range."""
     if args.fov_deg is not None:
-        _check("--fov-deg", args.fov_deg, 0.5, 90.0)
+        check_range("--fov-deg", args.fov_deg, 0.5, 90.0)
     if args.fov_range_deg is None:
         return None
     low, high = _pair("--fov-range-deg", args.fov_range_deg)
@@ -175,12 +169,13 @@ def run(args):
 
     options = detection_options(args)
     fov_range = _fov_range(args)
-    _check("--epoch", args.epoch, 1000.0, 3000.0)
-    _check("--centroid-sigma-px", args.centroid_sigma_px, 1e-3, 100.0)
-    _check("--time-budget-s", args.time_budget_s, 1e-3, 3600.0)
-    _check("--max-false-match", args.max_false_match, 1e-300, 1.0)
+    check_range("--epoch", args.epoch, 1000.0, 3000.0)
+    check_range("--boresight-error-deg", args.boresight_error_deg, 0.0, 180.0)
+    check_range("--centroid-sigma-px", args.centroid_sigma_px, 1e-3, 100.0)
+    check_range("--time-budget-s", args.time_budget_s, 1e-3, 3600.0)
+    check_range("--max-false-match", args.max_false_match, 1e-300, 1.0)
     if args.mag is not None:
-        _check("--mag", args.mag, -2.0, 8.0)
+        check_range("--mag", args.mag, -2.0, 8.0)
     camera = None if args.camera is None else read_camera_file(args.camera)
     boresight = None if args.boresight_deg is None else parse_boresight(args.boresight_deg, args.boresight_error_deg)
     frames = _frames(args, options)

@@ -88,16 +88,18 @@ def _centroid_rows(rows):
 def batch_jsonl(path, width, height):
     """SolveFrame records of a JSON Lines file (one per non-empty line)."""
     try:
-        handle = path.open()
+        handle = path.open("rb")
     except OSError as error:
         raise InputError(f"batch file {path} cannot be read ({error}).") from None
+    frames = 0
     with handle:
-        for number, line in enumerate(handle, 1):
-            if not line.strip():
+        for number, raw in enumerate(handle, 1):
+            if not raw.strip():
                 continue
+            frames += 1
             frame_id = number
             try:
-                record = json.loads(line)
+                record = json.loads(raw.decode("utf-8"))  # a line of bad bytes is that frame's error only
                 if not isinstance(record, dict):
                     raise ValueError("the line is not a JSON object")
                 frame_id = record.get("id", number)
@@ -108,8 +110,10 @@ def batch_jsonl(path, width, height):
                     raise ValueError('the key "centroids" is missing')
                 uv, flux = _centroid_rows(record["centroids"])
                 yield SolveFrame(frame_id, uv, flux, None, width, height)
-            except ValueError as error:  # json.JSONDecodeError is a ValueError
+            except ValueError as error:  # json.JSONDecodeError and UnicodeDecodeError are ValueErrors
                 yield SolveFrame(frame_id, reason=f"batch file {path.name} line {number}: {error}")
+    if not frames:
+        raise InputError(f"batch file {path} holds no frame (every line is empty).")
 
 
 def image_frame(path, options, width=None, height=None):
@@ -161,6 +165,8 @@ def batch_frames(path, options, width, height):
 def input_frame(path, options, width, height):
     """The SolveFrame of one INPUT: an image or a centroid CSV."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"input {path} is a directory; give an image or centroid file, or --batch for a folder.")
     if not path.is_file():
         raise InputError(f"input file {path} does not exist.")
     if path.suffix.lower() in IMAGE_SUFFIXES:

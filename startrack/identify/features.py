@@ -110,12 +110,13 @@ def feature_arrays(n_stars, n_pattern):  # pragma: no cover  (compiled)
 
 
 @njit
-def centroid_directions(uv, flux, camera_params, max_stars, n_pattern):  # pragma: no cover  (compiled)
+def centroid_directions(uv, flux, camera_params, max_stars, n_pattern, cos_merge):  # pragma: no cover  (compiled)
     """(status, obs_S (m, 3), index (m,), beta, gate, filled): the unit vectors in S of the centroids ``uv``
     (n, 2) [px] that lie on the sensor (pixel edges included), brightest first by ``flux`` (n,) (empty:
-    given order), at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``; empty features
-    for ``n_pattern`` stars (:func:`feature_arrays`).  status: DIRECTIONS_OK, BAD_COORDINATE (NaN or
-    infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
+    given order), a centroid within the merge radius (cosine ``cos_merge``) of a brighter one left out
+    (:func:`separated`), at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``; empty
+    features for ``n_pattern`` stars (:func:`feature_arrays`).  status: DIRECTIONS_OK, BAD_COORDINATE
+    (NaN or infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
     n = uv.shape[0]
     beta, gate, filled = feature_arrays(0, n_pattern)
     width, height = camera_params[3], camera_params[4]
@@ -135,12 +136,37 @@ def centroid_directions(uv, flux, camera_params, max_stars, n_pattern):  # pragm
         return ALL_OUTSIDE, np.empty((0, 3)), inside[:0], beta, gate, filled
     index = inside[:count]
     kept = flux.copy() if flux.size == 0 else flux[index]
-    index = index[brightest_first(kept, count, max_stars)]
+    index = index[brightest_first(kept, count, -1)]
     obs = np.empty((index.size, 3))
     for m in range(index.size):
         obs[m, 0], obs[m, 1], obs[m, 2] = _unproject(uv[index[m], 0], uv[index[m], 1], camera_params)
+    obs, index = separated(obs, index, cos_merge, max_stars)
     beta, gate, filled = feature_arrays(index.size, n_pattern)
     return DIRECTIONS_OK, obs, index, beta, gate, filled
+
+
+@njit
+def separated(obs, index, cos_merge, max_stars):  # pragma: no cover  (compiled)
+    """(obs, index) without the directions (brightest first) closer than the merge radius (cosine
+    ``cos_merge``) to a brighter one kept: a repeated or split centroid counts once, so it can neither
+    stand for several stars nor multiply the patterns searched. At most ``max_stars`` (< 0: all)."""
+    n = obs.shape[0]
+    limit = n if max_stars < 0 else min(n, max_stars)
+    keep = np.empty(n, np.int64)
+    count = 0
+    for m in range(n):
+        if count == limit:
+            break
+        alone = True
+        for k in range(count):
+            j = keep[k]
+            if obs[m, 0] * obs[j, 0] + obs[m, 1] * obs[j, 1] + obs[m, 2] * obs[j, 2] > cos_merge:
+                alone = False
+                break
+        if alone:
+            keep[count] = m
+            count += 1
+    return obs[keep[:count]], index[keep[:count]]
 
 
 class FrameFeatures:

@@ -34,8 +34,16 @@ import numpy as np
 
 from startrack.errors import InputError
 from startrack.identify.context import SearchContext
-from startrack.identify.features import (ALL_OUTSIDE, BAD_COORDINATE, BAD_FLUX, DIRECTIONS_OK, FrameFeatures,
-                                         brightest_first, centroid_directions)
+from startrack.identify.features import (
+    ALL_OUTSIDE,
+    BAD_COORDINATE,
+    BAD_FLUX,
+    DIRECTIONS_OK,
+    FrameFeatures,
+    brightest_first,
+    centroid_directions,
+    separated,
+)
 from startrack.identify.lost_in_space import LostInSpace
 from startrack.identify.result import IdentificationResult
 from startrack.identify.subcatalog import SubCatalog
@@ -163,6 +171,8 @@ class StarIdentifier:
         self.strategies = [available[m]() for m in METHODS if m in methods]
         self._max_stars = -1 if self.max_stars is None else self.max_stars
         self._sigma = self.centroid_sigma_px / camera.focal_px
+        #: Centroids closer than this (the larger of 1 px and the error bound) are one star.
+        self._cos_merge = math.cos(max(1.0, self.delta_px) / camera.focal_px)
         start = time.perf_counter()
         load_kernels(self)
         self.load_ms = 1e3 * (time.perf_counter() - start)
@@ -178,7 +188,8 @@ class StarIdentifier:
         if isinstance(flux, str):
             return _failed("error", flux, start)
         status, obs_S, index, beta, gate, filled = centroid_directions(
-            np.ascontiguousarray(uv), flux, self.field.camera_params, self._max_stars, 2 * self.pattern_stars)
+            np.ascontiguousarray(uv), flux, self.field.camera_params, self._max_stars, 2 * self.pattern_stars,
+            self._cos_merge)
         if status != DIRECTIONS_OK:
             return _failed("error", self._direction_errors[status].format(n=uv.shape[0]), start)
         if len(obs_S) < 3:
@@ -200,10 +211,11 @@ class StarIdentifier:
             return _failed("error", flux, start)
         if not np.all(np.isfinite(flux)):
             return _failed("error", "a flux value is NaN or infinite", start)
-        index = brightest_first(flux, obs.shape[0], self._max_stars)
+        index = brightest_first(flux, obs.shape[0], -1)
+        obs, index = separated(obs[index] / norms[index, None], index, self._cos_merge, self._max_stars)
         if len(index) < 3:
             return _too_few(len(index), start)
-        return self._solve(self.features(obs[index] / norms[index, None], index), prior, start)
+        return self._solve(self.features(obs, index), prior, start)
 
     # ------------------------------------------------------------------ internals
     @staticmethod

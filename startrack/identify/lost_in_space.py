@@ -14,13 +14,13 @@ fourth star extended) and returns the first verified hypothesis.
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from startrack.identify.features import fill_features
 from startrack.identify.pyramid import TRIANGLE_BUFFER, gate_cosines, no_result, search, verify_triangles
 from startrack.identify.zones import SKY
 from startrack.jit import njit
+
 
 @njit
 def search_tables(frame, widths, tables, stars, region, field):  # pragma: no cover  (compiled)

@@ -14,6 +14,7 @@ import pytest
 from navsim import cli
 from navsim.scenario import SCHEMA, study_schema
 from navsim.scenario.schema import ListOfTables, Table, Value
+from tests.cli_support import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
@@ -113,15 +114,6 @@ def _base_file(path):
 SCENARIO_CASES = scenario_cases(SCHEMA)
 
 
-def run_cli(argv, capsys):
-    """(exit status, stderr) of an in-process ``navsim`` call."""
-    try:
-        status = cli.main([str(a) for a in argv])
-    except SystemExit as exit_:
-        status = exit_.code
-    return status, capsys.readouterr().err
-
-
 def assert_one_clear_line(status, err, culprit, out=None):
     assert status not in (0, None), err
     assert "Traceback" not in err
@@ -138,7 +130,7 @@ def assert_one_clear_line(status, err, culprit, out=None):
 def test_every_scenario_key_refuses_a_bad_value(tmp_path, capsys, case_id, table, key, override):
     base = _base_file(table or key)
     out = tmp_path / "out"
-    status, err = run_cli(["run", base, "--out", out, "--set", f"{key}={override}"], capsys)
+    status, err = run_cli(cli.main, ["run", base, "--out", out, "--set", f"{key}={override}"], capsys)
     assert_one_clear_line(status, err, key.split(".")[-1], out)
 
 
@@ -157,7 +149,7 @@ def test_a_missing_required_key_is_named(tmp_path, capsys, key, base):
     del node[last]
     path = tmp_path / "missing.toml"
     path.write_text(_to_toml(data))
-    status, err = run_cli(["run", path, "--out", tmp_path / "out"], capsys)
+    status, err = run_cli(cli.main, ["run", path, "--out", tmp_path / "out"], capsys)
     assert_one_clear_line(status, err, last, tmp_path / "out")
     assert "missing" in err
 
@@ -193,7 +185,7 @@ CROSS_KEY = [
 
 @pytest.mark.parametrize("base, override, culprit", CROSS_KEY, ids=[c[1][:40] for c in CROSS_KEY])
 def test_inconsistent_keys_are_named(tmp_path, capsys, base, override, culprit):
-    status, err = run_cli(["run", BASES[base], "--out", tmp_path / "out", "--set", override], capsys)
+    status, err = run_cli(cli.main, ["run", BASES[base], "--out", tmp_path / "out", "--set", override], capsys)
     assert_one_clear_line(status, err, culprit, tmp_path / "out")
 
 
@@ -216,7 +208,7 @@ STUDY_CASES = study_cases()
 @pytest.mark.parametrize("case_id, key, override", STUDY_CASES, ids=[c[0] for c in STUDY_CASES])
 def test_every_study_parameter_refuses_a_bad_value(tmp_path, capsys, case_id, key, override):
     base = ROOT / "scenarios" / ("contest_starmap.toml" if ".contest_starmap." in key else "paper003_precision.toml")
-    status, err = run_cli(["run", base, "--out", tmp_path / "out", "--set", f"{key}={override}"], capsys)
+    status, err = run_cli(cli.main, ["run", base, "--out", tmp_path / "out", "--set", f"{key}={override}"], capsys)
     assert_one_clear_line(status, err, key.split(".")[-1], tmp_path / "out")
 
 
@@ -296,14 +288,14 @@ def test_every_option_refuses_a_bad_value(tmp_path, capsys, case_id, argv, culpr
     _files(tmp_path)
     demo = BASES["constant"]
     argv = [a.replace("{tmp}", str(tmp_path)).replace("{demo}", str(demo)) for a in argv]
-    status, err = run_cli(argv, capsys)
+    status, err = run_cli(cli.main, argv, capsys)
     assert_one_clear_line(status, err, culprit, tmp_path / "o")
     assert not Path("/proc/navsim-out").exists()
 
 
 def _run_dir(tmp_path, capsys):
     out = tmp_path / "run"
-    assert run_cli(["run", BASES["constant"], "--out", out], capsys)[0] == 0
+    assert run_cli(cli.main, ["run", BASES["constant"], "--out", out], capsys)[0] == 0
     return out
 
 
@@ -321,7 +313,7 @@ BROKEN_OUTPUTS = [
 def test_a_broken_run_directory_is_named_by_the_report(tmp_path, capsys, case_id, name, content, culprit):
     out = _run_dir(tmp_path, capsys)
     (out / name).write_bytes(content)
-    status, err = run_cli(["report", out, "-o", tmp_path / "r.pdf"], capsys)
+    status, err = run_cli(cli.main, ["report", out, "-o", tmp_path / "r.pdf"], capsys)
     assert_one_clear_line(status, err, culprit)
     assert not (tmp_path / "r.pdf").exists()
 
@@ -331,7 +323,7 @@ def test_a_broken_campaign_file_is_named(tmp_path, capsys, content):
     out = tmp_path / "mc"
     out.mkdir()
     (out / "campaign.json").write_text(content)
-    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "2", "--out", out], capsys)
+    status, err = run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "2", "--out", out], capsys)
     assert_one_clear_line(status, err, "campaign.json")
 
 
@@ -339,31 +331,31 @@ def test_an_output_of_one_kind_is_not_reused_for_another(tmp_path, capsys):
     """A run directory is refused to a campaign and the other way round; a second run into the same
     directory replaces the first whole (no stale file survives)."""
     run_dir = _run_dir(tmp_path, capsys)
-    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "2", "--out", run_dir], capsys)
+    status, err = run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "2", "--out", run_dir], capsys)
     assert_one_clear_line(status, err, "a run output")
     campaign = tmp_path / "mc"
-    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", campaign, "--workers", "1"], capsys)[0] == 0
-    status, err = run_cli(["run", BASES["constant"], "--out", campaign], capsys)
+    assert run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "1", "--out", campaign, "--workers", "1"], capsys)[0] == 0
+    status, err = run_cli(cli.main, ["run", BASES["constant"], "--out", campaign], capsys)
     assert_one_clear_line(status, err, "a campaign output")
     (run_dir / "stale.npy").write_bytes(b"old")
-    assert run_cli(["run", BASES["constant"], "--out", run_dir], capsys)[0] == 0
+    assert run_cli(cli.main, ["run", BASES["constant"], "--out", run_dir], capsys)[0] == 0
     assert not (run_dir / "stale.npy").exists()
 
 
 def test_a_second_campaign_on_a_locked_directory_is_refused(tmp_path, capsys):
     out = tmp_path / "mc"
-    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
+    assert run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
     (out / "campaign.lock").write_text(str(os.getppid()))  # a live process holds it
-    status, err = run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)
+    status, err = run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)
     assert_one_clear_line(status, err, "another campaign")
     (out / "campaign.lock").write_text("999999999")  # a stale lock is taken over
-    assert run_cli(["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
+    assert run_cli(cli.main, ["montecarlo", BASES["constant"], "--runs", "1", "--out", out, "--workers", "1"], capsys)[0] == 0
 
 
 def test_a_byte_order_mark_is_accepted(tmp_path, capsys):
     scenario = tmp_path / "bom.toml"
     scenario.write_bytes(b"\xef\xbb\xbf" + BASES["constant"].read_bytes())
-    assert run_cli(["run", scenario, "--out", tmp_path / "o"], capsys)[0] == 0
+    assert run_cli(cli.main, ["run", scenario, "--out", tmp_path / "o"], capsys)[0] == 0
 
 
 def test_the_corpus_is_large():

@@ -104,7 +104,6 @@ def test_process_noise_matches_van_loan(dt):
 
 from dataclasses import replace  # noqa: E402
 
-
 from navsim.estimation.consistency import chi2_band  # noqa: E402
 from navsim.estimation.nav_filter import ImuNoise, NavFilter  # noqa: E402
 from navsim.ins import driver  # noqa: E402

@@ -9,9 +9,9 @@ import pytest
 from startrack.errors import InputError
 from startrack.navigation_catalog import (
     DEG,
+    REFERENCE_000,
     NavigationCatalog,
     NavigationCatalogParams,
-    REFERENCE_000,
     build_navigation_catalog,
     cache_path,
     load_navigation_catalog,

@@ -131,3 +131,21 @@ def test_frames_with_two_guide_stars_need_the_dense_fall_back(setup):
         result = identifier.solve(uv, flux)
         assert result.ok and result.method == "lost_in_space"
         np.testing.assert_array_equal(hip[result.matches[:, 0]], result.matches[:, 1])
+
+
+@pytest.mark.parametrize("copies", [5, 20])
+def test_repeated_centroids_count_once(setup, copies):
+    """Every centroid repeated (jittered by 0.05 px) ``copies`` times: the same stars are identified as
+    from the frame itself, at the attitude the frame gives, and pure repeats of one point are too few stars — never a
+    search that explodes with the repeats (issue 14: 20 copies used never to finish)."""
+    catalog, camera, stars, identifier = setup
+    rng = np.random.default_rng(7)
+    frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, SIGMA_PX)
+    single = identifier.solve(frame.uv, frame.flux)
+    uv = np.repeat(frame.uv, copies, axis=0) + rng.normal(0.0, 0.05, (len(frame.uv) * copies, 2))
+    repeated = identifier.solve(uv, np.repeat(frame.flux, copies))
+    assert single.ok and repeated.ok
+    assert set(repeated.matches[:, 1]) == set(single.matches[:, 1])
+    # the brightest copy stands for each star, 0.05 px off: the attitude moves by as much, not by degrees
+    assert np.degrees(np.linalg.norm(_attitude_error_S(frame.q_IS, repeated.q_IS))) * 3600 < 30.0
+    assert identifier.solve(np.repeat([[500.0, 500.0]], 20, axis=0)).status == "too_few"

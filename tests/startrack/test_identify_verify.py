@@ -10,8 +10,7 @@ from scipy.stats import binom
 from startrack.attitude import SvdWahba
 from startrack.camera import Camera
 from startrack.identify.pairs import PairTable, kvector_range, pair_range
-from startrack.identify.verify import (FieldStars, binomial_tail, false_match_probability, match_nearest,
-                                       wahba_svd)
+from startrack.identify.verify import FieldStars, binomial_tail, false_match_probability, match_nearest, wahba_svd
 from startrack.navigation_catalog import load_navigation_catalog
 from startrack.star_catalog import load_star_catalog
 
