@@ -88,7 +88,7 @@ def prepare(scenario, overrides=(), star_catalog=None):
     grid = FrameGrid(dt=1.0 / gyro_hz, ratio=ratio, n_frames=n_gyro // ratio)
     sensor = build.star_sensor(scenario, star_catalog, ratio * grid.dt)
     q_BS, _ = build.mounting(scenario)
-    return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario), sensor=sensor,
+    return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario["gyro"], gyro_hz), sensor=sensor,
                     observers=build.observers(scenario, sensor), bias_steps=faults.bias_steps(scenario["faults"]),
                     attitude_jumps=faults.attitude_jumps(scenario["faults"]), R_BS=rot.to_matrix(q_BS))
 

@@ -144,6 +144,7 @@ class VectorRun:
     log_fields = {}
     timing_fields = {}
     sample = None
+    uses_prediction = False
 
     def __init__(self, record):
         self._record = record
