@@ -19,9 +19,9 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.campaign.tuning": ("tune",),
     "navsim.estimation.attitude_filter": ("AttitudeFilter",),
     "navsim.output": ("read_npz", "write_run"),
-    "navsim.records": ("CampaignSummary", "RunSummary"),
+    "navsim.records": ("CampaignSummary", "RunResult", "RunSummary"),
     "navsim.scenario": ("Scenario", "load_scenario"),
     "navsim.sensors.gyro": ("GyroModel",),
-    "navsim.simulation": ("RunResult", "prepare", "run", "run_batch", "run_study", "simulate"),
+    "navsim.simulation": ("prepare", "run", "run_batch", "run_study", "simulate"),
     "navsim.studies": ("StudyResult",),
 })

@@ -18,15 +18,9 @@ from startrack.errors import ArgumentParser, InputError, run_command
 
 
 def _print_summary(summary, out):
-    err = summary["attitude_error_rms_arcsec"]
-    nees = summary["nees"]
-    updates = summary["updates"]
-    lines = [
-        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, "
-        f"{summary['fidelity']}/{summary['measurement']})",
-        f"attitude RMS        x {err['x']:.2f}\"  y {err['y']:.2f}\"  z {err['z']:.2f}\"   "
-        f"cross-boresight {summary['cross_boresight_rms_arcsec']:.2f}\"  roll {summary['roll_rms_arcsec']:.2f}\"",
-        "final bias error    " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h",
+    nees, updates = summary["nees"], summary["updates"]
+    lines = _navigation_lines(summary) if summary.kind == "navigation" else _attitude_lines(summary)
+    lines += [
         f"NEES                mean {nees['mean']:.2f} (dof {nees['dof']}), "
         f"{100 * nees['fraction_in_band']:.1f} % inside the 95 % band",
         f"updates             {updates['accepted']} accepted, {updates['rejected']} rejected",
@@ -34,6 +28,34 @@ def _print_summary(summary, out):
         f"written to          {out}",
     ]
     print("\n".join(lines))
+
+
+def _attitude_lines(summary):
+    err = summary["attitude_error_rms_arcsec"]
+    return [
+        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, "
+        f"{summary['fidelity']}/{summary['measurement']})",
+        f"attitude RMS        x {err['x']:.2f}\"  y {err['y']:.2f}\"  z {err['z']:.2f}\"   "
+        f"cross-boresight {summary['cross_boresight_rms_arcsec']:.2f}\"  roll {summary['roll_rms_arcsec']:.2f}\"",
+        "final bias error    " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h",
+    ]
+
+
+def _navigation_lines(summary):
+    nav, position = summary["navigation"], summary["position_error_m"]
+    horizontal, vertical, nmi = position["horizontal"], position["vertical"], summary["position_error_nmi"]["horizontal"]
+    velocity = summary["velocity_error_m_per_s"]
+    return [
+        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, INS at "
+        f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
+        f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
+        f"RMS {horizontal['rms']:.2f} m  max {horizontal['max']:.2f} m",
+        f"vertical error      final {vertical['final']:.2f} m  RMS {vertical['rms']:.2f} m  max {vertical['max']:.2f} m",
+        f"velocity error RMS  horizontal {velocity['horizontal']['rms']:.3f} m/s  vertical {velocity['vertical']['rms']:.3f} m/s",
+        f"attitude error RMS  tilt {summary['tilt_error_arcsec']['rms']:.1f}\"  heading {summary['heading_error_arcsec']['rms']:.1f}\"",
+        "final bias error    gyro " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h, "
+        "accelerometer " + "  ".join(f"{v:+.1f}" for v in summary["accel_bias_error_final_micro_g"]) + " µg",
+    ]
 
 
 def _run(args):
