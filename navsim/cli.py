@@ -126,6 +126,14 @@ def _montecarlo(args):
               f"once the cause is fixed, {again})")
     if cross:
         print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
+    if summary.get("position_error_m"):
+        horizontal, nmi = summary["position_error_m"]["horizontal"], summary["position_error_nmi"]["horizontal"]
+        print(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 {horizontal['cep95']:.2f} m "
+              f"({nmi['cep95']:.3f} nmi)   vertical p95 {summary['position_error_m']['vertical']['p95']:.2f} m")
+    accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
+    if accel:
+        print(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "
+              f"(normalised RMS {', '.join(f'{v:.2f}' for v in accel['normalised_error_rms'])})")
     if nees:
         print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof; {100 * nees['fraction_in_band']:.1f} % of frames "
               f"inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
@@ -147,10 +155,12 @@ def _tune(args):
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
         return 0
-    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} {'cross RMS':>10} {'roll RMS':>9}")
+    labels = list(result.steps[0].errors)
+    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} " + " ".join(f"{label:>20}" for label in labels))
     for k, step in enumerate(result.steps):
+        errors = " ".join(f"{f'{value:.2f} {unit}':>20}" for value, unit in step.errors.values())
         print(f"{k:>4} {step.process_noise_scale:9.3f} {step.measurement_noise_scale:9.3f} {step.nees_per_dof:9.3f} "
-              f"{step.nis_per_dof:8.3f} {step.cross_boresight_rms_arcsec:9.2f}\" {step.roll_rms_arcsec:8.2f}\"")
+              f"{step.nis_per_dof:8.3f} {errors}")
     first, last = result.steps[0], result.steps[-1]
     print(f"before: NEES/dof {first.nees_per_dof:.2f}, NIS/dof {first.nis_per_dof:.2f}; "
           f"after: NEES/dof {last.nees_per_dof:.2f}, NIS/dof {last.nis_per_dof:.2f}")

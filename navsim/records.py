@@ -197,11 +197,19 @@ class CampaignSummary(Record):
     """The aggregate of a campaign's finished runs (``summary.json`` of a campaign directory), computed
     from the run files in run order, so identical whichever backend produced them.
 
-    Errors pool every steady frame of every run; ``nees`` is the run-averaged NEES against its band
-    for ``runs`` runs; ``divergent_runs`` lists runs with an error beyond 5σ or a NEES mean above
-    5 dof; ``gyro_calibration`` pools the final normalised errors of the calibration states (RMS per
-    state, expected 1, and the share within 3σ, expected 99.7 %); findings, ``paper_comparison`` and
-    ``notes`` pool the observers' per-run figures."""
+    Both kinds: ``nees`` is the run-averaged NEES against its band for ``runs`` runs, with the dof the
+    runs' summaries record; ``divergent_runs`` lists runs with an error beyond 5σ or a NEES mean above
+    5 dof; ``updates`` the accepted and rejected measurements.
+
+    Attitude runs: errors pool every steady frame of every run; ``gyro_calibration`` pools the final
+    normalised errors of the calibration states (RMS per state, expected 1, and the share within 3σ,
+    expected 99.7 %); findings, ``paper_comparison`` and ``notes`` pool the observers' per-run figures.
+
+    Navigation runs: ``position_error_m`` {horizontal: {cep50, cep95, rms, max} of the final horizontal
+    error over the runs, vertical: {p50, p95, rms, max} of the final vertical error};
+    ``position_error_nmi`` {horizontal: {cep50, cep95}}; ``velocity_error_m_per_s`` {horizontal,
+    vertical}, ``tilt_error_arcsec`` and ``heading_error_arcsec``: the spread {mean, p50, p95, max} of
+    the runs' RMS errors; ``imu_calibration`` pools the IMU error states as ``gyro_calibration``."""
 
     FORMAT = CAMPAIGN_FORMAT
 
@@ -216,10 +224,16 @@ class CampaignSummary(Record):
     filter_sigma_mean_arcsec: dict | None = None
     cross_boresight_rms_arcsec: dict | None = None
     roll_rms_arcsec: dict | None = None
+    position_error_m: dict | None = None
+    position_error_nmi: dict | None = None
+    velocity_error_m_per_s: dict | None = None
+    tilt_error_arcsec: dict | None = None
+    heading_error_arcsec: dict | None = None
     nees: dict | None = None
     updates: dict | None = None
     divergent_runs: list | None = None
     gyro_calibration: dict | None = None
+    imu_calibration: dict | None = None
     identification: dict | None = None
     paper_comparison: list | None = None
     notes: list | None = None
