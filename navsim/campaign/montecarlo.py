@@ -16,6 +16,7 @@ way the runs were produced.
 """
 
 import contextlib
+import functools
 import json
 import multiprocessing
 import os
@@ -58,14 +59,21 @@ MAX_RUNS = 1_000_000
 ENVIRONMENT_ERRORS = (OSError, MemoryError, TimeoutError)
 
 
+@functools.lru_cache(maxsize=1)
+def _prepared(scenario_json, source):
+    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`), computed once
+    per process and kept for every chunk it runs (a navigation truth takes seconds per hour)."""
+    return prepare(Scenario(data=json.loads(scenario_json), source=source))
+
+
 def run_chunk(scenario_data, source, members):
-    """Run campaign members [(seed, run_dir), ...] of one scenario, preparing its seed-free part
-    once (:func:`navsim.simulation.prepare`); each run is written atomically, and a run that
-    raises is recorded in ``run_dir/error.json`` (with its cause: the scenario, or the environment
-    when a rerun may cure it) without stopping the others. Returns the errors."""
+    """Run campaign members [(seed, run_dir), ...] of one scenario on its seed-free part (prepared once
+    per process); each run is written atomically, and a run that raises is recorded in
+    ``run_dir/error.json`` (with its cause: the scenario, or the environment when a rerun may cure
+    it) without stopping the others. Returns the errors."""
     errors = []
     try:
-        prepared = prepare(Scenario(data=scenario_data, source=source))
+        prepared = _prepared(json.dumps(scenario_data, sort_keys=True), source)
     except Exception as error:  # the scenario itself fails: every member records it
         prepared, failure = None, error
     for seed, run_dir in members:
