@@ -146,7 +146,7 @@ class Document:
         return typst.compile(str(path), root=str(self.workdir), ignore_system_fonts=True)
 
 
-def _scenario_name(summary, scenario, directory):
+def scenario_name(summary, scenario, directory):
     for name in ((summary or {}).get("scenario"), (scenario or {}).get("name")):
         if isinstance(name, str) and name:
             return name
@@ -159,7 +159,7 @@ def _scenario_name(summary, scenario, directory):
 def run_report(run) -> bytes:
     """The PDF (bytes) of one run directory's report."""
     summary, s = run.summary, run.series
-    name = _scenario_name(summary, run.scenario, run.directory)
+    name = scenario_name(summary, run.scenario, run.directory)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim run report: {name}", f"navsim run · {name}")
         description = (run.scenario or {}).get("description", "")
@@ -169,7 +169,7 @@ def run_report(run) -> bytes:
             f"{run.frames} star-sensor frames over {number(float(s['t'][-1]), 1)} s; fidelity "
             f"{summary.get('fidelity', 'n/a')}, measurement {summary.get('measurement', 'n/a')}."))
         _key_results(doc, run)
-        _scenario_section(doc, run.scenario)
+        scenario_section(doc, run.scenario)
         _attitude_section(doc, run)
         _bias_section(doc, run)
         _calibration_section(doc, run.summary.get("gyro_calibration"))
@@ -177,7 +177,7 @@ def run_report(run) -> bytes:
         _sensor_section(doc, run)
         _address_section(doc, run)
         _frame_section(doc, run)
-        _comparison_section(doc, summary.get("paper_comparison"))
+        comparison_section(doc, summary.get("paper_comparison"))
         _notes_section(doc, summary.get("notes"))
         _absent_section(doc, run)
         return doc.compile()
@@ -232,7 +232,7 @@ def _key_results(doc, run):
         doc.add(table(("Quantity", "Value", "Unit"), rows, ("left", "right", "left")))
 
 
-def _scenario_section(doc, scenario):
+def scenario_section(doc, scenario):
     if not scenario:
         return
     doc.heading("Scenario parameters")
@@ -367,7 +367,7 @@ def _frame_section(doc, run):
                     "identifications.")
 
 
-def _comparison_section(doc, comparison):
+def comparison_section(doc, comparison):
     if not isinstance(comparison, list) or not comparison:
         return
     doc.heading("Comparison with the source documents")
@@ -417,7 +417,7 @@ def study_report(study) -> bytes:
     kind = summary["study"]
     module = STUDIES[kind]
     parameters = study.scenario["study"][kind]
-    name = _scenario_name(summary, study.scenario, study.directory)
+    name = scenario_name(summary, study.scenario, study.directory)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim study report: {name}", f"navsim study · {name}")
         doc.title(f"Static study report: {name}", study.scenario.get("description") or str(study.directory))
@@ -425,8 +425,8 @@ def study_report(study) -> bytes:
                              f"wall time {number(summary.get('wall_seconds'), 1)} s."))
         doc.heading("Key results")
         doc.add(table(("Quantity", "Value", "Unit"), module.key_results(summary, parameters), ("left", "right", "left")))
-        _scenario_section(doc, study.scenario)
-        _comparison_section(doc, summary.get("paper_comparison"))
+        scenario_section(doc, study.scenario)
+        comparison_section(doc, summary.get("paper_comparison"))
         _notes_section(doc, summary.get("notes"))
         doc.heading("Figures")
         for fig, caption in module.figures(summary, study.arrays, parameters):
@@ -442,7 +442,7 @@ def campaign_report(campaign) -> bytes:
     first = campaign.runs[0]
     name = campaign.campaign.get("scenario")
     if not isinstance(name, str) or not name:
-        name = _scenario_name(first.summary, campaign.scenario, campaign.directory)
+        name = scenario_name(first.summary, campaign.scenario, campaign.directory)
     env = stats.envelopes(campaign)
     avg = stats.averaged_nees(campaign)
     success, criterion = stats.identification_success(campaign)
@@ -486,9 +486,9 @@ def campaign_report(campaign) -> bytes:
 
         doc.heading("Campaign")
         settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}  # scenario: next section
-        doc.add(table(("Setting", "Value"), [(k, _short(general(v))) for k, v in flatten(settings)],
+        doc.add(table(("Setting", "Value"), [(k, short(general(v))) for k, v in flatten(settings)],
                       ("left", "left")))
-        _scenario_section(doc, campaign.scenario)
+        scenario_section(doc, campaign.scenario)
 
         doc.heading("Statistics across runs")
         doc.paragraph(markup("Per-run metrics from each run's summary.json (after its settling time), "
@@ -531,20 +531,20 @@ def campaign_report(campaign) -> bytes:
             doc.figure(figures.identification_success(success, criterion), "Identification success per mode.")
 
         if campaign.summary:
-            rows = [(k, _short(general(v))) for k, v in flatten(campaign.summary.to_json())]
+            rows = [(k, short(general(v))) for k, v in flatten(campaign.summary.to_json())]
             if rows:
                 doc.heading("Aggregate summary")
                 doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))
                 doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
-            _comparison_section(doc, campaign.summary.get("paper_comparison"))
+            comparison_section(doc, campaign.summary.get("paper_comparison"))
             _notes_section(doc, campaign.summary.get("notes"))
 
         if campaign.failed:
             doc.heading("Failed runs")
-            doc.add(table(("Run", "Error"), [(f.name, _short(f.message, 160)) for f in campaign.failed],
+            doc.add(table(("Run", "Error"), [(f.name, short(f.message, 160)) for f in campaign.failed],
                           ("left", "left")))
         return doc.compile()
 
 
-def _short(text, limit=90):
+def short(text, limit=90):
     return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -268,10 +268,10 @@ class MetricRow:
     maximum: float
 
 
-def metric_table(campaign):
-    """Across-run statistics of each per-run metric found in the run summaries."""
+def metric_table(campaign, metrics=RUN_METRICS):
+    """Across-run statistics of each per-run metric (label, unit, path) found in the run summaries."""
     rows = []
-    for label, unit, path in RUN_METRICS:
+    for label, unit, path in metrics:
         values = [lookup(r.summary, path) for r in campaign.runs]
         values = np.array([v for v in values if v is not None], dtype=float)
         if values.size == 0:
