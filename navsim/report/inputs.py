@@ -137,7 +137,7 @@ def read_series(path: Path, kind, names=None) -> dict:
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
     for name in REQUIRED_SERIES[kind]:
-        if name not in series:
+        if name not in series and (names is None or name in names):
             raise InputError(f"{path}: the array '{name}' is missing.")
     n = series["t"].shape[0] if series["t"].ndim == 1 else -1
     if n < 1:
