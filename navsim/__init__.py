@@ -1,7 +1,8 @@
 """navsim: the INS / star-sensor navigation system simulator.
 
 Truth attitude motion, gyro models, quaternion kinematics (RK4), the multiplicative error-state
-Kalman filter, the closed loop that runs the star sensor inside the simulation, faults, scenarios,
+Kalman filter, the closed loop that runs the star sensor inside the simulation, the strapdown INS
+with its navigation filter and aiding (scenarios with a ``[trajectory]`` table), faults, scenarios,
 Monte Carlo campaigns, filter tuning, the static studies of the source documents
 (:mod:`navsim.studies`) and the ``navsim`` command line.
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.ins.summary import ned_metres
-from navsim.report.statistics import Envelopes, common_frames
+from navsim.report.statistics import common_frames, envelopes_of
 
 #: Per-run metrics of navigation runs tabulated across a campaign: (label, unit, path in summary.json).
 RUN_METRICS = (
@@ -58,9 +58,5 @@ def position_envelopes(campaign):
     t = common_frames(campaign)
     n = t.size
     err = np.stack([r.series["position_error_m"][:n] for r in campaign.runs])
-    ddof = 1 if len(campaign.runs) > 1 else 0
-    p05, p50, p95 = np.percentile(err, [5, 50, 95], axis=0)
     sigma = np.sqrt(np.mean(np.stack([_position_sigma(r, n) ** 2 for r in campaign.runs]), axis=0))
-    return Envelopes(t=t, runs=err.shape[0], mean=err.mean(axis=0), std=err.std(axis=0, ddof=ddof), p05=p05, p50=p50,
-                     p95=p95, rms=np.sqrt(np.mean(err**2, axis=0)), sigma3_filter=3.0 * sigma, final=err[:, -1, :],
-                     final_sigma_filter=sigma[-1])
+    return envelopes_of(t, err, sigma)

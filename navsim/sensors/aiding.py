@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from navsim.earth.wgs84 import radii
+from navsim.sensors.recorded_run import RecordedRun
 
 
 @dataclass(frozen=True)
@@ -72,20 +73,8 @@ class AidingFrame:
     info: dict = field(default_factory=dict)
 
 
-class AidingRun:
-    """The per-run aiding sensors: they read their :class:`AidingRecord` frame by frame; the filter's
-    verdicts do not change what they measure."""
-
-    log_fields = {}
-    timing_fields = {}
-    sample = None
-    uses_prediction = False
-
-    def __init__(self, record):
-        self._record = record
-
-    def record(self):
-        return self._record
+class AidingRun(RecordedRun):
+    """The per-run aiding sensors: they read their :class:`AidingRecord` frame by frame."""
 
     def observe(self, request):
         r, j = self._record, request.index
@@ -95,9 +84,3 @@ class AidingRun:
         if not np.isnan(r.baro[j]):
             measurements.append(("baro", (r.baro[j], r.baro_sigma)))
         return AidingFrame(measurements=tuple(measurements))
-
-    def after_update(self, update):
-        pass
-
-    def lose_track(self):
-        pass
