@@ -22,6 +22,12 @@ from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, qua
 
 #: First index of the position error (δL, δλ, δh) in the error state.
 DP = 6
+#: The states a baro height updates: the vertical channel δv_D, δh and the body-z accelerometer bias
+#: (down in level flight); for its update every other state is a consider state (Schmidt), so a baro
+#: damps the vertical channel and tells the filter nothing of the horizontal ones. (Estimating them
+#: all, the filter would draw horizontal information from a white-noise height through the Coriolis
+#: and v²/R couplings of the vertical channel, which no biased, lagging baro really carries.)
+BARO_STATES = (5, DP + 2, 14)
 #: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
 #: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].
 ACC_SIZE = 31
@@ -211,26 +217,29 @@ def position_update(nav, imu, P, acc, q_c, dt, fix, sigma, gate):
         R[i, i] = (sigma[i] / scale[i]) ** 2
         z[i] = nav[i] - fix[i]
     z_m = z * scale
-    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate)
+    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, np.ones(n, dtype=np.bool_))  # every state estimated
     return z_m, nis, accepted
 
 
 @njit
 def baro_update(nav, imu, P, acc, q_c, dt, height, sigma, gate):
-    """Flush the covariance, then the gated update with a baro height [m] of σ [m]: z = ĥ − h_baro,
-    H = e_h. Returns (z (1,) [m], nis, accepted)."""
+    """Flush the covariance, then the gated update of the vertical channel (:data:`BARO_STATES`) with
+    a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""
     flush(nav, P, acc, q_c, dt)
     n = P.shape[0]
     H = np.zeros((1, n))
     H[0, DP + 2] = 1.0
     R = np.full((1, 1), sigma * sigma)
     z = np.array([nav[2] - height])
-    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate)
+    estimated = np.zeros(n, dtype=np.bool_)
+    for i in BARO_STATES:
+        estimated[i] = True
+    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, estimated)
     return z, nis, accepted
 
 
 @njit
-def _gated_update(nav, imu, P, H, R, z, gate):
+def _gated_update(nav, imu, P, H, R, z, gate, estimated):
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
     nis = 0.0
@@ -239,7 +248,7 @@ def _gated_update(nav, imu, P, H, R, z, gate):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
         return nis, False
-    dx, P_next = joseph_update(P, H, R, z, np.ones(P.shape[0], dtype=np.bool_))  # every state estimated
+    dx, P_next = joseph_update(P, H, R, z, estimated)
     P[:, :] = P_next
     reset(nav, imu, dx, P.shape[0])
     return nis, True

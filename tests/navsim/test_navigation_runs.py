@@ -25,16 +25,14 @@ BASE = Path(__file__).resolve().parent / "data" / "base_navigation.toml"
 #: σ of the free INS test: gyro and accelerometer turn-on biases [deg/h, µg], initial tilt [arcsec],
 #: heading [deg], velocity [m/s] and position [m].
 GYRO_BIAS, ACCEL_BIAS, TILT, HEADING, VELOCITY, POSITION = 0.05, 50.0, 20.0, 0.05, 0.02, 1.0
-#: Two hours at rest on the equator, an IMU with turn-on biases only, and a coarse height reference
-#: (σ 100 m) that bounds the vertical channel without teaching the filter the horizontal ones: with a
-#: precise one (1 m) the filter, linearised about its own estimate, draws north-channel information from
-#: the second-order (v²/R) terms of the vertical and its σ falls to 40 % of the closed form in 2 h.
+#: Two hours at rest on the equator, an IMU with turn-on biases only, and a baro for the vertical channel
+#: (it updates the vertical states only: the horizontal channels stay free).
 FREE_AT_REST = {
     "name": "free_at_rest",
     "trajectory": {"start": {"lat_deg": 0.0, "lon_deg": 30.0}, "segments": [{"kind": "hold", "duration_s": 7200.0}]},
     "imu": {"rate_hz": 10.0, "gyro": {"bias_turn_on_deg_per_h": GYRO_BIAS},
             "accelerometer": {"bias_turn_on_micro_g": ACCEL_BIAS}},
-    "baro": {"rate_hz": 1.0, "noise_sigma_m": 100.0},
+    "baro": {"rate_hz": 1.0},
     "filter": {"initial_tilt_sigma_arcsec": TILT, "initial_heading_sigma_deg": HEADING,
                "initial_velocity_sigma_m_per_s": VELOCITY, "initial_position_sigma_m": POSITION},
 }
