@@ -37,7 +37,8 @@ UPDATE_FIELDS = {"n_measurements": (np.int32, 0), "n_accepted": (np.int32, 0), "
 
 @dataclass(frozen=True)
 class FrameGrid:
-    """The run's time base: IMU interval dt [s], IMU samples per star-sensor frame, frame count."""
+    """The run's time base: IMU interval dt [s], IMU samples per frame (a star-sensor frame, an aiding
+    epoch), frame count."""
 
     dt: float
     ratio: int
