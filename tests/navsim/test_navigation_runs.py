@@ -151,3 +151,13 @@ def test_position_aided_campaign_of_the_shipped_scenario(tmp_path):
     assert nees["fraction_in_band"] >= 0.8
     assert summary["divergent_runs"] == []
     assert summary["imu_calibration"]["accel_bias_micro_g"]["within_3_sigma"] >= 0.97
+
+
+def test_tune_needs_measurements():
+    """A free INS without a baro has no NIS to fit: one clear error, not a search on nothing."""
+    from navsim.campaign.tuning import tune
+    from startrack.errors import InputError
+
+    short = {**FREE_AT_REST, "trajectory": {**FREE_AT_REST["trajectory"], "segments": [{"kind": "hold", "duration_s": 60.0}]}}
+    with pytest.raises(InputError, match="filter tuning needs measurements"):
+        tune({key: value for key, value in short.items() if key != "baro"}, runs=1)
