@@ -16,8 +16,18 @@ from navsim.campaign.navigation import cep
 from navsim.report import figures
 from navsim.report import navigation_figures as nav_figures
 from navsim.report import statistics as stats
-from navsim.report.document import (Document, comparison_section, scenario_name, scenario_section, short, flatten,
-                                    general, markup, number, table)
+from navsim.report.document import (
+    Document,
+    comparison_section,
+    flatten,
+    general,
+    markup,
+    number,
+    scenario_name,
+    scenario_section,
+    short,
+    table,
+)
 from navsim.report.navigation_statistics import RUN_METRICS, horizontal_percentiles, position_envelopes
 from startrack import units
 
