@@ -188,7 +188,7 @@ class RunSummary(Record):
         record = super().from_json(payload, source)
         missing = [name for name in KIND_FIELDS[record.kind] if getattr(record, name) is None]
         if missing:
-            raise InputError(f"{source}: the key '{missing[0]}' of a {record.kind} run is missing.")
+            raise InputError(f"{source}: the key '{missing[0]}' is missing ({record.kind} run).")
         return record
 
 
