@@ -416,3 +416,17 @@ def _leaves(table):
             yield from _leaves(spec.item)
         else:
             yield spec
+
+
+@pytest.mark.parametrize("drop", ["error_state", "lat_true"])
+def test_a_navigation_run_without_its_arrays_is_named_by_the_report(tmp_path, capsys, drop):
+    from navsim.output import read_npz, write_npz
+
+    out = tmp_path / "run"
+    assert run_cli(["run", BASES["navigation"], "--out", out], capsys)[0] == 0
+    series = read_npz(out / "timeseries.npz")
+    del series[drop]
+    write_npz(out / "timeseries.npz", series)
+    status, err = run_cli(["report", out, "-o", tmp_path / "r.pdf"], capsys)
+    assert_one_clear_line(status, err, drop)
+    assert not (tmp_path / "r.pdf").exists()
