@@ -2,7 +2,7 @@
 navigation scenario").
 
 Its own strict schema (:data:`SCHEMA`: units in the key names, every value bounded) and cross-key
-rules (:func:`validate`): the trajectory's segments as :mod:`navsim.truth.tables` writes them (a
+rules (:func:`validate`): the trajectory's segments of :mod:`navsim.truth.segments` (a
 segment that cannot be flown is named), the IMU (a gyro and an accelerometer, each a preset and/or
 datasheet fields), an optional baro, position aiding (none: a free INS), an optional gravity
 disturbance and the filter, whose noise and initial σ come from the datasheets unless given.
