@@ -1,7 +1,8 @@
 """navsim: the INS / star-sensor navigation system simulator.
 
 Truth attitude motion, gyro models, quaternion kinematics (RK4), the multiplicative error-state
-Kalman filter, the closed loop that runs the star sensor inside the simulation, faults, scenarios,
+Kalman filter, the closed loop that runs the star sensor inside the simulation, the strapdown INS
+with its navigation filter and aiding (scenarios with a ``[trajectory]`` table), faults, scenarios,
 Monte Carlo campaigns, filter tuning, the static studies of the source documents
 (:mod:`navsim.studies`) and the ``navsim`` command line.
 
@@ -19,9 +20,9 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.campaign.tuning": ("tune",),
     "navsim.estimation.attitude_filter": ("AttitudeFilter",),
     "navsim.output": ("read_npz", "write_run"),
-    "navsim.records": ("CampaignSummary", "RunSummary"),
+    "navsim.records": ("CampaignSummary", "RunResult", "RunSummary"),
     "navsim.scenario": ("Scenario", "load_scenario"),
     "navsim.sensors.gyro": ("GyroModel",),
-    "navsim.simulation": ("RunResult", "prepare", "run", "run_batch", "run_study", "simulate"),
+    "navsim.simulation": ("prepare", "run", "run_batch", "run_study", "simulate"),
     "navsim.studies": ("StudyResult",),
 })

@@ -18,15 +18,9 @@ from startrack.errors import ArgumentParser, InputError, run_command
 
 
 def _print_summary(summary, out):
-    err = summary["attitude_error_rms_arcsec"]
-    nees = summary["nees"]
-    updates = summary["updates"]
-    lines = [
-        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, "
-        f"{summary['fidelity']}/{summary['measurement']})",
-        f"attitude RMS        x {err['x']:.2f}\"  y {err['y']:.2f}\"  z {err['z']:.2f}\"   "
-        f"cross-boresight {summary['cross_boresight_rms_arcsec']:.2f}\"  roll {summary['roll_rms_arcsec']:.2f}\"",
-        "final bias error    " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h",
+    nees, updates = summary["nees"], summary["updates"]
+    lines = _navigation_lines(summary) if summary.kind == "navigation" else _attitude_lines(summary)
+    lines += [
         f"NEES                mean {nees['mean']:.2f} (dof {nees['dof']}), "
         f"{100 * nees['fraction_in_band']:.1f} % inside the 95 % band",
         f"updates             {updates['accepted']} accepted, {updates['rejected']} rejected",
@@ -34,6 +28,34 @@ def _print_summary(summary, out):
         f"written to          {out}",
     ]
     print("\n".join(lines))
+
+
+def _attitude_lines(summary):
+    err = summary["attitude_error_rms_arcsec"]
+    return [
+        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, "
+        f"{summary['fidelity']}/{summary['measurement']})",
+        f"attitude RMS        x {err['x']:.2f}\"  y {err['y']:.2f}\"  z {err['z']:.2f}\"   "
+        f"cross-boresight {summary['cross_boresight_rms_arcsec']:.2f}\"  roll {summary['roll_rms_arcsec']:.2f}\"",
+        "final bias error    " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h",
+    ]
+
+
+def _navigation_lines(summary):
+    nav, position = summary["navigation"], summary["position_error_m"]
+    horizontal, vertical, nmi = position["horizontal"], position["vertical"], summary["position_error_nmi"]["horizontal"]
+    velocity = summary["velocity_error_m_per_s"]
+    return [
+        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, INS at "
+        f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
+        f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
+        f"RMS {horizontal['rms']:.2f} m  max {horizontal['max']:.2f} m",
+        f"vertical error      final {vertical['final']:.2f} m  RMS {vertical['rms']:.2f} m  max {vertical['max']:.2f} m",
+        f"velocity error RMS  horizontal {velocity['horizontal']['rms']:.3f} m/s  vertical {velocity['vertical']['rms']:.3f} m/s",
+        f"attitude error RMS  tilt {summary['tilt_error_arcsec']['rms']:.1f}\"  heading {summary['heading_error_arcsec']['rms']:.1f}\"",
+        "final bias error    gyro " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h, "
+        "accelerometer " + "  ".join(f"{v:+.1f}" for v in summary["accel_bias_error_final_micro_g"]) + " µg",
+    ]
 
 
 def _run(args):
@@ -104,6 +126,14 @@ def _montecarlo(args):
               f"once the cause is fixed, {again})")
     if cross:
         print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
+    if summary.get("position_error_m"):
+        horizontal, nmi = summary["position_error_m"]["horizontal"], summary["position_error_nmi"]["horizontal"]
+        print(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 {horizontal['cep95']:.2f} m "
+              f"({nmi['cep95']:.3f} nmi)   vertical p95 {summary['position_error_m']['vertical']['p95']:.2f} m")
+    accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
+    if accel:
+        print(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "
+              f"(normalised RMS {', '.join(f'{v:.2f}' for v in accel['normalised_error_rms'])})")
     if nees:
         print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof; {100 * nees['fraction_in_band']:.1f} % of frames "
               f"inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
@@ -125,10 +155,12 @@ def _tune(args):
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
         return 0
-    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} {'cross RMS':>10} {'roll RMS':>9}")
+    labels = list(result.steps[0].errors)
+    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} " + " ".join(f"{label:>20}" for label in labels))
     for k, step in enumerate(result.steps):
+        errors = " ".join(f"{f'{value:.2f} {unit}':>20}" for value, unit in step.errors.values())
         print(f"{k:>4} {step.process_noise_scale:9.3f} {step.measurement_noise_scale:9.3f} {step.nees_per_dof:9.3f} "
-              f"{step.nis_per_dof:8.3f} {step.cross_boresight_rms_arcsec:9.2f}\" {step.roll_rms_arcsec:8.2f}\"")
+              f"{step.nis_per_dof:8.3f} {errors}")
     first, last = result.steps[0], result.steps[-1]
     print(f"before: NEES/dof {first.nees_per_dof:.2f}, NIS/dof {first.nis_per_dof:.2f}; "
           f"after: NEES/dof {last.nees_per_dof:.2f}, NIS/dof {last.nis_per_dof:.2f}")

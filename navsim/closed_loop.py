@@ -1,22 +1,24 @@
-"""The driver loop of docs/design.md: truth -> IMU -> predict -> star sensor -> update -> log.
+"""The driver loop of docs/design.md: truth -> IMU -> predict -> sensors -> update -> log.
 
-One loop serves any navigation filter that offers ``predict(samples, dt)``,
-``sensor_prediction(last_sample)``, ``update_stars``/``update_attitude``, ``reinitialise(q_IS)``,
-``disturb(rotation_vector)`` and ``snapshot()``, and any star sensor run of
-:mod:`navsim.sensors.star_sensor`. Per frame:
+One loop serves every filter and every sensor run of a simulation: the attitude filter with a star
+sensor (:mod:`navsim.sensors.star_sensor`), the navigation filter with its aiding sensors
+(:mod:`navsim.sensors.aiding`). A filter offers ``predict(samples, dt)``, an update per measurement
+kind it takes (:data:`UPDATES`), ``snapshot()`` and, with a star sensor, ``sensor_prediction(last_sample)``,
+``reinitialise(q_IS)`` and ``disturb(rotation_vector)``. Per frame:
 
 1. the filter propagates over the frame's IMU samples (observers see the same samples);
 2. faults that knock the estimate off (attitude jumps) are applied, and the sensor loses track;
-3. the sensor observes the sky from the truth, with the filter's predicted attitude and rate;
-4. its measurements go through the gated filter update; when the filter rejects every star of a
-   sub-catalog or full-sky identification (it lost track), it is re-initialised from that fix and
-   updated again; the sensor learns the verdict;
+3. the sensors observe from the truth at the frame (and, for a sensor that points itself with it,
+   the filter's predicted attitude and rate);
+4. each measurement of the frame goes through the filter's gated update for its kind; when the filter
+   rejects every star of a sub-catalog or full-sky identification (it lost track), it is
+   re-initialised from that fix and updated again; the sensor learns the verdict;
 5. observers (the source documents' per-frame experiments, :mod:`navsim.studies`) see the frame,
    and the log keeps the filter's state, the update statistics and the sensor's quantities.
 
-When every measurement is known before the run (vector fidelity) and nothing acts inside the loop,
-the filter's compiled fast path (``process_record``) runs the whole record at once; it is tested
-equal to the step-by-step loop.
+When every measurement is known before the run (vector fidelity, open-loop aiding) and nothing acts
+inside the loop, the filter's compiled fast path (``process_record``) runs the whole record at once;
+it is tested equal to the step-by-step loop.
 """
 
 import dataclasses
@@ -25,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.estimation.updates import FrameUpdate
 from navsim.sensors.star_sensor import MODES, FrameRequest
 
 #: Update statistics logged at every frame: name -> (dtype, value when nothing was fused).
@@ -34,7 +37,8 @@ UPDATE_FIELDS = {"n_measurements": (np.int32, 0), "n_accepted": (np.int32, 0), "
 
 @dataclass(frozen=True)
 class FrameGrid:
-    """The run's time base: IMU interval dt [s], IMU samples per star-sensor frame, frame count."""
+    """The run's time base: IMU interval dt [s], IMU samples per frame (a star-sensor frame, an aiding
+    epoch), frame count."""
 
     dt: float
     ratio: int
@@ -49,9 +53,10 @@ class FrameGrid:
 def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compiled=True):
     """Run ``filt`` with ``sensor_run`` over every frame of ``grid``; returns a :class:`FrameLog`.
 
-    ``imu`` (M, 3) measured rates; ``truth``: q_IB (M+1, 4) on the IMU grid and ``omega_mean``
-    (M, 3) the true body rate of each interval; ``jumps``: an :class:`~navsim.sensors.faults.AttitudeJumps`
-    or None; ``observers``: per-run observers; ``compiled``: allow the fast path.
+    ``imu`` (M, ·) the measured IMU samples (rates [rad/s]; with the specific force [m/s²] beside them
+    for the INS); ``truth`` the run's truth on the IMU grid, whose ``at(k)`` is the truth record of
+    the frame closing interval k; ``jumps``: an :class:`~navsim.sensors.faults.AttitudeJumps` or None;
+    ``observers``: per-run observers; ``compiled``: allow the fast path.
     """
     log = FrameLog(grid.n_frames, sensor_run.log_fields, sensor_run.timing_fields)
     record = sensor_run.record()
@@ -67,9 +72,9 @@ def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compi
         for rotation_vector in jumps.due(k * grid.dt) if jumps is not None else ():
             filt.disturb(rotation_vector)
             sensor_run.lose_track()
-        q_IS_pred, omega_S_pred = filt.sensor_prediction(imu[k - 1])
-        request = FrameRequest(index=j, t=k * grid.dt, q_IB_true=truth.q_IB[k], omega_B_true=truth.omega_mean[k - 1],
-                               q_IS_pred=q_IS_pred, omega_S_pred=omega_S_pred)
+        prediction = filt.sensor_prediction(imu[k - 1]) if sensor_run.uses_prediction else (None, None)
+        request = FrameRequest(index=j, t=k * grid.dt, truth=truth.at(k), q_IS_pred=prediction[0],
+                               omega_S_pred=prediction[1])
         frame = sensor_run.observe(request)
         update = fuse(filt, frame)
         sensor_run.after_update(update)
@@ -79,19 +84,25 @@ def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compi
     return log
 
 
+#: The filter method that takes each kind of measurement a frame may carry (``frame.measurements``).
+UPDATES = {"attitude": "update_attitude", "stars": "update_stars", "position": "update_position", "baro": "update_baro"}
+
+
 def fuse(filt, frame):
-    """The gated update with the frame's measurements (None when it has none); a filter that
-    rejects every star of a sub-catalog or full-sky identification has lost track: it is
+    """The gated updates with the frame's measurements, in their order: the update (None when the
+    frame has none, a :class:`~navsim.estimation.updates.FrameUpdate` for several kinds). A filter
+    that rejects every star of a sub-catalog or full-sky identification has lost track: it is
     re-initialised from that identification's attitude and updated again."""
-    if frame.q_IS is not None:
-        return filt.update_attitude(frame.q_IS, frame.R_S)
-    if not len(frame.ref_I):
-        return None
-    update = filt.update_stars(frame.ref_I, frame.obs_S, frame.sigma)
-    if update.n_accepted == 0 and frame.fix_q_IS is not None:
-        filt.reinitialise(frame.fix_q_IS)
-        update = dataclasses.replace(filt.update_stars(frame.ref_I, frame.obs_S, frame.sigma), reinitialised=True)
-    return update
+    updates = []
+    for kind, measurement in frame.measurements:
+        update = getattr(filt, UPDATES[kind])(*measurement)
+        if kind == "stars" and update.n_accepted == 0 and frame.fix_q_IS is not None:
+            filt.reinitialise(frame.fix_q_IS)
+            update = dataclasses.replace(filt.update_stars(*measurement), reinitialised=True)
+        updates.append(update)
+    if len(updates) > 1:
+        return FrameUpdate(tuple(updates))
+    return updates[0] if updates else None
 
 
 class FrameLog:

@@ -40,7 +40,7 @@ def write_json(path, payload):
 
 
 def write_run(directory, result, max_frames=None):
-    """Write a :class:`~navsim.simulation.RunResult` into ``directory`` (created if needed).
+    """Write a :class:`~navsim.records.RunResult` into ``directory`` (created if needed).
 
     ``max_frames`` keeps every k-th frame of the time series so that at most that many remain
     (campaigns keep envelopes, not every frame, of thousands of runs); the summary is unchanged.

@@ -1,5 +1,8 @@
 """Simulation runs: the seed-free preparation of a scenario, then seeded runs through the closed loop.
 
+Attitude runs (a star sensor and a gyro) are here; navigation runs (a ``[trajectory]`` table: the
+INS) are :mod:`navsim.ins.simulation`'s, reached through the same :func:`prepare` and :func:`simulate`.
+
 Random sub-streams (numpy ``SeedSequence(seed).spawn(3)``, in this fixed order): 0 gyro, 1 star
 sensor, 2 filter initial error. At vector fidelity the star sensor draws its noise from stream 1
 directly; at image fidelity stream 1 spawns four, all before the first frame: 0 attitude jumps,
@@ -10,13 +13,14 @@ in one process, a pool or a cluster.
 import dataclasses
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from navsim.closed_loop import FrameGrid, mode_statistics, mode_timing, run_loop
 from navsim.estimation.consistency import nees, nees_statistics
-from navsim.records import RunSummary
+from navsim.ins import simulation as navigation
+from navsim.records import RunResult, RunSummary
 from navsim.scenario import build, resolve_scenario
 from navsim.sensors import faults
 from navsim.sensors.star_sensor import MODES
@@ -30,21 +34,6 @@ from startrack.star_catalog import load_star_catalog
 
 #: The attitude filter's NEES is over its attitude and gyro-bias errors.
 NEES_DOF = 6
-
-
-@dataclass(frozen=True)
-class RunResult:
-    """``summary``: the run's :class:`~navsim.records.RunSummary` (reads as the JSON mapping of
-    summary.json); ``series``: arrays logged at every star-sensor frame; ``scenario``: the validated
-    scenario (units in key names) the run used; ``sample_frame``: one rendered frame with its
-    detections and identifications (image fidelity); ``timing_series``: per-frame wall-clock times
-    [ms] (image fidelity), apart from ``series`` because they differ between runs of one seed."""
-
-    summary: RunSummary
-    series: dict
-    scenario: dict
-    sample_frame: dict | None = None
-    timing_series: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -78,6 +67,8 @@ def prepare(scenario, overrides=(), star_catalog=None):
     """Validate ``scenario`` and compute everything that does not depend on the seed."""
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a simulation run")
+    if scenario.is_navigation:
+        return navigation.prepare(scenario)
     gyro_hz = scenario["gyro"]["rate_hz"]
     ratio = int(round(gyro_hz / scenario["star_sensor"]["rate_hz"]))
     factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
@@ -88,14 +79,17 @@ def prepare(scenario, overrides=(), star_catalog=None):
     grid = FrameGrid(dt=1.0 / gyro_hz, ratio=ratio, n_frames=n_gyro // ratio)
     sensor = build.star_sensor(scenario, star_catalog, ratio * grid.dt)
     q_BS, _ = build.mounting(scenario)
-    return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario), sensor=sensor,
+    return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario["gyro"], gyro_hz), sensor=sensor,
                     observers=build.observers(scenario, sensor), bias_steps=faults.bias_steps(scenario["faults"]),
                     attitude_jumps=faults.attitude_jumps(scenario["faults"]), R_BS=rot.to_matrix(q_BS))
 
 
 def simulate(prepared, seed, compiled=True):
-    """The seeded part of one run on a :class:`Prepared` scenario. Returns a :class:`RunResult`.
-    ``compiled=False`` keeps the step-by-step loop where the filter's fast path would run."""
+    """The seeded part of one run on a :class:`Prepared` scenario (or a navigation one). Returns a
+    :class:`~navsim.records.RunResult`. ``compiled=False`` keeps the step-by-step loop where the
+    filter's fast path would run."""
+    if isinstance(prepared, navigation.NavigationPrepared):
+        return navigation.simulate(prepared, seed, compiled)
     started = time.perf_counter()
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
     gyro_ss, sensor_ss, init_ss = np.random.SeedSequence(seed).spawn(3)
@@ -160,7 +154,7 @@ def add_timing(timing, findings):
 
 
 def run(scenario, seed=None, overrides=(), star_catalog=None):
-    """Simulate one run; ``seed`` overrides the scenario's. Returns a :class:`RunResult`.
+    """Simulate one run; ``seed`` overrides the scenario's. Returns a :class:`~navsim.records.RunResult`.
 
     ``overrides`` is a dict {"gyro.rate_hz": 200} or a list of "key=value" strings.
     ``star_catalog`` (a startrack StarCatalog) is loaded from the scenario epoch when needed.
@@ -190,7 +184,7 @@ def run_study(scenario, seed=None, overrides=(), progress=False):
 def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
     """Many runs of one scenario sharing its seed-free part (truth, models, catalog): a batch of
     one equals :func:`run` with that seed. The compiled filter loop releases the GIL, so
-    ``threads`` > 1 runs members concurrently. Returns the list of :class:`RunResult`."""
+    ``threads`` > 1 runs members concurrently. Returns the list of :class:`~navsim.records.RunResult`."""
     prepared = prepare(scenario, overrides, star_catalog)
     if threads <= 1:
         return [simulate(prepared, int(seed)) for seed in seeds]

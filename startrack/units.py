@@ -48,6 +48,8 @@ def rrw_to_si(x):
 STANDARD_GRAVITY = 9.80665
 #: International nautical mile [m].
 NAUTICAL_MILE = 1852.0
+#: The gravity-anomaly unit milligal [m/s²] (1 Gal = 1 cm/s²).
+MILLIGAL = 1e-5
 
 
 def micro_g_to_si(x):

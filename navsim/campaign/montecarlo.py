@@ -15,7 +15,10 @@ ones. The aggregate is computed from the files, in run order, and is therefore i
 way the runs were produced.
 """
 
+import contextlib
+import functools
 import json
+import multiprocessing
 import os
 import re
 import shutil
@@ -26,7 +29,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from navsim.estimation.consistency import nees_statistics
+from navsim.campaign import navigation
+from navsim.campaign.pooling import averaged_nees, calibration, diverged, spread
 from navsim.output import read_npz, write_json, write_run
 from navsim.places import campaign_lock, check_output, mark
 from navsim.records import CampaignSummary, RunSummary
@@ -55,14 +59,21 @@ MAX_RUNS = 1_000_000
 ENVIRONMENT_ERRORS = (OSError, MemoryError, TimeoutError)
 
 
+@functools.lru_cache(maxsize=1)
+def _prepared(scenario_json, source):
+    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`), computed once
+    per process and kept for every chunk it runs (a navigation truth takes seconds per hour)."""
+    return prepare(Scenario(data=json.loads(scenario_json), source=source))
+
+
 def run_chunk(scenario_data, source, members):
-    """Run campaign members [(seed, run_dir), ...] of one scenario, preparing its seed-free part
-    once (:func:`navsim.simulation.prepare`); each run is written atomically, and a run that
-    raises is recorded in ``run_dir/error.json`` (with its cause: the scenario, or the environment
-    when a rerun may cure it) without stopping the others. Returns the errors."""
+    """Run campaign members [(seed, run_dir), ...] of one scenario on its seed-free part (prepared once
+    per process); each run is written atomically, and a run that raises is recorded in
+    ``run_dir/error.json`` (with its cause: the scenario, or the environment when a rerun may cure
+    it) without stopping the others. Returns the errors."""
     errors = []
     try:
-        prepared = prepare(Scenario(data=scenario_data, source=source))
+        prepared = _prepared(json.dumps(scenario_data, sort_keys=True), source)
     except Exception as error:  # the scenario itself fails: every member records it
         prepared, failure = None, error
     for seed, run_dir in members:
@@ -197,11 +208,34 @@ def _execute(scenario, chunks, n_workers, client, bar):
         _run_pool(scenario, chunks, n_workers, bar)
 
 
-def _run_pool(scenario, chunks, n_workers, bar):
-    """Local processes; on Ctrl-C the pending chunks are cancelled and the workers stopped at once."""
-    pool = ProcessPoolExecutor(max_workers=n_workers)
+#: One BLAS thread per worker process, set before the worker imports numpy: workers whose BLAS
+#: starts a thread per core spin against each other on the same cores (2.6 times slower per run on
+#: two cores, benchmarks/strapdown.py).
+SINGLE_THREADED_BLAS = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _environment(values):
+    """``os.environ`` updated with ``values`` inside the block, restored after it."""
+    saved = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
     try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key)
+            else:
+                os.environ[key] = value
+
+
+def _run_pool(scenario, chunks, n_workers, bar):
+    """Local processes (freshly spawned, single-threaded BLAS); on Ctrl-C the pending chunks are
+    cancelled and the workers stopped at once."""
+    with _environment(SINGLE_THREADED_BLAS):
+        pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
         futures = {pool.submit(run_chunk, scenario.data, scenario.source, c): len(c) for c in chunks}
+    try:
         for future in as_completed(futures):
             future.result()
             bar.update(futures[future])
@@ -275,7 +309,8 @@ def load_runs(directory):
 
 
 def aggregate(directory):
-    """The :class:`~navsim.records.CampaignSummary` of the run files (deterministic: no wall-clock values)."""
+    """The :class:`~navsim.records.CampaignSummary` of the run files (deterministic: no wall-clock
+    values), with the statistics of the runs' kind (attitude or navigation, dispatched once)."""
     request, finished, failed = load_runs(directory)
     base = {"scenario": request["scenario"], "base_seed": request["base_seed"], "runs_requested": request["runs"],
             "runs_finished": len(finished), "runs_failed": len(failed),
@@ -283,59 +318,38 @@ def aggregate(directory):
     if not finished:
         return CampaignSummary(**base)
     summaries = [summary for _, summary, _ in finished]
-    return CampaignSummary(**base, **_error_statistics(finished, request["scenario_data"]["settle_s"]),
+    statistics = navigation.statistics if summaries[0].kind == "navigation" else _attitude_statistics
+    return CampaignSummary(**base, **statistics(finished, request["scenario_data"]["settle_s"]),
                            updates={key: int(sum(s["updates"][key] for s in summaries)) for key in ("accepted", "rejected")},
-                           gyro_calibration=_calibration(summaries), identification=_identification(summaries),
                            **_pooled_findings(summaries))
 
 
-def _error_statistics(finished, settle):
-    """Attitude errors pooled over every steady frame, per-run RMS spread, run-averaged NEES, divergent runs."""
-    errors, sigmas, nees_runs, divergent = [], [], [], []
-    dof = finished[0][1]["nees"]["dof"]
+def _attitude_statistics(finished, settle):
+    """Attitude errors pooled over every steady frame, per-run RMS spread, run-averaged NEES, divergent
+    runs, the gyro calibration states and the image-fidelity identification."""
+    errors, sigmas, divergent = [], [], []
     for k, summary, series in finished:
         steady = series["t"] >= settle
         errors.append(series["attitude_error"][steady])
         sigmas.append(np.sqrt(series["P_diag"][steady, :3]))
-        nees_runs.append(series["nees"])
-        if np.any(np.abs(errors[-1]) > 5.0 * sigmas[-1]) or summary["nees"]["mean"] > 5.0 * dof:
+        if diverged(summary, errors[-1], sigmas[-1]):
             divergent.append(k)
     stacked, sigma = np.concatenate(errors), np.concatenate(sigmas)
     arcsec = units.rad_to_arcsec
-    nees_block = {}
-    if len({len(n) for n in nees_runs}) == 1:
-        mean_nees = np.mean(np.array(nees_runs), axis=0)
-        nees_block = nees_statistics(mean_nees[finished[0][2]["t"] >= settle], dof, len(finished))
+    summaries = [summary for _, summary, _ in finished]
     return {
         "attitude_error_rms_arcsec": {axis: float(arcsec(np.sqrt(np.mean(stacked[:, i] ** 2)))) for i, axis in enumerate("xyz")},
         "attitude_error_percentiles_arcsec": {
             axis: {f"p{p}": float(arcsec(np.percentile(np.abs(stacked[:, i]), p))) for p in (50, 95, 99)}
             for i, axis in enumerate("xyz")},
         "filter_sigma_mean_arcsec": {axis: float(arcsec(np.mean(sigma[:, i]))) for i, axis in enumerate("xyz")},
-        "cross_boresight_rms_arcsec": _spread([s["cross_boresight_rms_arcsec"] for _, s, _ in finished]),
-        "roll_rms_arcsec": _spread([s["roll_rms_arcsec"] for _, s, _ in finished]),
-        "nees": nees_block,
+        "cross_boresight_rms_arcsec": spread([s["cross_boresight_rms_arcsec"] for s in summaries]),
+        "roll_rms_arcsec": spread([s["roll_rms_arcsec"] for s in summaries]),
+        "nees": averaged_nees(finished, settle),
         "divergent_runs": divergent,
+        "gyro_calibration": calibration([s.gyro_calibration for s in summaries]),
+        "identification": _identification(summaries),
     }
-
-
-def _spread(values):
-    return {"mean": float(np.mean(values)), "p50": float(np.percentile(values, 50)),
-            "p95": float(np.percentile(values, 95)), "max": float(np.max(values))}
-
-
-def _calibration(summaries):
-    """Final normalised errors of the gyro calibration states over the runs: RMS per state (1 for a
-    consistent filter) and the share within 3σ."""
-    runs = [s.gyro_calibration for s in summaries if s.gyro_calibration]
-    if not runs:
-        return None
-    out = {"runs": len(runs)}
-    for name in runs[0]:
-        errors = np.array([r[name]["normalised_error"] for r in runs])
-        out[name] = {"normalised_error_rms": [float(v) for v in np.sqrt(np.mean(errors**2, axis=0))],
-                     "within_3_sigma": float(np.mean(np.abs(errors) <= 3.0))}
-    return out
 
 
 def _identification(summaries):

@@ -1,7 +1,8 @@
 """Filter tuning: scale Q and R until the filter is consistent over a batch of seeded runs.
 
-Consistency means the time-averaged NEES of attitude and bias is at its expected value (its
-dof, 6) and the NIS per degree of freedom is 1 (Bar-Shalom, Li & Kirubarajan, *Estimation with
+Consistency means the time-averaged NEES of the filter's error state is at its expected value (its
+dof, which each run's summary records: 6 for the attitude filter's attitude and bias, 15 or 21 for
+the navigation filter) and the NIS per degree of freedom is 1 (Bar-Shalom, Li & Kirubarajan, *Estimation with
 Applications to Tracking and Navigation*, §5.4). With common random numbers (the same seeds at
 every evaluation) the two scale factors are fitted together by minimising
 
@@ -18,19 +19,21 @@ import numpy as np
 from scipy.optimize import minimize
 
 from navsim.scenario import resolve_scenario
+from navsim.scenario.navigation import aiding_rates
 from navsim.simulation import run_batch
+from startrack.errors import InputError
 
 
 @dataclass
 class TuneStep:
-    """Statistics of one iteration's batch with the scales it used."""
+    """Statistics of one iteration's batch with the scales it used; ``errors``: the batch mean of
+    each headline error of the runs' kind, {label: (value, unit)} (:data:`navsim.records.HEADLINE`)."""
 
     process_noise_scale: float
     measurement_noise_scale: float
     nees_per_dof: float
     nis_per_dof: float
-    cross_boresight_rms_arcsec: float
-    roll_rms_arcsec: float
+    errors: dict
 
 
 @dataclass
@@ -54,7 +57,7 @@ class TuneResult:
 
 
 def batch_statistics(results, settle_s):
-    """(NEES per dof, NIS per dof, mean cross-boresight RMS, mean roll RMS) over a batch."""
+    """(NEES per dof, NIS per dof, {label: (batch mean, unit)} of the headline errors) over a batch."""
     nees, nis, dof = [], 0.0, 0
     nees_dof = results[0].summary["nees"]["dof"]
     for result in results:
@@ -63,12 +66,9 @@ def batch_statistics(results, settle_s):
         accepted = np.isfinite(result.series["nis"]) & steady
         nis += float(np.sum(result.series["nis"][accepted]))
         dof += int(np.sum(result.series["nis_dof"][accepted]))
-    return (
-        float(np.mean(np.concatenate(nees))) / nees_dof,
-        nis / max(dof, 1),
-        float(np.mean([r.summary["cross_boresight_rms_arcsec"] for r in results])),
-        float(np.mean([r.summary["roll_rms_arcsec"] for r in results])),
-    )
+    headlines = [r.summary.headline() for r in results]
+    errors = {label: (float(np.mean([h[label][0] for h in headlines])), unit) for label, (_, unit) in headlines[0].items()}
+    return float(np.mean(np.concatenate(nees))) / nees_dof, nis / max(dof, 1), errors
 
 
 def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0.05, threads=1):
@@ -80,6 +80,9 @@ def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0
     """
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("filter tuning")
+    if scenario.is_navigation and not aiding_rates(scenario.data):
+        raise InputError(f"{scenario.source}: filter tuning needs measurements to judge the NIS by; a free INS without "
+                         "[baro] has none (add [aiding.position] or [baro])")
     base_seed = scenario["seed"] if seed is None else int(seed)
     seeds = [base_seed + k for k in range(runs)]
     outcome = TuneResult()
@@ -88,8 +91,8 @@ def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0
         q_scale, r_scale = (float(v) for v in np.exp(log_scales))
         results = run_batch(scenario, seeds, overrides={"filter.process_noise_scale": q_scale,
                                                         "filter.measurement_noise_scale": r_scale}, threads=threads)
-        nees, nis, cross, roll = batch_statistics(results, scenario["settle_s"])
-        outcome.steps.append(TuneStep(q_scale, r_scale, nees, nis, cross, roll))
+        nees, nis, errors = batch_statistics(results, scenario["settle_s"])
+        outcome.steps.append(TuneStep(q_scale, r_scale, nees, nis, errors))
         if abs(nees - 1.0) < tolerance and abs(nis - 1.0) < tolerance:
             raise _Converged
         return np.log(nees) ** 2 + np.log(nis) ** 2

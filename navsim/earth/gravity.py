@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from navsim.earth.wgs84 import A, E2, F, GAMMA_E, K_SOMIGLIANA, M
+from navsim.earth.wgs84 import E2, GAMMA_E, K_SOMIGLIANA, A, F, M
 from startrack.errors import InputError
 from startrack.jit import njit
 

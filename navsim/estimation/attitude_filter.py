@@ -30,47 +30,18 @@ The linear algebra is compiled (:mod:`navsim.estimation.kernels`); it is tested 
 filterpy's ``KalmanFilter.predict``/``update`` (Joseph form), which is the reference engine.
 """
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from navsim.estimation import kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
+from navsim.estimation.updates import UpdateResult
 from startrack import rotation as rot
 
 #: How a group of extra states is treated.
 TREATMENTS = ("estimate", "consider", "ignore")
 #: The groups of extra states in error-state order, with their sizes.
 GROUPS = (("bias_instability", 3), ("scale_factor", 3), ("gyro_misalignment", 6), ("mounting", 3))
-
-
-@dataclass(frozen=True)
-class UpdateResult:
-    """Outcome of one measurement update: innovations z (one row per measurement), NIS per
-    measurement against the prior, the accepted mask, and whether the attitude was re-initialised
-    from the sensor's own fix before it (a lost track)."""
-
-    z: np.ndarray
-    nis: np.ndarray
-    accepted: np.ndarray
-    reinitialised: bool = False
-
-    @property
-    def n_accepted(self):
-        return int(np.count_nonzero(self.accepted))
-
-    @property
-    def n_rejected(self):
-        return self.accepted.size - self.n_accepted
-
-    def statistics(self):
-        """(accepted, NIS sum of the accepted, its dof, RMS of their innovations [rad])."""
-        if self.z.shape[1] == 3:
-            if not self.accepted[0]:
-                return 0, np.nan, 0, np.nan
-            return 1, float(self.nis[0]), 3, float(np.sqrt(np.sum(self.z * self.z) / 3.0))
-        return kernels.star_statistics(self.z, self.nis, self.accepted)
 
 
 def _read_only(array):
@@ -179,7 +150,7 @@ class AttitudeFilter:
         variance = self._variance(sigma, ref_I.shape[0])
         self._x, self._P, z, nis, accepted = kernels.stars_update(
             self._x, self._P, ref_I, obs_S, variance, self.gate[2], self.model, self.estimated)
-        return UpdateResult(z=z, nis=nis, accepted=accepted)
+        return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
 
     def _variance(self, sigma, count):
         return self.variance_scale * np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (count,)).copy()

@@ -7,21 +7,22 @@ biases, optional scale factors) and the covariance P of the error state
 
     x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)],   C_nb,est = (I − [φ×]) C_nb,true.
 
-``predict`` mechanizes the corrected IMU increments at the IMU rate and propagates P every
-``covariance_interval`` increments with the discretised error dynamics (Φ, Q_d by series, tested
+``predict(samples, dt)`` mechanizes the corrected IMU samples at the IMU rate and propagates P every
+``covariance_interval`` intervals with the discretised error dynamics (Φ, Q_d by series, tested
 against expm and Van Loan); ``update_position`` and ``update_baro`` gate each measurement by its
 chi-square NIS against the prior, update in Joseph form and reset the estimate into the nominal
-state. Nobody else writes the state or P: read them through the properties.
+state; ``process_record`` is the compiled fast path over a whole aiding record, tested equal to the
+step-by-step loop of :mod:`navsim.closed_loop`. Nobody else writes the state or P: read them
+through the properties.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.earth.wgs84 import radii
 from navsim.estimation import nav_kernels
-from navsim.estimation.attitude_filter import UpdateResult
 from navsim.estimation.consistency import chi2_quantile
+from navsim.estimation.updates import UpdateResult
 from navsim.ins import strapdown
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -58,67 +59,73 @@ class NavFilter:
     [m/s], ``q_nb``; ``P`` (15x15, or 21x21 with ``estimate_scale_factors``); ``noise``
     (:class:`ImuNoise`); ``dt`` the IMU interval [s]; ``covariance_interval`` the number of
     increments per covariance propagation; ``gate_probability`` of the chi-square gates;
-    ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
+    ``process_noise_scale`` (multiplies Q) and ``measurement_noise_scale`` (multiplies each
+    measurement's σ) for tuning; ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
     """
 
     def __init__(self, lat, lon, h, v_n, q_nb, P, noise, dt, estimate_scale_factors=False,
-                 covariance_interval=20, gate_probability=0.9999, gyro_bias=(0.0, 0.0, 0.0),
-                 accel_bias=(0.0, 0.0, 0.0)):
+                 covariance_interval=20, gate_probability=0.9999, process_noise_scale=1.0,
+                 measurement_noise_scale=1.0, gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0)):
         self.n = SCALE_STATES if estimate_scale_factors else BASE_STATES
         if not dt > 0.0:
             raise InputError(f"imu.rate_hz: the IMU interval must be > 0, got {dt!r} s")
         if int(covariance_interval) < 1:
             raise InputError(f"filter.covariance_interval: must be >= 1 IMU interval, got {covariance_interval!r}")
-        self.dt = float(dt)
-        self.covariance_interval = int(covariance_interval)
-        self.q_c = noise.spectral_densities(self.n)
-        self.gate = {dof: float(chi2_quantile(gate_probability, dof)) for dof in (1, 3)}
-        self._imu = np.zeros(12)
-        self._imu[0:3], self._imu[3:6] = gyro_bias, accel_bias
-        self.reset(lat, lon, h, v_n, q_nb, P)
-
-    def reset(self, lat, lon, h, v_n, q_nb, P):
-        """Re-initialise the navigation state and the covariance (the IMU error estimates are kept)."""
         P = np.array(P, dtype=float)
         if P.shape != (self.n, self.n):
             raise InputError(f"filter.P: must be {self.n}x{self.n} for the chosen states, got {P.shape}")
+        self.dt = float(dt)
+        self.covariance_interval = int(covariance_interval)
+        self.q_c = float(process_noise_scale) * noise.spectral_densities(self.n)
+        self.sigma_scale = float(measurement_noise_scale)
+        self.gates = np.array([chi2_quantile(gate_probability, dof) for dof in (3, 1)], dtype=float)
+        self._imu = np.zeros(12)
+        self._imu[0:3], self._imu[3:6] = gyro_bias, accel_bias
         self._nav = strapdown.initial_state(lat, lon, h, v_n, q_nb)
         self._P = 0.5 * (P + P.T)
         self._acc = np.zeros(nav_kernels.ACC_SIZE)
 
-    def predict(self, dtheta, dv):
-        """Mechanize IMU increments ``dtheta`` [rad], ``dv`` [m/s] (3,) or (m, 3), one interval each."""
-        dtheta = np.ascontiguousarray(np.atleast_2d(dtheta), dtype=float)
-        dv = np.ascontiguousarray(np.atleast_2d(dv), dtype=float)
-        nav_kernels.predict(self._nav, self._imu, self._P, self._acc, dtheta, dv, self.dt, self.q_c,
+    def predict(self, samples, dt):
+        """Mechanize IMU samples (m, 6) of the filter's interval ``dt`` [s]: each row the interval means
+        of the measured rate [rad/s] and specific force [m/s²] (an increment divided by dt)."""
+        if dt != self.dt:
+            raise ValueError(f"IMU interval {dt} s, the filter was built for {self.dt} s")
+        samples = np.ascontiguousarray(np.atleast_2d(samples), dtype=float)
+        nav_kernels.predict(self._nav, self._imu, self._P, self._acc, samples, self.dt, self.q_c,
                             self.covariance_interval)
 
     def update_position(self, lat, lon, h, sigma):
-        """Update with a position fix (L, λ [rad], h [m]) of NED σ ``sigma`` (3,) [m], gated at 3 dof."""
-        self._flush()
-        r_m, r_n = radii(self._nav[0])
-        sigma = np.broadcast_to(np.asarray(sigma, dtype=float), (3,))
-        scale = np.array([r_m + self._nav[2], (r_n + self._nav[2]) * np.cos(self._nav[0]), 1.0])
-        R = np.diag((sigma / scale) ** 2)
-        z = self._nav[0:3] - np.array([lat, lon, h])
-        nis, accepted = nav_kernels.position_update(self._nav, self._imu, self._P, z, R, self.gate[3])
+        """Update with a position fix (L, λ [rad], h [m]) of NED σ ``sigma`` (3,) [m], gated at 3 dof;
+        the innovation is reported in NED metres."""
+        sigma = np.broadcast_to(np.asarray(sigma, dtype=float), (3,)) * self.sigma_scale
+        z, nis, accepted = nav_kernels.position_update(self._nav, self._imu, self._P, self._acc, self.q_c, self.dt,
+                                                       np.array([lat, lon, h], dtype=float), sigma, self.gates[0])
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
     def update_baro(self, h, sigma):
         """Update with a baro height ``h`` [m] of σ ``sigma`` [m], gated at 1 dof."""
-        self._flush()
-        z = self._nav[2] - float(h)
-        nis, accepted = nav_kernels.baro_update(self._nav, self._imu, self._P, z, float(sigma) ** 2, self.gate[1])
-        return UpdateResult(z=np.array([[z]]), nis=np.array([nis]), accepted=np.array([accepted]))
+        z, nis, accepted = nav_kernels.baro_update(self._nav, self._imu, self._P, self._acc, self.q_c, self.dt,
+                                                   float(h), float(sigma) * self.sigma_scale, self.gates[1])
+        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
-    def _flush(self):
-        nav_kernels.flush(self._nav, self._P, self._acc, self.q_c, self.dt)
+    def process_record(self, samples, ratio, dt, record):
+        """The compiled fast path: the whole :class:`~navsim.sensors.aiding.AidingRecord` at once
+        (:func:`nav_kernels.run_record`), returning the per-frame log the step-by-step loop of
+        :mod:`navsim.closed_loop` would have written. ``samples`` (F*ratio, 6) IMU samples."""
+        if dt != self.dt:
+            raise ValueError(f"IMU interval {dt} s, the filter was built for {self.dt} s")
+        out = nav_kernels.run_record(self._nav, self._imu, self._P, self._acc, np.ascontiguousarray(samples, dtype=float),
+                                     int(ratio), self.dt, self.q_c, self.covariance_interval,
+                                     np.ascontiguousarray(record.position), record.position_sigma * self.sigma_scale,
+                                     np.ascontiguousarray(record.baro), record.baro_sigma * self.sigma_scale, self.gates)
+        nav_log, imu_log, P_log = out[0], out[1], out[2]
+        log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[3:]))
+        return {**_snapshot_arrays(nav_log, imu_log, self.n), "P": P_log, **log}
 
     def snapshot(self):
         """What a run log keeps of the filter at an epoch: position, velocity, attitude, IMU error
         estimates and P (copies)."""
-        return {"lat": self._nav[0], "lon": self._nav[1], "h": self._nav[2], "v_n": self.v_n, "q_nb": self.q_nb,
-                "gyro_bias": self.gyro_bias, "accel_bias": self.accel_bias, "P": self.P}
+        return {**_snapshot_arrays(self._nav[0:10], self._imu, self.n), "P": self.P}
 
     @property
     def P(self):
@@ -150,6 +157,17 @@ class NavFilter:
     def scale_factors(self):
         """(ŝ_g, ŝ_a) estimates [-] (zero unless estimated)."""
         return self._imu[6:9].copy(), self._imu[9:12].copy()
+
+
+def _snapshot_arrays(nav, imu, n):
+    """The snapshot's named parts (copies) of nav[0:10] and the IMU estimates, one row or (F, ·) rows:
+    lat, lon, h, v_n, q_nb, gyro_bias, accel_bias and, with scale-factor states, gyro_scale_factor
+    and accel_scale_factor."""
+    out = {"lat": nav[..., 0].copy(), "lon": nav[..., 1].copy(), "h": nav[..., 2].copy(), "v_n": nav[..., 3:6].copy(),
+           "q_nb": nav[..., 6:10].copy(), "gyro_bias": imu[..., 0:3].copy(), "accel_bias": imu[..., 3:6].copy()}
+    if n > BASE_STATES:
+        out["gyro_scale_factor"], out["accel_scale_factor"] = imu[..., 6:9].copy(), imu[..., 9:12].copy()
+    return out
 
 
 def error_state(lat, lon, h, v_n, q_nb, gyro_bias, accel_bias, truth_lat, truth_lon, truth_h, truth_v_n,

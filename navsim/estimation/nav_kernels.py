@@ -22,6 +22,12 @@ from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, qua
 
 #: First index of the position error (δL, δλ, δh) in the error state.
 DP = 6
+#: The states a baro height updates: the vertical channel δv_D, δh and the body-z accelerometer bias
+#: (down in level flight); for its update every other state is a consider state (Schmidt), so a baro
+#: damps the vertical channel and tells the filter nothing of the horizontal ones. (Estimating them
+#: all, the filter would draw horizontal information from a white-noise height through the Coriolis
+#: and v²/R couplings of the vertical channel, which no biased, lagging baro really carries.)
+BARO_STATES = (5, DP + 2, 14)
 #: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
 #: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].
 ACC_SIZE = 31
@@ -121,12 +127,13 @@ def discretize(F, q_c, dt):
 
 
 @njit
-def correct(dtheta, dv, imu, dt, n, a, b):
-    """Write into ``a``, ``b`` the increments corrected by the estimates ``imu`` = [b̂_g, b̂_a, ŝ_g, ŝ_a]:
-    (1 − ŝ_g)(Δθ − b̂_g Δt) and (1 − ŝ_a)(Δv − b̂_a Δt)."""
+def correct(sample, imu, dt, n, a, b):
+    """Write into ``a``, ``b`` the increments of one IMU ``sample`` (6,) (interval means: rate [rad/s],
+    specific force [m/s²]) corrected by the estimates ``imu`` = [b̂_g, b̂_a, ŝ_g, ŝ_a]:
+    (1 − ŝ_g)(ω̃ − b̂_g) Δt and (1 − ŝ_a)(f̃ − b̂_a) Δt."""
     for i in range(3):
-        a[i] = dtheta[i] - imu[i] * dt
-        b[i] = dv[i] - imu[3 + i] * dt
+        a[i] = (sample[i] - imu[i]) * dt
+        b[i] = (sample[3 + i] - imu[3 + i]) * dt
         if n > 15:
             a[i] *= 1.0 - imu[6 + i]
             b[i] *= 1.0 - imu[9 + i]
@@ -166,13 +173,13 @@ def flush(nav, P, acc, q_c, dt):
 
 
 @njit
-def predict(nav, imu, P, acc, dtheta, dv, dt, q_c, every):
-    """Mechanize the corrected increments (M, 3) and propagate P every ``every`` intervals
+def predict(nav, imu, P, acc, samples, dt, q_c, every):
+    """Mechanize the corrected IMU samples (M, 6) and propagate P every ``every`` intervals
     (the remainder stays in ``acc`` until the next call or update). All arrays change in place."""
     n = P.shape[0]
     a, b = np.empty(3), np.empty(3)
-    for k in range(dtheta.shape[0]):
-        correct(dtheta[k], dv[k], imu, dt, n, a, b)
+    for k in range(samples.shape[0]):
+        correct(samples[k], imu, dt, n, a, b)
         accumulate(acc, nav[6:10], a, b)
         step(nav, a, b, dt)
         if acc[0] >= every:
@@ -193,28 +200,46 @@ def reset(nav, imu, dx, n):
 
 
 @njit
-def position_update(nav, imu, P, z, R, gate):
-    """Gated update with (L, λ, h) innovations z = est − measured (3,) of covariance R (3x3):
-    H = [0 0 I 0 …]. Returns (nis, accepted); state, P and the nominal state change in place."""
+def position_update(nav, imu, P, acc, q_c, dt, fix, sigma, gate):
+    """Flush the covariance, then the gated update with a position fix ``fix`` = (L, λ, h) [rad, rad, m]
+    of NED σ ``sigma`` (3,) [m]: z = (L̂, λ̂, ĥ) − fix, H = [0 0 I 0 …],
+    R = diag(σ_N²/(R_M+h)², σ_E²/((R_N+h) cos L)², σ_D²). Returns (z in NED metres (3,), nis,
+    accepted); the state, P and the nominal state change in place."""
+    flush(nav, P, acc, q_c, dt)
     n = P.shape[0]
+    r_m, r_n = radii(nav[0])
+    scale = np.array([r_m + nav[2], (r_n + nav[2]) * np.cos(nav[0]), -1.0])
     H = np.zeros((3, n))
+    R = np.zeros((3, 3))
+    z = np.empty(3)
     for i in range(3):
         H[i, DP + i] = 1.0
-    return _gated_update(nav, imu, P, H, R, z, gate)
+        R[i, i] = (sigma[i] / scale[i]) ** 2
+        z[i] = nav[i] - fix[i]
+    z_m = z * scale
+    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, np.ones(n, dtype=np.bool_))  # every state estimated
+    return z_m, nis, accepted
 
 
 @njit
-def baro_update(nav, imu, P, z, variance, gate):
-    """Gated update with a height innovation z = ĥ − h_baro [m] of variance [m²]: H = e_h."""
+def baro_update(nav, imu, P, acc, q_c, dt, height, sigma, gate):
+    """Flush the covariance, then the gated update of the vertical channel (:data:`BARO_STATES`) with
+    a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""
+    flush(nav, P, acc, q_c, dt)
     n = P.shape[0]
     H = np.zeros((1, n))
     H[0, DP + 2] = 1.0
-    R = np.full((1, 1), variance)
-    return _gated_update(nav, imu, P, H, R, np.array([z]), gate)
+    R = np.full((1, 1), sigma * sigma)
+    z = np.array([nav[2] - height])
+    estimated = np.zeros(n, dtype=np.bool_)
+    for i in BARO_STATES:
+        estimated[i] = True
+    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, estimated)
+    return z, nis, accepted
 
 
 @njit
-def _gated_update(nav, imu, P, H, R, z, gate):
+def _gated_update(nav, imu, P, H, R, z, gate, estimated):
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
     nis = 0.0
@@ -223,7 +248,40 @@ def _gated_update(nav, imu, P, H, R, z, gate):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
         return nis, False
-    dx, P_next = joseph_update(P, H, R, z, np.ones(P.shape[0], dtype=np.bool_))  # every state estimated
+    dx, P_next = joseph_update(P, H, R, z, estimated)
     P[:, :] = P_next
     reset(nav, imu, dx, P.shape[0])
     return nis, True
+
+
+@njit
+def run_record(nav, imu, P, acc, samples, ratio, dt, q_c, every, position, position_sigma, baro, baro_sigma, gates):
+    """The whole-record loop of the fast path: for each frame f, ``ratio`` IMU samples of ``samples``
+    (F*ratio, 6) propagate the filter (:func:`predict`), then the frame's position fix (a row of
+    ``position`` (F, 3), NaN: none) and baro height (``baro`` (F,), NaN: none) update it in that
+    order, with ``gates`` = (3-dof, 1-dof) NIS gates. Returns the per-frame logs of the step-by-step
+    loop: nav[0:10] (F, 10), the IMU estimates (F, 12), P (F, n, n) and the frame's update
+    statistics (measurements, accepted, NIS sum, dof, innovation RMS [m])."""
+    frames = position.shape[0]
+    n = P.shape[0]
+    nav_log, imu_log, P_log = np.empty((frames, 10)), np.empty((frames, 12)), np.empty((frames, n, n))
+    n_meas, n_acc, dof_log = np.zeros(frames, np.int32), np.zeros(frames, np.int32), np.zeros(frames, np.int32)
+    nis_log, rms_log = np.full(frames, np.nan), np.full(frames, np.nan)
+    for f in range(frames):
+        predict(nav, imu, P, acc, samples[f * ratio:(f + 1) * ratio], dt, q_c, every)
+        count, accepted, nis_sum, dof, squares = 0, 0, 0.0, 0, 0.0
+        if not np.isnan(position[f, 0]):
+            z, nis, ok = position_update(nav, imu, P, acc, q_c, dt, position[f], position_sigma, gates[0])
+            count += 1
+            if ok:
+                accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 3, squares + np.sum(z * z)
+        if not np.isnan(baro[f]):
+            z, nis, ok = baro_update(nav, imu, P, acc, q_c, dt, baro[f], baro_sigma, gates[1])
+            count += 1
+            if ok:
+                accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 1, squares + z[0] * z[0]
+        nav_log[f], imu_log[f], P_log[f] = nav[0:10], imu, P
+        n_meas[f], n_acc[f], dof_log[f] = count, accepted, dof
+        if accepted:
+            nis_log[f], rms_log[f] = nis_sum, np.sqrt(squares / dof)
+    return nav_log, imu_log, P_log, n_meas, n_acc, nis_log, dof_log, rms_log

@@ -29,7 +29,7 @@ import numpy as np
 
 from navsim.earth.frames import earth_rate_n, transport_rate_n
 from navsim.earth.gravity import normal_gravity
-from navsim.earth.wgs84 import A, GAMMA_E, radii
+from navsim.earth.wgs84 import GAMMA_E, A, radii
 from startrack import rotation as rot
 from startrack.errors import InputError
 from startrack.jit import njit

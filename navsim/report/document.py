@@ -146,7 +146,7 @@ class Document:
         return typst.compile(str(path), root=str(self.workdir), ignore_system_fonts=True)
 
 
-def _scenario_name(summary, scenario, directory):
+def scenario_name(summary, scenario, directory):
     for name in ((summary or {}).get("scenario"), (scenario or {}).get("name")):
         if isinstance(name, str) and name:
             return name
@@ -159,7 +159,7 @@ def _scenario_name(summary, scenario, directory):
 def run_report(run) -> bytes:
     """The PDF (bytes) of one run directory's report."""
     summary, s = run.summary, run.series
-    name = _scenario_name(summary, run.scenario, run.directory)
+    name = scenario_name(summary, run.scenario, run.directory)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim run report: {name}", f"navsim run · {name}")
         description = (run.scenario or {}).get("description", "")
@@ -169,7 +169,7 @@ def run_report(run) -> bytes:
             f"{run.frames} star-sensor frames over {number(float(s['t'][-1]), 1)} s; fidelity "
             f"{summary.get('fidelity', 'n/a')}, measurement {summary.get('measurement', 'n/a')}."))
         _key_results(doc, run)
-        _scenario_section(doc, run.scenario)
+        scenario_section(doc, run.scenario)
         _attitude_section(doc, run)
         _bias_section(doc, run)
         _calibration_section(doc, run.summary.get("gyro_calibration"))
@@ -177,8 +177,8 @@ def run_report(run) -> bytes:
         _sensor_section(doc, run)
         _address_section(doc, run)
         _frame_section(doc, run)
-        _comparison_section(doc, *_with_timing(summary, "paper_comparison"))
-        _notes_section(doc, *_with_timing(summary, "notes"))
+        comparison_section(doc, summary)
+        _notes_section(doc, summary)
         _absent_section(doc, run)
         return doc.compile()
 
@@ -232,7 +232,7 @@ def _key_results(doc, run):
         doc.add(table(("Quantity", "Value", "Unit"), rows, ("left", "right", "left")))
 
 
-def _scenario_section(doc, scenario):
+def scenario_section(doc, scenario):
     if not scenario:
         return
     doc.heading("Scenario parameters")
@@ -369,11 +369,14 @@ def _frame_section(doc, run):
 
 def _with_timing(summary, key):
     """(the summary's ``key`` list, the same list of its wall-clock ``timing``) for a section."""
-    return summary.get(key) or [], (summary.get("timing") or {}).get(key) or []
+    rows = summary.get(key) if isinstance(summary.get(key), list) else []
+    timing = summary.get("timing") if isinstance(summary.get("timing"), dict) else {}
+    return rows, timing.get(key) if isinstance(timing.get(key), list) else []
 
 
-def _comparison_section(doc, comparison, timed=()):
-    """The comparison table; rows of wall-clock figures (``timed``) marked as such."""
+def comparison_section(doc, summary):
+    """The summary's comparison with the source documents; rows of wall-clock figures marked as such."""
+    comparison, timed = _with_timing(summary, "paper_comparison")
     rows = [tuple(general(row.get(k, "")) for k in ("quantity", "ours", "paper", "source"))
             for row in [*comparison, *timed] if isinstance(row, dict)]
     if not rows:
@@ -384,7 +387,9 @@ def _comparison_section(doc, comparison, timed=()):
     doc.add(table(("Quantity", "Ours", "Source document", "Source"), rows, ("left", "right", "right", "left")))
 
 
-def _notes_section(doc, notes, timed=()):
+def _notes_section(doc, summary):
+    """The summary's notes on the comparison, then those on wall-clock figures."""
+    notes, timed = _with_timing(summary, "notes")
     if not notes and not timed:
         return
     doc.heading("What the comparison shows")
@@ -422,7 +427,7 @@ def study_report(study) -> bytes:
     kind = summary["study"]
     module = STUDIES[kind]
     parameters = study.scenario["study"][kind]
-    name = _scenario_name(summary, study.scenario, study.directory)
+    name = scenario_name(summary, study.scenario, study.directory)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim study report: {name}", f"navsim study · {name}")
         doc.title(f"Static study report: {name}", study.scenario.get("description") or str(study.directory))
@@ -430,9 +435,9 @@ def study_report(study) -> bytes:
                              f"wall time {number(summary.get('wall_seconds'), 1)} s."))
         doc.heading("Key results")
         doc.add(table(("Quantity", "Value", "Unit"), module.key_results(summary, parameters), ("left", "right", "left")))
-        _scenario_section(doc, study.scenario)
-        _comparison_section(doc, summary.get("paper_comparison") or [])
-        _notes_section(doc, summary.get("notes") or [])
+        scenario_section(doc, study.scenario)
+        comparison_section(doc, summary)
+        _notes_section(doc, summary)
         doc.heading("Figures")
         for fig, caption in module.figures(summary, study.arrays, parameters):
             doc.figure(fig, caption)
@@ -447,7 +452,7 @@ def campaign_report(campaign) -> bytes:
     first = campaign.runs[0]
     name = campaign.campaign.get("scenario")
     if not isinstance(name, str) or not name:
-        name = _scenario_name(first.summary, campaign.scenario, campaign.directory)
+        name = scenario_name(first.summary, campaign.scenario, campaign.directory)
     env = stats.envelopes(campaign)
     avg = stats.averaged_nees(campaign)
     success, criterion = stats.identification_success(campaign)
@@ -491,9 +496,9 @@ def campaign_report(campaign) -> bytes:
 
         doc.heading("Campaign")
         settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}  # scenario: next section
-        doc.add(table(("Setting", "Value"), [(k, _short(general(v))) for k, v in flatten(settings)],
+        doc.add(table(("Setting", "Value"), [(k, short(general(v))) for k, v in flatten(settings)],
                       ("left", "left")))
-        _scenario_section(doc, campaign.scenario)
+        scenario_section(doc, campaign.scenario)
 
         doc.heading("Statistics across runs")
         doc.paragraph(markup("Per-run metrics from each run's summary.json (after its settling time), "
@@ -536,20 +541,20 @@ def campaign_report(campaign) -> bytes:
             doc.figure(figures.identification_success(success, criterion), "Identification success per mode.")
 
         if campaign.summary:
-            rows = [(k, _short(general(v))) for k, v in flatten(campaign.summary.to_json())]
+            rows = [(k, short(general(v))) for k, v in flatten(campaign.summary.to_json())]
             if rows:
                 doc.heading("Aggregate summary")
                 doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))
                 doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
-            _comparison_section(doc, *_with_timing(campaign.summary, "paper_comparison"))
-            _notes_section(doc, *_with_timing(campaign.summary, "notes"))
+            comparison_section(doc, campaign.summary)
+            _notes_section(doc, campaign.summary)
 
         if campaign.failed:
             doc.heading("Failed runs")
-            doc.add(table(("Run", "Error"), [(f.name, _short(f.message, 160)) for f in campaign.failed],
+            doc.add(table(("Run", "Error"), [(f.name, short(f.message, 160)) for f in campaign.failed],
                           ("left", "left")))
         return doc.compile()
 
 
-def _short(text, limit=90):
+def short(text, limit=90):
     return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -288,10 +288,11 @@ def rendered_frame(run):
 # ----------------------------------------------------------------------------- campaigns
 
 
-def error_envelopes(env):
-    """Across-run mean ± σ and 5-95 % envelope of the error per axis, with the filter's average ±3σ."""
+def error_envelopes(env, labels=tuple(f"δθ{axis} [arcsec]" for axis in AXES), xlabel="time [s]", t_scale=1.0):
+    """Across-run mean ± σ and 5-95 % envelope of the error per axis (``labels``), with the filter's
+    average ±3σ; time divided by ``t_scale`` for the x axis."""
     fig, axes = new_figure(4.6, 3, 1)
-    t = env.t
+    t = env.t / t_scale
     for i, ax in enumerate(axes[:, 0]):
         ax.fill_between(t, env.p05[:, i], env.p95[:, i], color=COLORS[i], alpha=0.15, lw=0, label="5-95 %")
         ax.fill_between(t, env.mean[:, i] - env.std[:, i], env.mean[:, i] + env.std[:, i], color=COLORS[i],
@@ -303,10 +304,10 @@ def error_envelopes(env):
             ax.plot(t, env.sigma3_filter[:, i], "k--", lw=0.7, label="filter ±3σ (mean P)")
             ax.plot(t, -env.sigma3_filter[:, i], "k--", lw=0.7)
         _clip_to(ax, env.p05[:, i], env.p95[:, i], bound)
-        ax.set_ylabel(f"δθ{AXES[i]} [arcsec]")
+        ax.set_ylabel(labels[i])
         ax.legend(loc="upper right", ncols=5)
     axes[0, 0].set_title(f"{env.runs} runs")
-    axes[-1, 0].set_xlabel("time [s]")
+    axes[-1, 0].set_xlabel(xlabel)
     return fig
 
 

@@ -24,13 +24,32 @@ from startrack.errors import InputError
 
 #: A finished or failed run's directory (a leftover ``run_NNNNN.partial`` is neither).
 RUN_NAME = re.compile(r"run_\d{5,}")
-#: Arrays every run must have; the report cannot say anything without them.
-REQUIRED_SERIES = ("t", "attitude_error")
-#: Per-frame arrays and the trailing shape each must have when present (() for one number per frame).
+#: Arrays every run of a kind must have; the report cannot say anything without them.
+REQUIRED_SERIES = {"attitude": ("t", "attitude_error"),
+                   "navigation": ("t", "lat", "lon", "lat_true", "lon_true", "error_state", "error_sigma", "position_error_m")}
+#: Per-frame arrays with columns of their own count: the least number of columns (the filter's states).
+MIN_COLUMNS = {"P_diag": 6, "error_state": 15, "error_sigma": 15}
+#: Per-frame arrays and the trailing shape each must have when present (() for one number per frame,
+#: None for the arrays of :data:`MIN_COLUMNS`).
 SERIES_SHAPES = {
     "t": (),
     "attitude_error": (3,),
-    "P_diag": None,  # (F, n) with n >= 6
+    "P_diag": None,
+    "error_state": None,
+    "error_sigma": None,
+    "position_error_m": (3,),
+    "lat": (),
+    "lon": (),
+    "h": (),
+    "lat_true": (),
+    "lon_true": (),
+    "h_true": (),
+    "v_n": (3,),
+    "v_n_true": (3,),
+    "gyro_bias": (3,),
+    "accel_bias": (3,),
+    "gyro_bias_true": (3,),
+    "accel_bias_true": (3,),
     "bias_true": (3,),
     "bias_est": (3,),
     "nees": (),
@@ -48,8 +67,9 @@ SERIES_SHAPES = {
     "subcatalog_index": (),
     "subcatalog_address": (2,),
 }
-#: The arrays a campaign report reads from each run (the rest are not loaded).
-CAMPAIGN_SERIES = ("t", "attitude_error", "P_diag", "nees", "mode", "n_identified", "n_stacked", "n_accepted")
+#: The arrays a campaign report reads from each run of a kind (the rest are not loaded).
+CAMPAIGN_SERIES = {"attitude": ("t", "attitude_error", "P_diag", "nees", "mode", "n_identified", "n_stacked", "n_accepted"),
+                   "navigation": ("t", "error_state", "error_sigma", "position_error_m", "lat_true", "h_true", "nees")}
 
 
 @dataclass
@@ -106,8 +126,8 @@ def read_json(path: Path) -> dict:
     return payload
 
 
-def read_series(path: Path, names=None) -> dict:
-    """The arrays of ``timeseries.npz`` (all, or those of ``names`` present), shape-checked."""
+def read_series(path: Path, kind, names=None) -> dict:
+    """The arrays of ``timeseries.npz`` of a run of ``kind`` (all, or those of ``names`` present), shape-checked."""
     if not zipfile.is_zipfile(path):
         raise InputError(f"{path}: not an .npz array file (not a zip archive).")
     try:
@@ -116,8 +136,8 @@ def read_series(path: Path, names=None) -> dict:
             series = {name: data[name] for name in present}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
-    for name in REQUIRED_SERIES:
-        if name not in series:
+    for name in REQUIRED_SERIES[kind]:
+        if name not in series and (names is None or name in names):
             raise InputError(f"{path}: the array '{name}' is missing.")
     n = series["t"].shape[0] if series["t"].ndim == 1 else -1
     if n < 1:
@@ -126,9 +146,10 @@ def read_series(path: Path, names=None) -> dict:
         if name not in series:
             continue
         shape = series[name].shape
-        ok = shape[:1] == (n,) and (len(shape) == 2 and shape[1] >= 6 if trailing is None else shape[1:] == trailing)
+        ok = shape[:1] == (n,) and (len(shape) == 2 and shape[1] >= MIN_COLUMNS[name] if trailing is None
+                                    else shape[1:] == trailing)
         if not ok:
-            expected = f"({n}, >= 6)" if trailing is None else str((n, *trailing))
+            expected = f"({n}, >= {MIN_COLUMNS[name]})" if trailing is None else str((n, *trailing))
             raise InputError(f"{path}: array '{name}' has shape {shape}, expected {expected} (one row per frame).")
         if series[name].dtype.kind not in "biuf":
             raise InputError(f"{path}: array '{name}' is not numeric (dtype {series[name].dtype}).")
@@ -153,7 +174,7 @@ def directory_kind(directory: Path) -> str:
 
 def load_run(directory: Path) -> RunData:
     summary = RunSummary.read(directory / "summary.json")
-    series = read_series(directory / "timeseries.npz")
+    series = read_series(directory / "timeseries.npz", summary.kind)
     if (directory / "timing.npz").is_file():  # wall-clock times per frame, kept apart from the reproducible series
         series |= _read_timing(directory / "timing.npz", series["t"].size)
     scenario = read_json(directory / "scenario.json")
@@ -244,8 +265,9 @@ def load_campaign(directory: Path) -> CampaignData:
             message = error.get("error") or error.get("message") or json.dumps(error, sort_keys=True)
             data.failed.append(FailedRun(run_dir.name, str(message)))
         elif (run_dir / "summary.json").is_file() and (run_dir / "timeseries.npz").is_file():
-            series = read_series(run_dir / "timeseries.npz", CAMPAIGN_SERIES)
-            data.runs.append(RunData(run_dir, RunSummary.read(run_dir / "summary.json"), series))
+            summary = RunSummary.read(run_dir / "summary.json")
+            series = read_series(run_dir / "timeseries.npz", summary.kind, CAMPAIGN_SERIES[summary.kind])
+            data.runs.append(RunData(run_dir, summary, series))
     if not data.runs:
         raise InputError(f"{directory}: the campaign has no finished runs under runs/ "
                          f"({len(data.failed)} failed); nothing to report.")

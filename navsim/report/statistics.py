@@ -149,20 +149,27 @@ def common_frames(campaign):
 
 
 def envelopes(campaign):
+    """:class:`Envelopes` of the attitude error [arcsec] with the filter's ±3σ (when P_diag was logged)."""
     t = common_frames(campaign)
     n = t.size
     err = units.rad_to_arcsec(np.stack([r.series["attitude_error"][:n] for r in campaign.runs]))
-    ddof = 1 if len(campaign.runs) > 1 else 0
-    p05, p50, p95 = np.percentile(err, [5, 50, 95], axis=0)
-    sigma3, final_sigma = None, None
+    sigma = None
     if all("P_diag" in r.series for r in campaign.runs):
         var = np.mean(np.stack([r.series["P_diag"][:n, ATTITUDE] for r in campaign.runs]), axis=0)
         sigma = units.rad_to_arcsec(np.sqrt(var))
-        sigma3, final_sigma = 3.0 * sigma, sigma[-1]
+    return envelopes_of(t, err, sigma)
+
+
+def envelopes_of(t, err, sigma):
+    """:class:`Envelopes` of the errors ``err`` (M runs, F frames, 3) with the filter's σ (F, 3) from
+    the covariance averaged over the runs (or None)."""
+    ddof = 1 if err.shape[0] > 1 else 0
+    p05, p50, p95 = np.percentile(err, [5, 50, 95], axis=0)
     return Envelopes(
         t=t, runs=err.shape[0], mean=err.mean(axis=0), std=err.std(axis=0, ddof=ddof),
         p05=p05, p50=p50, p95=p95, rms=np.sqrt(np.mean(err**2, axis=0)),
-        sigma3_filter=sigma3, final=err[:, -1, :], final_sigma_filter=final_sigma,
+        sigma3_filter=None if sigma is None else 3.0 * sigma, final=err[:, -1, :],
+        final_sigma_filter=None if sigma is None else sigma[-1],
     )
 
 
@@ -268,10 +275,10 @@ class MetricRow:
     maximum: float
 
 
-def metric_table(campaign):
-    """Across-run statistics of each per-run metric found in the run summaries."""
+def metric_table(campaign, metrics=RUN_METRICS):
+    """Across-run statistics of each per-run metric (label, unit, path) found in the run summaries."""
     rows = []
-    for label, unit, path in RUN_METRICS:
+    for label, unit, path in metrics:
         values = [lookup(r.summary, path) for r in campaign.runs]
         values = np.array([v for v in values if v is not None], dtype=float)
         if values.size == 0:

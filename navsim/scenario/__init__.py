@@ -1,9 +1,10 @@
 """Scenario files: strict TOML with the unit in every key name.
 
 ``load_scenario(path, overrides)`` reads a file, applies ``--set key=value`` overrides
-(dotted keys, TOML values), validates everything against :data:`SCHEMA` (a simulation) or
-:func:`study_schema` (a static study: a file with a ``[study]`` table, see :mod:`navsim.studies`)
-and returns a :class:`Scenario` (the validated plain dictionary plus the name of its file). Every
+(dotted keys, TOML values), validates everything against :data:`SCHEMA` (an attitude simulation),
+:data:`navsim.scenario.navigation.SCHEMA` (a navigation simulation: a file with a ``[trajectory]``
+table) or :func:`study_schema` (a static study: a file with a ``[study]`` table, see
+:mod:`navsim.studies`) and returns a :class:`Scenario` (the validated plain dictionary plus the name of its file). Every
 problem ends in one :class:`InputError` naming the file, the key and what is wrong.
 """
 
@@ -16,14 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from navsim.estimation.attitude_filter import TREATMENTS
-from navsim.scenario.schema import ListOfTables, Table, Value
+from navsim.scenario import navigation
+from navsim.scenario.inertial_fields import GYRO_ERRORS, MAX_ARCSEC, MAX_ARW, MAX_BIAS, MAX_RATE, MAX_RRW
+from navsim.scenario.schema import ListOfTables, Table, Value, is_multiple
 from navsim.studies import STUDIES
 from startrack.errors import InputError
 
 PROFILES = ("constant_rate", "sinusoidal_axis", "rate_segments", "rigid_body")
-#: Upper bounds of physical values, far beyond any real vehicle or sensor: rates [deg/s], angle
-#: errors [arcsec], gyro noise [deg/√h, deg/h/√h] and bias [deg/h].
-MAX_RATE, MAX_ARCSEC, MAX_ARW, MAX_RRW, MAX_BIAS = 1e4, 36000.0, 1e3, 1e4, 1e6
 #: What one run holds in memory: gyro samples, truth samples (the finer grid) and star-sensor frames.
 MAX_GYRO_SAMPLES, MAX_TRUTH_SAMPLES, MAX_FRAMES = 1e7, 4e7, 2e5
 
@@ -80,21 +80,8 @@ SCHEMA = Table(
                 ),
             }
         ),
-        "gyro": Table(
-            {
-                "preset": Value("str", default=None, choices=("navigation", "tactical", "mems")),
-                "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e5),
-                "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW),
-                "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_RRW),
-                "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
-                "bias_instability_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
-                "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
-                "scale_factor_ppm": Value("float", default=None, minimum=0.0, maximum=1e5),
-                "misalignment_arcsec": Value("float", default=None, minimum=0.0, maximum=MAX_ARCSEC),
-                "quantization_arcsec": Value("float", default=None, minimum=0.0, maximum=MAX_ARCSEC),
-                "saturation_deg_per_s": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_RATE),
-            }
-        ),
+        "gyro": Table({"preset": GYRO_ERRORS["preset"], "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e5),
+                       **GYRO_ERRORS}),
         "star_sensor": Table(
             {
                 "fidelity": Value("str", default="vector", choices=("vector", "image"),
@@ -249,6 +236,11 @@ class Scenario:
         """True for a static study (a ``[study]`` table), False for a simulation."""
         return "study" in self.data
 
+    @property
+    def is_navigation(self):
+        """True for a navigation simulation (a ``[trajectory]`` table: the INS), False otherwise."""
+        return "trajectory" in self.data
+
     def require_simulation(self, action):
         """Raise an InputError when this is a static study, which ``action`` cannot take."""
         if self.is_study:
@@ -315,6 +307,8 @@ def validate(data, source="<scenario>"):
     """Check a raw dictionary against the schema and the cross-key rules."""
     if isinstance(data, dict) and "study" in data:
         return _validate_study(data, source)
+    if isinstance(data, dict) and "trajectory" in data:
+        return Scenario(data=navigation.validate(_checked(navigation.SCHEMA, data, source), source), source=source)
     for (table, key), replacement in RENAMED.items():
         if isinstance(data, dict) and isinstance(data.get(table), dict) and key in data[table]:
             raise InputError(f"{source}: {table}.{key}: renamed; use {replacement}")
@@ -326,12 +320,12 @@ def validate(data, source="<scenario>"):
     _only_chosen(truth, "truth", "profile", PROFILES, source)
     gyro_hz = checked["gyro"]["rate_hz"]
     sensor_hz = checked["star_sensor"]["rate_hz"]
-    if not _is_multiple(gyro_hz, sensor_hz):
+    if not is_multiple(gyro_hz, sensor_hz):
         raise InputError(
             f"{source}: star_sensor.rate_hz: {sensor_hz:g} Hz must divide gyro.rate_hz = {gyro_hz:g} Hz"
         )
     truth_hz = truth.get("rate_hz") or 4.0 * gyro_hz
-    if not _is_multiple(truth_hz, gyro_hz):
+    if not is_multiple(truth_hz, gyro_hz):
         raise InputError(
             f"{source}: truth.rate_hz: {truth_hz:g} Hz must be an integer multiple of gyro.rate_hz"
         )
@@ -435,11 +429,6 @@ def resolve_scenario(scenario, overrides=()):
     if isinstance(scenario, dict):
         return scenario_from_dict(scenario, overrides)
     return load_scenario(Path(scenario), overrides)
-
-
-def _is_multiple(high, low):
-    ratio = high / low
-    return ratio >= 1.0 - 1e-9 and abs(ratio - round(ratio)) < 1e-9
 
 
 def load_scenario(path, overrides=()):

@@ -151,10 +151,29 @@ class Table:
 
 
 @dataclass(frozen=True)
-class ListOfTables:
-    """A TOML array of tables, each checked against ``item``."""
+class Tagged:
+    """A table whose ``tag`` key picks one of ``variants`` (name -> :class:`Table`), each with its own
+    keys, defaults and bounds (a trajectory segment of one kind)."""
 
-    item: Table
+    tag: str
+    variants: dict
+    doc: str = ""
+
+    def check(self, where, value):
+        if not isinstance(value, dict):
+            raise InputError(f"{where}: must be a table")
+        kind = value.get(self.tag)
+        if not isinstance(kind, str) or kind not in self.variants:
+            raise InputError(f"{where}.{self.tag}: must be one of {', '.join(self.variants)}; got {kind!r}")
+        rest = {key: v for key, v in value.items() if key != self.tag}
+        return {self.tag: kind, **self.variants[kind].check(where, rest)}
+
+
+@dataclass(frozen=True)
+class ListOfTables:
+    """A TOML array of tables, each checked against ``item`` (a :class:`Table` or :class:`Tagged`)."""
+
+    item: Table | Tagged
     required: bool = False
     min_length: int = 0
     doc: str = field(default="")
@@ -165,3 +184,9 @@ class ListOfTables:
         if len(value) < self.min_length:
             raise InputError(f"{where}: needs at least {self.min_length} entries")
         return [self.item.check(f"{where}[{i}]", v) for i, v in enumerate(value)]
+
+
+def is_multiple(high, low):
+    """True when the rate ``high`` is an integer multiple (>= 1) of the rate ``low`` (to 1e-9)."""
+    ratio = high / low
+    return ratio >= 1.0 - 1e-9 and abs(ratio - round(ratio)) < 1e-9

@@ -88,6 +88,7 @@ class ImageRun:
 
     log_fields = LOG_FIELDS
     timing_fields = TIMING_FIELDS
+    uses_prediction = True
 
     def __init__(self, sensor, storm_rng, render_rng, n_frames, full_frames):
         self.sensor = sensor
@@ -118,7 +119,7 @@ class ImageRun:
             self.lose_track()
             return StarFrame(mode=lost[0], reason=lost[1], info=info | {"mode": MODE_CODE[lost[0]]})
         s = self.sensor
-        q_IS_true = rot.multiply(request.q_IB_true, s.q_BS_true)
+        q_IS_true = rot.multiply(request.truth.q_IB, s.q_BS_true)
         uv_pred, visible = s.camera.project(request.q_IS_pred, s.stars_I)
         predicted = np.flatnonzero(visible)
         full = (not self._tracking or len(predicted) == 0 or request.index == self._sample_at
@@ -163,7 +164,7 @@ class ImageRun:
             half = max(s.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
             windows = Windows.around(uv_predicted, half, camera.height, camera.width)
         frame = render_star_field(camera, model, q_IS_true, s.stars_I, s.stars_mag, self._render_rng,
-                                  omega_S=self._R_SB_true @ request.omega_B_true, windows=windows,
+                                  omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
                                   extra_sources=self._false_stars(request.t))
         b, sigma_n = model.background_dn, model.noise_dn
         if full:

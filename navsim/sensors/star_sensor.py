@@ -11,6 +11,9 @@ which answers three calls:
   the stars), ``None`` when nothing was fused;
 - ``lose_track()``: the estimate was knocked off (attitude-jump fault), start acquiring again.
 
+``uses_prediction`` says whether the run points itself with the filter's predicted attitude and rate
+(the image-fidelity sensor does; pre-drawn vector-fidelity frames do not).
+
 ``record()`` returns the measurements of every frame when they are known before the run (vector
 fidelity: they do not depend on the filter), which lets the filter take its compiled fast path;
 otherwise None. ``log_fields`` declares the per-frame quantities the sensor adds to the run log, and
@@ -28,16 +31,16 @@ MODE_CODE = {name: code for code, name in enumerate(MODES)}
 
 @dataclass(frozen=True)
 class FrameRequest:
-    """What the loop knows at a frame: its index and time [s], the truth (q_IB, the body rate over
-    the last gyro interval [rad/s]) from which the sky is seen, and the filter's prediction of the
-    sensor attitude q_IS and of the rate in sensor axes [rad/s]."""
+    """What the loop knows at a frame: its index and time [s], the truth record of the frame (for
+    the star sensor :class:`~navsim.truth.profiles.FrameTruth`: q_IB and the body rate over the last
+    gyro interval [rad/s], from which the sky is seen) and, for a sensor run that ``uses_prediction``,
+    the filter's prediction of the sensor attitude q_IS and of the rate in sensor axes [rad/s]."""
 
     index: int
     t: float
-    q_IB_true: np.ndarray
-    omega_B_true: np.ndarray
-    q_IS_pred: np.ndarray
-    omega_S_pred: np.ndarray
+    truth: object
+    q_IS_pred: np.ndarray | None = None
+    omega_S_pred: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -62,5 +65,10 @@ class StarFrame:
     diagnostics: dict = field(default_factory=dict)
 
     @property
-    def has_measurements(self):
-        return self.q_IS is not None or len(self.ref_I) > 0
+    def measurements(self):
+        """((kind, arguments of the filter's update),) of the frame: an attitude fix, stars or nothing."""
+        if self.q_IS is not None:
+            return (("attitude", (self.q_IS, self.R_S)),)
+        if len(self.ref_I):
+            return (("stars", (self.ref_I, self.obs_S, self.sigma)),)
+        return ()

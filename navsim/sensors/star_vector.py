@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.sensors.recorded_run import RecordedRun
 from navsim.sensors.star_sensor import StarFrame
 from startrack import rotation as rot
 
@@ -137,19 +138,9 @@ class Record:
     sigma: float = 0.0
 
 
-class VectorRun:
+class VectorRun(RecordedRun):
     """The per-run sensor of :class:`StarVectorSensor` and :class:`AttitudeFixSensor`: it reads its
     :class:`Record` frame by frame; tracking state and faults other than lost frames do not apply."""
-
-    log_fields = {}
-    timing_fields = {}
-    sample = None
-
-    def __init__(self, record):
-        self._record = record
-
-    def record(self):
-        return self._record
 
     def observe(self, request):
         r, j = self._record, request.index
@@ -161,9 +152,3 @@ class VectorRun:
         if not len(ref_I):
             return StarFrame(mode="no_fix")
         return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, sigma=np.full(len(ref_I), r.sigma))
-
-    def after_update(self, update):
-        pass
-
-    def lose_track(self):
-        pass

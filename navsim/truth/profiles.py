@@ -125,6 +125,15 @@ class RigidBody:
 
 
 @dataclass(frozen=True)
+class FrameTruth:
+    """The truth at one star-sensor frame: attitude q_IB (4,) and the mean body rate over the last
+    gyro interval omega_B (3,) [rad/s]."""
+
+    q_IB: np.ndarray
+    omega_B: np.ndarray
+
+
+@dataclass(frozen=True)
 class TruthRecord:
     """The truth on the gyro grid: times t (M+1,) [s], attitude q_IB (M+1, 4) and the mean body rate
     of each gyro interval omega_mean (M, 3) [rad/s] (what an ideal rate-integrating gyro reports)."""
@@ -132,6 +141,10 @@ class TruthRecord:
     t: np.ndarray
     q_IB: np.ndarray
     omega_mean: np.ndarray
+
+    def at(self, k):
+        """The :class:`FrameTruth` of the frame that closes gyro interval k (sample k)."""
+        return FrameTruth(q_IB=self.q_IB[k], omega_B=self.omega_mean[k - 1])
 
 
 def sample_truth(profile, q0, n_gyro, gyro_hz, factor):

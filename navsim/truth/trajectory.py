@@ -21,6 +21,7 @@ so the coning and sculling content of the motion is in them; the same quadrature
 """
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,6 +40,16 @@ WEIGHTS = 0.5 * _W
 _HERMITE = np.stack([2 * NODES**3 - 3 * NODES**2 + 1, NODES**3 - 2 * NODES**2 + NODES,
                      -2 * NODES**3 + 3 * NODES**2, NODES**3 - NODES**2])
 CHUNK = 50_000
+
+
+class State(NamedTuple):
+    """The truth at one sample: ``lat``, ``lon`` [rad], ``h`` [m], ``v_n`` (3,) [m/s], ``q_nb`` (4,)."""
+
+    lat: float
+    lon: float
+    h: float
+    v_n: np.ndarray
+    q_nb: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -63,17 +74,22 @@ class Trajectory:
     def dt(self):
         return 1.0 / self.rate_hz
 
+    def at(self, k):
+        """The :class:`State` at sample k (the end of interval k)."""
+        return State(lat=self.lat[k], lon=self.lon[k], h=self.h[k], v_n=self.v_n[k], q_nb=self.q_nb[k])
 
-def generate(profile, rate_hz, disturbance=None, seed=None):
+
+def generate(profile, rate_hz, disturbance=None, seed=None, duration=None):
     """The truth :class:`Trajectory` of ``profile`` sampled at ``rate_hz`` [Hz] over its whole
-    duration (the last partial interval dropped). ``disturbance`` is an optional
-    :class:`~navsim.earth.gravity.GravityDisturbance`; a random one draws from ``seed``."""
+    duration, or its first ``duration`` [s] (the last partial interval dropped). ``disturbance`` is an
+    optional :class:`~navsim.earth.gravity.GravityDisturbance`; a random one draws from ``seed``."""
     if not (isinstance(rate_hz, (int, float)) and rate_hz > 0.0 and np.isfinite(rate_hz)):
         raise InputError(f"imu.rate_hz: must be > 0, got {rate_hz!r}")
     dt = 1.0 / rate_hz
-    n = int(np.floor(profile.duration * rate_hz + 1e-9))
+    span = profile.duration if duration is None else min(duration, profile.duration)
+    n = int(np.floor(span * rate_hz + 1e-9))
     if n < 1:
-        raise InputError(f"imu.rate_hz: {rate_hz} Hz gives no sample interval in {profile.duration} s")
+        raise InputError(f"imu.rate_hz: {rate_hz} Hz gives no sample interval in {span} s")
     t = np.arange(n + 1) * dt
     at_samples = profile.channels(t)
     v_samples = _velocity(at_samples)

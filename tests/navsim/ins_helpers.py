@@ -1,11 +1,16 @@
-"""Shared helpers of the INS tests: navigation errors of a strapdown log against a truth trajectory."""
+"""Shared helpers of the INS tests: navigation errors of a strapdown log against a truth trajectory, and
+the trajectories of the shipped navigation scenarios."""
+
+from pathlib import Path
 
 import numpy as np
 
 from navsim.earth.wgs84 import radii
+from navsim.scenario import load_scenario
 from navsim.truth.segments import Profile
-from navsim.truth.tables import AIRCRAFT_2H
 from startrack import rotation as rot
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 
 def position_errors(log, truth, every=1):
@@ -20,9 +25,15 @@ def attitude_errors(log, truth, every=1):
     return rot.attitude_error(truth.q_nb[::every], log.q_nb)
 
 
+def trajectory_table(name):
+    """The validated [trajectory] table of scenarios/NAME.toml."""
+    return load_scenario(SCENARIOS / f"{name}.toml")["trajectory"]
+
+
 def aircraft_first_hour():
-    """The 2 h aircraft table cut at 1 h: climb to 7 km, four turns, a speed change and the start of
-    the descent."""
-    segments = AIRCRAFT_2H["segments"][:9]
-    head = Profile.from_table({**AIRCRAFT_2H, "segments": segments}).duration
-    return Profile.from_table({**AIRCRAFT_2H, "segments": segments + [{"kind": "straight", "duration_s": 3600.0 - head}]})
+    """The 2 h aircraft flight of the shipped scenarios cut at 1 h: climb to 7 km, four turns, a speed
+    change and the start of the descent."""
+    table = trajectory_table("free_ins_navigation_aircraft")
+    segments = table["segments"][:9]
+    head = Profile.from_table({**table, "segments": segments}).duration
+    return Profile.from_table({**table, "segments": segments + [{"kind": "straight", "duration_s": 3600.0 - head}]})

@@ -1,5 +1,5 @@
-"""The bad-input corpus of the navsim command line: every scenario key kind of the schema with values
-it must refuse, every option of every command, broken files and unusable output places. Each case
+"""The bad-input corpus of the navsim command line: every scenario key of the attitude and navigation
+schemas with values it must refuse, every option of every command, broken files and unusable output places. Each case
 must end with one line that names the culprit, a non-zero exit status, no traceback, and nothing
 written. (The startrack command line has its corpus in tests/startrack.)"""
 
@@ -12,13 +12,13 @@ from pathlib import Path
 import pytest
 
 from navsim import cli
-from navsim.scenario import SCHEMA, study_schema
-from navsim.scenario.schema import ListOfTables, Table, Value
+from navsim.scenario import SCHEMA, navigation, study_schema
+from navsim.scenario.schema import ListOfTables, Table, Tagged, Value
 from tests.cli_support import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
-BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid")}
+BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid", "navigation")}
 STUDY = ROOT / "scenarios" / "paper003_precision.toml"
 #: Which base scenario reaches the keys below each table (the first match wins; "constant" otherwise).
 BASE_OF = (("truth.sinusoidal_axis", "image"), ("truth.rate_segments", "segments"), ("truth.rigid_body", "rigid"),
@@ -76,42 +76,47 @@ def bad_values(spec):
     return out
 
 
-def scenario_cases(schema, prefix="", item_of=None):
-    """(case id, base, key path, --set override) for every leaf of ``schema`` and every table's unknown key."""
-    cases = [(f"{prefix or '<top>'}: an unknown key", prefix, f"{prefix + '.' if prefix else ''}bogus_key", "1")]
+def scenario_cases(schema, prefix="", base=None):
+    """(case id, base, key path, --set override) for every leaf of ``schema`` and every table's unknown
+    key; ``base`` names the base scenario of every case (None: by :data:`BASE_OF`)."""
+    cases = [(f"{prefix or '<top>'}: an unknown key", base or _base_name(prefix),
+              f"{prefix + '.' if prefix else ''}bogus_key", "1")]
     for key, spec in schema.entries.items():
         path = f"{prefix}.{key}" if prefix else key
         if isinstance(spec, Table):
-            cases += scenario_cases(spec, path)
+            cases += scenario_cases(spec, path, base)
         elif isinstance(spec, ListOfTables):
-            cases.append((f"{path}: not an array of tables", prefix, path, "5"))
-            cases += [(case_id, base, path, override) for case_id, base, _, override in _item_cases(spec.item, path)]
+            cases.append((f"{path}: not an array of tables", base or _base_name(path), path, "5"))
+            cases += list(_item_cases(spec.item, path, base or _base_name(path)))
         else:
-            cases += [(f"{path}: {label}", prefix, path, toml(value)) for label, value in bad_values(spec)]
+            cases += [(f"{path}: {label}", base or _base_name(path), path, toml(value)) for label, value in bad_values(spec)]
     return cases
 
 
-def _item_cases(item, path):
-    """Cases for each field of a list-of-tables item: the list replaced by one item with that field bad."""
-    valid = _valid_item(item, path)
-    for key, spec in item.entries.items():
-        for label, value in bad_values(spec):
-            yield f"{path}[0].{key}: {label}", path, path, toml([{**valid, key: value}])
-
-
-def _valid_item(item, path):
-    base = tomllib.loads(_base_file(path).read_text())
-    node = base
+def _item_cases(item, path, base):
+    """Cases for each field of a list-of-tables item: the list replaced by one item with that field bad
+    (for tagged items, of each kind: its first item in the base, or an unknown kind and key)."""
+    items = tomllib.loads(BASES[base].read_text())
     for part in path.split("."):
-        node = node[part]
-    return dict(node[0])
+        items = items[part]
+    variants = item.variants if isinstance(item, Tagged) else {"": item}
+    for kind, table in variants.items():
+        valid = next(dict(row) for row in items if not kind or row[item.tag] == kind)
+        label = f"{path}[{kind}]" if kind else f"{path}[0]"
+        for key, spec in table.entries.items():
+            for bad, value in bad_values(spec):
+                yield f"{label}.{key}: {bad}", base, path, toml([{**valid, key: value}])
+        if kind:
+            yield f"{label}: an unknown key", base, path, toml([{**valid, "bogus_key": 1.0}])
+    if isinstance(item, Tagged):
+        yield f"{path}: an unknown {item.tag}", base, path, toml([{item.tag: "fly"}])
 
 
-def _base_file(path):
-    return BASES[next((base for table, base in BASE_OF if path.startswith(table)), "constant")]
+def _base_name(path):
+    return next((base for table, base in BASE_OF if path.startswith(table)), "constant")
 
 
-SCENARIO_CASES = scenario_cases(SCHEMA)
+SCENARIO_CASES = scenario_cases(SCHEMA) + scenario_cases(navigation.SCHEMA, base="navigation")
 
 
 def assert_one_clear_line(status, err, culprit, out=None):
@@ -126,17 +131,20 @@ def assert_one_clear_line(status, err, culprit, out=None):
         assert not Path(out).exists() or not any(Path(out).iterdir()), f"{out} was written"
 
 
-@pytest.mark.parametrize("case_id, table, key, override", SCENARIO_CASES, ids=[c[0] for c in SCENARIO_CASES])
-def test_every_scenario_key_refuses_a_bad_value(tmp_path, capsys, case_id, table, key, override):
-    base = _base_file(table or key)
+@pytest.mark.parametrize("case_id, base, key, override", SCENARIO_CASES,
+                         ids=[f"{c[1]}: {c[0]}" for c in SCENARIO_CASES])
+def test_every_scenario_key_refuses_a_bad_value(tmp_path, capsys, case_id, base, key, override):
     out = tmp_path / "out"
-    status, err = run_cli(cli.main, ["run", base, "--out", out, "--set", f"{key}={override}"], capsys)
+    status, err = run_cli(cli.main, ["run", BASES[base], "--out", out, "--set", f"{key}={override}"], capsys)
     assert_one_clear_line(status, err, key.split(".")[-1], out)
 
 
 REQUIRED = [("duration_s", "constant"), ("truth.profile", "constant"), ("gyro.rate_hz", "constant"),
             ("star_sensor.rate_hz", "constant"), ("star_sensor.fov_deg", "constant"),
-            ("truth.sinusoidal_axis.amplitude_deg", "image"), ("truth.rigid_body.inertia_kg_m2", "rigid")]
+            ("truth.sinusoidal_axis.amplitude_deg", "image"), ("truth.rigid_body.inertia_kg_m2", "rigid"),
+            ("name", "navigation"), ("trajectory.start.lat_deg", "navigation"), ("trajectory.segments", "navigation"),
+            ("imu.rate_hz", "navigation"), ("baro.rate_hz", "navigation"), ("aiding.position.sigma_ned_m", "navigation"),
+            ("gravity.model", "navigation")]
 
 
 @pytest.mark.parametrize("key, base", REQUIRED)
@@ -180,6 +188,31 @@ CROSS_KEY = [
     ("image", "star_sensor.image.sky_hip=[999999]", "sky_hip"),             # not in the catalog
     ("constant", "filter.estimate_scale_factor=true", "filter.estimate_scale_factor"),  # renamed
     ("constant", "filter.initial_misalignment_sigma_arcsec=10.0", "initial_misalignment_sigma_arcsec"),
+    # navigation scenarios (the INS): the issue's list, then the other cross-key rules
+    ("navigation", "trajectory.start.lat_deg=91.0", "trajectory.start.lat_deg"),
+    ("navigation", "trajectory.start.lat_deg=-90.5", "trajectory.start.lat_deg"),
+    ("navigation", "trajectory.start.height_m=-1500.0", "trajectory.start.height_m"),
+    ("navigation", 'trajectory.segments=[{kind = "hold", duration_s = 1.0}, {kind = "accelerate", speed_m_per_s = 100.0, '
+                   'acceleration_m_per_s2 = 5.0}, {kind = "turn", heading_change_deg = 90.0, rate_deg_per_s = 3.0, '
+                   'bank_deg = 10.0}]', "segments[2].bank_deg"),                   # a turn that cannot be flown
+    ("navigation", "imu.rate_hz=0.0", "imu.rate_hz"),
+    ("navigation", "imu.rate_hz=-100.0", "imu.rate_hz"),
+    ("navigation", "aiding.position.rate_hz=0.0", "aiding.position.rate_hz"),
+    ("navigation", "baro.rate_hz=-1.0", "baro.rate_hz"),
+    ('navigation', 'trajectory.segments=[{kind = "turn", heading_change_deg = 90.0, rate_deg_per_s = 0.0}]', "rate_deg_per_s"),
+    ("navigation", "aiding.position.rate_hz=50.0", "aiding.position.rate_hz"),  # faster than the IMU
+    ("navigation", "baro.rate_hz=40.0", "baro.rate_hz"),                        # faster than the IMU
+    ("navigation", "aiding.position.rate_hz=3.0", "aiding.position.rate_hz"),   # does not divide the IMU rate
+    ("navigation", "aiding.position.rate_hz=0.75", "aiding.position.rate_hz"),  # does not divide the baro's
+    ("navigation", "duration_s=100.0", "duration_s"),                           # longer than the trajectory
+    ("navigation", "settle_s=40.0", "settle_s"),
+    ("navigation", "trajectory.start.speed_m_per_s=10.0", "segments[0].kind"),  # a hold needs zero speed
+    ("navigation", 'trajectory.segments=[{kind = "hold", duration_s = 2000000.0}]', "duration_s"),  # too many samples
+    ("navigation", 'gravity.model="constant"', "gravity.correlation_length_m"),
+    ("navigation", "gravity.xi_arcsec=-1.0", "xi_arcsec"),
+    ("navigation", 'epoch_utc="2024-13-01T00:00:00"', "epoch_utc"),
+    ("navigation", 'epoch_utc="2024-03-20T00:00:00+02:00"', "epoch_utc"),
+    ("navigation", "trajectory.start={lat_deg = 45.0}", "trajectory.start.lon_deg"),
 ]
 
 
@@ -375,3 +408,17 @@ def _leaves(table):
             yield from _leaves(spec.item)
         else:
             yield spec
+
+
+@pytest.mark.parametrize("drop", ["error_state", "lat_true"])
+def test_a_navigation_run_without_its_arrays_is_named_by_the_report(tmp_path, capsys, drop):
+    from navsim.output import read_npz, write_npz
+
+    out = tmp_path / "run"
+    assert run_cli(cli.main, ["run", BASES["navigation"], "--out", out], capsys)[0] == 0
+    series = read_npz(out / "timeseries.npz")
+    del series[drop]
+    write_npz(out / "timeseries.npz", series)
+    status, err = run_cli(cli.main, ["report", out, "-o", tmp_path / "r.pdf"], capsys)
+    assert_one_clear_line(status, err, drop)
+    assert not (tmp_path / "r.pdf").exists()

@@ -3,17 +3,17 @@ the faults at vector fidelity, the loop driven by stub filter and sensor, and th
 fast path against the step-by-step loop."""
 
 import copy
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import navsim
 from navsim.closed_loop import FrameGrid, run_loop
-from navsim.estimation.attitude_filter import UpdateResult
+from navsim.estimation.updates import UpdateResult
 from navsim.sensors.faults import AttitudeJumps
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame
 from navsim.simulation import prepare, simulate
+from navsim.truth.profiles import TruthRecord
 from startrack import units
 from startrack.errors import InputError
 
@@ -160,7 +160,7 @@ class _RecordingFilter:
         self.calls.append(("update_stars", len(ref_I)))
         first = sum(c[0] == "update_stars" for c in self.calls) == 1  # the first identification is rejected
         accepted = np.full(len(ref_I), not first)
-        return UpdateResult(z=np.zeros((len(ref_I), 2)), nis=np.ones(len(ref_I)), accepted=accepted)
+        return UpdateResult(z=np.zeros((len(ref_I), 2)), nis=np.ones(len(ref_I)), accepted=accepted, per_row=True)
 
     def update_attitude(self, q_IS, R_S):
         self.calls.append(("update_attitude",))
@@ -182,6 +182,7 @@ class _ScriptedSensor:
     log_fields = {"mode": ((), np.int8, 0)}
     timing_fields = {}
     sample = None
+    uses_prediction = True
 
     def __init__(self):
         self.verdicts, self.lost = [], 0
@@ -211,7 +212,7 @@ def test_the_loop_needs_nothing_but_the_filter_interface():
     attitude jump and tells the sensor every verdict."""
     filt, sensor = _RecordingFilter(), _ScriptedSensor()
     grid = FrameGrid(dt=0.1, ratio=5, n_frames=4)
-    truth = SimpleNamespace(q_IB=np.tile([0.0, 0.0, 0.0, 1.0], (21, 1)), omega_mean=np.zeros((20, 3)))
+    truth = TruthRecord(t=np.arange(21) * 0.1, q_IB=np.tile([0.0, 0.0, 0.0, 1.0], (21, 1)), omega_mean=np.zeros((20, 3)))
     jumps = AttitudeJumps([(1.0, np.radians(2.0))], np.random.default_rng(0))
     log = run_loop(filt, sensor, np.zeros((20, 3)), truth, grid, jumps)
     names = [c[0] for c in filt.calls]

@@ -102,16 +102,17 @@ def test_process_noise_matches_van_loan(dt):
 
 # --- the filter at work -------------------------------------------------------------------------
 
+import copy  # noqa: E402
+import re  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 from navsim.estimation.consistency import chi2_band  # noqa: E402
 from navsim.estimation.nav_filter import ImuNoise, NavFilter  # noqa: E402
-from navsim.ins import driver  # noqa: E402
 from navsim.sensors.accelerometer import AccelerometerModel  # noqa: E402
 from navsim.sensors.gyro import GyroModel  # noqa: E402
+from navsim.simulation import prepare, run_batch, simulate  # noqa: E402
 from navsim.truth import trajectory  # noqa: E402
 from navsim.truth.segments import Profile  # noqa: E402
-from startrack import units  # noqa: E402
 from startrack.errors import InputError  # noqa: E402
 
 TURNS = {"start": {"lat_deg": 40.0, "lon_deg": 10.0, "height_m": 1000.0, "speed_m_per_s": 100.0, "heading_deg": 0.0},
@@ -123,55 +124,60 @@ TURNS = {"start": {"lat_deg": 40.0, "lon_deg": 10.0, "height_m": 1000.0, "speed_
                       {"kind": "turn", "heading_change_deg": 90.0, "rate_deg_per_s": 3.0},
                       {"kind": "accelerate", "speed_m_per_s": 150.0, "acceleration_m_per_s2": 1.0},
                       {"kind": "straight", "duration_s": 60.0}]}
+#: The tactical IMU with only the errors the 15-state filter models: turn-on bias, bias random walk and
+#: white noise (no Gauss-Markov part, scale factor or misalignment).
+MATCHED = {"preset": "tactical", "bias_instability_deg_per_h": 0.0, "scale_factor_ppm": 0.0, "misalignment_arcsec": 0.0}
+MATCHED_ACCEL = {"preset": "tactical", "bias_instability_micro_g": 0.0, "scale_factor_ppm": 0.0, "misalignment_arcsec": 0.0}
+#: 7 min of turns, climb and acceleration: a tactical IMU at 50 Hz and 1 Hz position fixes of 3 m.
+AIDED_TURNS = {
+    "name": "aided_turns", "trajectory": TURNS,
+    "imu": {"rate_hz": 50.0, "gyro": MATCHED, "accelerometer": MATCHED_ACCEL},
+    "aiding": {"position": {"rate_hz": 1.0, "sigma_ned_m": [3.0, 3.0, 3.0]}},
+    "filter": {"initial_tilt_sigma_arcsec": 180.0, "initial_heading_sigma_deg": 0.3, "initial_velocity_sigma_m_per_s": 0.1,
+               "initial_position_sigma_m": 5.0},
+}
 
 
-def _tactical_matched(rate_hz):
-    """Tactical gyro and accelerometer whose errors the 15-state filter models exactly: turn-on bias,
-    bias random walk and white noise (no Gauss-Markov, scale factor or misalignment)."""
-    off = {"bias_instability_sigma": 0.0, "scale_factor_sigma": 0.0, "misalignment_sigma": 0.0}
-    return replace(GyroModel.preset("tactical", rate_hz), **off), replace(AccelerometerModel.preset("tactical", rate_hz), **off)
-
-
-def position_aided_campaign(truth, runs, fix_rate_hz=1.0, fix_sigma=3.0):
-    """The Monte Carlo of the position-aided filter: one run per seed 0..runs-1."""
-    gyro, accel = _tactical_matched(truth.rate_hz)
-    P0 = driver.initial_covariance(gyro, accel, np.array([0.05, 0.05, 0.3]) * units.DEG, 0.1, 5.0, truth.lat[0], truth.h[0])
-    return [driver.position_aided_run(truth, gyro, accel, P0, fix_rate_hz, fix_sigma, seed) for seed in range(runs)], P0
-
-
-def _check_campaign(results, P0):
+def _check_campaign(results):
     """NEES of the run average inside its two-sided 95 % chi-square band (time mean, and at >= 80 %
     of the fixes), no divergent run, and the accelerometer bias within 3σ at the end (>= 97 % of the
     run-axis cases, expected 99.7 %) with its horizontal σ reduced by the turns."""
     runs = len(results)
-    nees = np.array([r.nees for r in results]).mean(axis=0)
+    nees = np.array([r.series["nees"] for r in results]).mean(axis=0)
     low, high = chi2_band(15, runs)
+    assert results[0].summary["nees"]["dof"] == 15
     assert low <= nees.mean() <= high
     assert np.mean((nees >= low) & (nees <= high)) >= 0.8
-    divergent = [r for r in results if not np.all(np.isfinite(r.error)) or np.any(np.abs(r.error) > 10 * r.sigma)]
-    assert not divergent
-    error = np.array([r.error[-1, 12:15] for r in results])
-    sigma = np.array([r.sigma[-1, 12:15] for r in results])
-    assert np.mean(np.abs(error) <= 3 * sigma) >= 0.97
-    assert np.all(sigma[:, :2] < 0.7 * np.sqrt(P0[12, 12]))
-    return nees, low, high
+    error, sigma = (np.array([r.series[name] for r in results]) for name in ("error_state", "error_sigma"))
+    assert np.all(np.isfinite(error)) and not np.any(np.abs(error) > 10 * sigma)
+    calibration = [r.summary["imu_calibration"]["accel_bias_micro_g"] for r in results]
+    assert np.mean(np.abs([c["normalised_error"] for c in calibration]) <= 3.0) >= 0.97
+    assert np.all(sigma[:, -1, 12:14] < 0.7 * sigma[:, 0, 12:14])
 
 
 def test_position_aided_campaign_is_consistent():
     """50 runs of 7 min of turns, climb and acceleration, tactical IMU at 50 Hz, 1 Hz fixes of 3 m."""
-    truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
-    results, P0 = position_aided_campaign(truth, 50)
-    _check_campaign(results, P0)
+    _check_campaign(run_batch(AIDED_TURNS, range(50)))
 
 
-@pytest.mark.slow
-def test_position_aided_campaign_over_an_hour_of_flight():
-    """The same campaign over the first hour of the 2 h aircraft flight, IMU at 100 Hz."""
-    from tests.navsim.ins_helpers import aircraft_first_hour
+@pytest.mark.parametrize("overrides", [
+    {},
+    {"baro": {"rate_hz": 2.0, "noise_sigma_m": 2.0}, "imu.gyro.preset": "tactical", "filter.measurement_noise_scale": 1.3},
+    {"aiding": {}, "baro": {"rate_hz": 1.0}, "imu.gyro.scale_factor_ppm": 100.0, "filter.covariance_interval": 7},
+])
+def test_compiled_fast_path_equals_the_step_by_step_loop(overrides):
+    """The navigation filter's whole-record path gives, to the last bit, what the loop's frame-by-frame
+    predict and updates give: position and baro in one frame, 21 states, a free INS with a baro."""
+    prepared = prepare(AIDED_TURNS, overrides)
+    fast, steps = simulate(prepared, 5), simulate(prepared, 5, compiled=False)
+    assert fast.series.keys() == steps.series.keys()
+    for name in fast.series:
+        np.testing.assert_array_equal(fast.series[name], steps.series[name], err_msg=name)
 
-    truth = trajectory.generate(aircraft_first_hour(), 100.0)
-    results, P0 = position_aided_campaign(truth, 50)
-    _check_campaign(results, P0)
+
+def _samples(dtheta, dv, dt):
+    """IMU samples (interval means) of increments."""
+    return np.hstack([dtheta, dv]) / dt
 
 
 def test_perfect_imu_and_perfect_start_stay_on_the_truth():
@@ -182,10 +188,10 @@ def test_perfect_imu_and_perfect_start_stay_on_the_truth():
     P = np.diag([1e-8] * 3 + [1e-4] * 3 + [1e-14, 1e-14, 1.0] + [1e-12] * 3 + [1e-8] * 3)
     f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt)
     for k0 in range(0, truth.dtheta.shape[0], 50):
-        f.predict(truth.dtheta[k0:k0 + 50], truth.dv[k0:k0 + 50])
+        f.predict(_samples(truth.dtheta[k0:k0 + 50], truth.dv[k0:k0 + 50], truth.dt), truth.dt)
         k1 = min(k0 + 50, truth.dtheta.shape[0])
         result = f.update_position(truth.lat[k1], truth.lon[k1], truth.h[k1], 3.0)
-        assert result.nis[0] < 1e-6
+        assert result.nis[0] < 1e-6 and np.all(np.abs(result.z) < 1e-3)  # the innovation in metres
     lat, lon, h = f.position
     assert abs(h - truth.h[-1]) < 1e-3 and abs(lat - truth.lat[-1]) * 6.4e6 < 1e-3
     assert np.max(np.abs(f.v_n - truth.v_n[-1])) < 1e-4
@@ -207,12 +213,6 @@ def test_bad_filter_input_is_named():
     noise = ImuNoise(arw=1e-5, vrw=1e-3)
     with pytest.raises(InputError, match="filter.P: must be 15x15"):
         NavFilter(0.5, 0.1, 0.0, np.zeros(3), [0, 0, 0, 1.0], np.eye(9), noise, 0.01)
-    with pytest.raises(InputError, match="faster than the IMU"):
-        driver.check_aiding_rate(100.0, 200.0, "aiding.rate_hz")
-    with pytest.raises(InputError, match="aiding.rate_hz: must be > 0"):
-        driver.check_aiding_rate(100.0, 0.0, "aiding.rate_hz")
-    with pytest.raises(InputError, match="not a multiple"):
-        driver.check_aiding_rate(100.0, 3.0, "aiding.rate_hz")
 
 
 def test_scale_factor_states_are_estimated_within_three_sigma():
@@ -220,22 +220,33 @@ def test_scale_factor_states_are_estimated_within_three_sigma():
     and no misalignment: every scale factor ends within 3σ, no σ grows, and the vertical
     accelerometer's (sensing g throughout) is the best observed in 7 min."""
     truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
-    gyro, accel = _tactical_matched(50.0)
-    gyro, accel = replace(gyro, scale_factor_sigma=100e-6), replace(accel, scale_factor_sigma=300e-6)
+    off = {"bias_instability_sigma": 0.0, "misalignment_sigma": 0.0}
+    gyro = replace(GyroModel.preset("tactical", 50.0), **off, scale_factor_sigma=100e-6)
+    accel = replace(AccelerometerModel.preset("tactical", 50.0), **off, scale_factor_sigma=300e-6)
     g_seed, a_seed = np.random.SeedSequence(4).spawn(2)
     g_rec, a_rec = gyro.measure(truth.dtheta / truth.dt, g_seed), accel.measure(truth.dv / truth.dt, a_seed)
-    P15 = driver.initial_covariance(gyro, accel, np.array([0.05, 0.05, 0.3]) * units.DEG, 0.1, 5.0, truth.lat[0], truth.h[0])
-    P = np.zeros((21, 21))
-    P[:15, :15] = P15
-    P[15:18, 15:18], P[18:21, 18:21] = np.eye(3) * 100e-6**2, np.eye(3) * 300e-6**2
+    sigma0 = np.array([np.radians(0.05)] * 2 + [np.radians(0.3)] + [0.1] * 3 + [5.0 / 6.4e6] * 2 + [5.0]
+                      + [gyro.bias_turn_on_sigma] * 3 + [accel.bias_turn_on_sigma] * 3 + [100e-6] * 3 + [300e-6] * 3)
     noise = ImuNoise(gyro.arw, accel.vrw, gyro.filter_rrw, accel.filter_bias_rw)
-    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt,
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], np.diag(sigma0**2), noise, truth.dt,
                   estimate_scale_factors=True)
     for k in range(0, truth.dtheta.shape[0], 50):
-        f.predict(g_rec.omega[k:k + 50] * truth.dt, a_rec.force[k:k + 50] * truth.dt)
+        f.predict(np.hstack([g_rec.omega[k:k + 50], a_rec.force[k:k + 50]]), truth.dt)
         f.update_position(truth.lat[k + 50], truth.lon[k + 50], truth.h[k + 50], 3.0)
     s_g, s_a = f.scale_factors
     error = np.concatenate([np.diag(g_rec.matrix) - 1.0 - s_g, np.diag(a_rec.matrix) - 1.0 - s_a])
     sigma = np.sqrt(np.diag(f.P)[15:21])
     assert np.all(np.abs(error) <= 3.0 * sigma)
     assert np.all(sigma <= np.array([100e-6] * 3 + [300e-6] * 3)) and sigma[5] < 0.9 * 300e-6
+
+
+def test_a_navigation_scenario_is_validated_like_a_file():
+    """The scenario dictionary's cross-key rules: a fix faster than the IMU, a free INS too long for its
+    vertical channel, a turn that cannot be flown."""
+    bad = [({"aiding.position.rate_hz": 100.0}, "faster than the IMU"),
+           ({"aiding": {}, "trajectory.segments": [{"kind": "straight", "duration_s": 4000.0}]}, "needs a [baro] table"),
+           ({"trajectory.segments": [{"kind": "turn", "heading_change_deg": 90.0, "rate_deg_per_s": 3.0, "bank_deg": 10.0}]},
+            "cannot be flown")]
+    for overrides, message in bad:
+        with pytest.raises(InputError, match=re.escape(message)):
+            prepare(copy.deepcopy(AIDED_TURNS), overrides)

@@ -16,7 +16,7 @@ from navsim.truth.segments import Hold, Profile, Start
 from startrack import rotation as rot
 from startrack import units
 from startrack.errors import InputError
-from tests.navsim.ins_helpers import aircraft_first_hour, attitude_errors, position_errors
+from tests.navsim.ins_helpers import aircraft_first_hour, attitude_errors, position_errors, trajectory_table
 
 
 def _start(truth, q_nb=None):
@@ -116,9 +116,8 @@ def test_earth_rate_oscillation_in_the_ship_run():
     equation ψ̇ = −ω_ie × ψ − ε: the drift's part across the Earth's axis turns at ω_ie) of amplitude
     R ε_⊥/ω_ie (within 5 %); periods of 20 h or 28 h fit four times worse."""
     from navsim.earth.wgs84 import OMEGA_IE
-    from navsim.truth.tables import SHIP_24H
-
-    table = {"start": SHIP_24H["start"], "segments": [{**SHIP_24H["segments"][0], "duration_s": 86400.0}]}
+    ship = trajectory_table("free_ins_navigation_ship")
+    table = {"start": ship["start"], "segments": [{**ship["segments"][0], "duration_s": 86400.0}]}
     truth = trajectory.generate(Profile.from_table(table), 10.0)
     drift = units.deg_per_h_to_rad_per_s(0.01)
     log = strapdown.run(_start(truth), truth.dtheta + np.array([drift, 0.0, 0.0]) * truth.dt, truth.dv, truth.dt,

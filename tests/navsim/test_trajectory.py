@@ -10,10 +10,10 @@ from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.wgs84 import radii
 from navsim.truth import trajectory
 from navsim.truth.segments import Climb, Hold, Profile, ShipMotion, Start, Straight, Turn, window
-from navsim.truth.tables import AIRCRAFT_2H, SHIP_24H
 from startrack import rotation as rot
 from startrack import units
 from startrack.errors import InputError
+from tests.navsim.ins_helpers import trajectory_table
 
 MANOEUVRES = {
     "start": {"lat_deg": 60.0, "lon_deg": -20.0, "height_m": 500.0, "speed_m_per_s": 150.0, "heading_deg": 10.0},
@@ -85,9 +85,9 @@ def test_body_rate_against_finite_differences_of_the_attitude():
     assert np.abs(rate_nb).max() > 0.05  # the profile does rotate
 
 
-def test_tables_validate_and_last_as_named():
-    assert Profile.from_table(AIRCRAFT_2H).duration == pytest.approx(7200.0)
-    assert Profile.from_table(SHIP_24H).duration == pytest.approx(86400.0)
+def test_the_shipped_trajectories_last_as_named():
+    assert Profile.from_table(trajectory_table("free_ins_navigation_aircraft")).duration == pytest.approx(7200.0)
+    assert Profile.from_table(trajectory_table("free_ins_navigation_ship")).duration == pytest.approx(86400.0)
 
 
 def test_gravity_disturbance_enters_the_specific_force():

@@ -26,7 +26,7 @@ def test_tune_recovers_the_arw_ratio_and_restores_consistency(base_scenario):
     assert last.nis_per_dof == pytest.approx(1.0, abs=0.1)
     assert last.process_noise_scale == pytest.approx(4.0, rel=0.2)  # (0.1 / 0.05)²
     assert last.measurement_noise_scale == pytest.approx(1.0, rel=0.1)
-    assert last.cross_boresight_rms_arcsec < first.cross_boresight_rms_arcsec
+    assert last.errors["cross-boresight RMS"][0] < first.errors["cross-boresight RMS"][0]
 
 
 def test_tune_command_prints_the_settings_to_use():

@@ -1,0 +1,55 @@
+"""The campaign statistics of navigation runs (the INS): CEP50/95 of the final horizontal position
+error, the vertical error, the spread of the runs' velocity, tilt and heading errors, the
+run-averaged NEES over the filter's own error state, divergent runs and the IMU error states."""
+
+import numpy as np
+
+from navsim.campaign.pooling import averaged_nees, calibration, diverged, spread
+from startrack import units
+
+
+def statistics(finished, settle):
+    """The navigation fields of a :class:`~navsim.records.CampaignSummary` from the finished runs
+    [(index, summary, series), ...]: CEP50/CEP95 are the median and 95th percentile over the runs
+    of the final horizontal position error (its radial distance from the truth)."""
+    summaries = [summary for _, summary, _ in finished]
+    divergent = []
+    for k, summary, series in finished:
+        steady = series["t"] >= settle
+        if diverged(summary, series["error_state"][steady], series["error_sigma"][steady]):
+            divergent.append(k)
+    horizontal = np.array([s["position_error_m"]["horizontal"]["final"] for s in summaries])
+    vertical = np.array([s["position_error_m"]["vertical"]["final"] for s in summaries])
+
+    def per_run(*path):
+        values = []
+        for s in summaries:
+            value = s[path[0]]
+            for key in path[1:]:
+                value = value[key]
+            values.append(value)
+        return spread(values)
+
+    return {
+        "position_error_m": {"horizontal": {**cep(horizontal), "rms": _rms(horizontal), "max": float(horizontal.max())},
+                             "vertical": {"p50": float(np.percentile(vertical, 50)), "p95": float(np.percentile(vertical, 95)),
+                                          "rms": _rms(vertical), "max": float(vertical.max())}},
+        "position_error_nmi": {"horizontal": cep(horizontal / units.NAUTICAL_MILE)},
+        "velocity_error_m_per_s": {"horizontal": per_run("velocity_error_m_per_s", "horizontal", "rms"),
+                                   "vertical": per_run("velocity_error_m_per_s", "vertical", "rms")},
+        "tilt_error_arcsec": per_run("tilt_error_arcsec", "rms"),
+        "heading_error_arcsec": per_run("heading_error_arcsec", "rms"),
+        "nees": averaged_nees(finished, settle),
+        "divergent_runs": divergent,
+        "imu_calibration": calibration([s.imu_calibration for s in summaries]),
+    }
+
+
+def cep(radial):
+    """{cep50, cep95}: the circular error probable (50 %) and its 95 % twin, the median and 95th
+    percentile of radial horizontal errors ``radial`` over the runs."""
+    return {"cep50": float(np.percentile(radial, 50)), "cep95": float(np.percentile(radial, 95))}
+
+
+def _rms(values):
+    return float(np.sqrt(np.mean(np.square(values))))

@@ -1,0 +1,47 @@
+"""What a campaign pools the same way whatever the kind of its runs: the run-averaged NEES against its
+band, the divergent runs, the spread of a per-run figure and the final normalised errors of the
+filter's calibration states."""
+
+import numpy as np
+
+from navsim.estimation.consistency import nees_statistics
+
+#: A run diverged when an error exceeds this many σ of its filter, or its NEES mean this many dof.
+DIVERGENCE_SIGMAS = 5.0
+
+
+def diverged(summary, errors, sigmas):
+    """True when the steady ``errors`` (F, m) exceed 5 of their filter's ``sigmas`` (F, m) anywhere or
+    the run's NEES mean is above 5 times its dof."""
+    return bool(np.any(np.abs(errors) > DIVERGENCE_SIGMAS * sigmas)) or summary["nees"]["mean"] > DIVERGENCE_SIGMAS * summary["nees"]["dof"]
+
+
+def averaged_nees(finished, settle):
+    """The NEES averaged over the runs at every steady frame against the band of that many runs, with
+    the dof the runs' summaries record ({} when the runs differ in length)."""
+    nees_runs = [series["nees"] for _, _, series in finished]
+    if len({len(n) for n in nees_runs}) != 1:
+        return {}
+    mean_nees = np.mean(np.array(nees_runs), axis=0)
+    return nees_statistics(mean_nees[finished[0][2]["t"] >= settle], finished[0][1]["nees"]["dof"], len(finished))
+
+
+def spread(values):
+    """{mean, p50, p95, max} of a per-run figure over the runs."""
+    return {"mean": float(np.mean(values)), "p50": float(np.percentile(values, 50)),
+            "p95": float(np.percentile(values, 95)), "max": float(np.max(values))}
+
+
+def calibration(runs):
+    """Final normalised errors of calibration states over the runs (each a summary's
+    ``gyro_calibration`` or ``imu_calibration``): RMS per state (1 for a consistent filter) and the
+    share within 3σ; None without any."""
+    runs = [r for r in runs if r]
+    if not runs:
+        return None
+    out = {"runs": len(runs)}
+    for name in runs[0]:
+        errors = np.array([r[name]["normalised_error"] for r in runs])
+        out[name] = {"normalised_error_rms": [float(v) for v in np.sqrt(np.mean(errors**2, axis=0))],
+                     "within_3_sigma": float(np.mean(np.abs(errors) <= 3.0))}
+    return out

@@ -1,0 +1,76 @@
+"""What a filter update returns, and the statistics the run log keeps of a frame's updates.
+
+A measurement is either one vector gated as a whole (an attitude fix, a position fix, a baro height)
+or, for identified stars, one 2-dof residual per star, each gated alone (``per_row``). A frame
+whose measurements are of several kinds (a position fix and a baro height) is logged with the
+statistics of all its updates together (:class:`FrameUpdate`).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim.estimation import kernels
+
+
+@dataclass(frozen=True)
+class UpdateResult:
+    """Outcome of one measurement update: innovations z (estimate − measurement, one row per
+    measurement), NIS per measurement against the prior, the accepted mask, whether each row is a
+    measurement of its own (stars) rather than the rows of one vector, and whether the state was
+    re-initialised from the sensor's own fix before it (a lost track)."""
+
+    z: np.ndarray
+    nis: np.ndarray
+    accepted: np.ndarray
+    per_row: bool = False
+    reinitialised: bool = False
+
+    @property
+    def n_accepted(self):
+        return int(np.count_nonzero(self.accepted))
+
+    @property
+    def n_rejected(self):
+        return self.accepted.size - self.n_accepted
+
+    def statistics(self):
+        """(accepted, NIS sum of the accepted, its dof, RMS of their innovations [rad or m])."""
+        if self.per_row:
+            return kernels.star_statistics(self.z, self.nis, self.accepted)
+        if not self.accepted[0]:
+            return 0, np.nan, 0, np.nan
+        dof = self.z.shape[1]
+        return 1, float(self.nis[0]), dof, float(np.sqrt(np.sum(self.z * self.z) / dof))
+
+
+@dataclass(frozen=True)
+class FrameUpdate:
+    """The updates of one frame with measurements of several kinds (each a vector gated as a whole),
+    logged together: accepted count, NIS and dof summed, the RMS over every accepted innovation."""
+
+    updates: tuple
+
+    @property
+    def accepted(self):
+        return np.concatenate([u.accepted for u in self.updates])
+
+    @property
+    def n_accepted(self):
+        return int(np.count_nonzero(self.accepted))
+
+    @property
+    def reinitialised(self):
+        return any(u.reinitialised for u in self.updates)
+
+    def statistics(self):
+        """(accepted, NIS sum of the accepted, its dof, RMS of their innovations), NaN when none was accepted."""
+        accepted = [u for u in self.updates if u.accepted[0]]
+        if not accepted:
+            return 0, np.nan, 0, np.nan
+        nis, dof, squares = 0.0, 0, 0.0
+        for u in accepted:
+            nis += float(u.nis[0])
+            dof += u.z.shape[1]
+            squares += float(np.sum(u.z * u.z))
+        return len(accepted), nis, dof, float(np.sqrt(squares / dof))

@@ -1,0 +1,122 @@
+"""What a navigation run keeps: its per-frame series (estimate, truth, the error state and its σ)
+and its :class:`~navsim.records.RunSummary` (position, velocity, tilt and heading errors, the IMU
+error states, NEES over the filter's own error state).
+
+The error state is the filter's (docs/design.md): x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)],
+est − true except the IMU errors (true − est), with C_nb,est = (I − [φ×]) C_nb,true, so φ_N, φ_E are
+the tilts and the heading error (est − true) is −φ_D. The position error in NED metres is
+(δL (R_M + h), δλ (R_N + h) cos L, −δh).
+"""
+
+import numpy as np
+
+from navsim.earth.wgs84 import radii
+from navsim.estimation.consistency import nees, nees_statistics
+from navsim.estimation.nav_filter import error_state
+from navsim.records import RunSummary
+from startrack import units
+
+#: Slices of the error state: tilt (φ_N, φ_E), heading (φ_D), velocity, position, biases, scale factors.
+TILT, HEADING, VELOCITY, POSITION = slice(0, 2), 2, slice(3, 6), slice(6, 9)
+GYRO_BIAS, ACCEL_BIAS, GYRO_SCALE, ACCEL_SCALE = slice(9, 12), slice(12, 15), slice(15, 18), slice(18, 21)
+#: The accelerometer-bias unit of the summaries [m/s²].
+MICRO_G = 1e-6 * units.STANDARD_GRAVITY
+
+
+def ned_metres(delta_position, lat, h):
+    """Position errors (δL, δλ, δh) (..., 3) [rad, rad, m] at (L, h) as NED metres (..., 3)."""
+    r_m, r_n = radii(lat)
+    return np.stack([delta_position[..., 0] * (r_m + h), delta_position[..., 1] * (r_n + h) * np.cos(lat),
+                     -delta_position[..., 2]], axis=-1)
+
+
+def navigation_series(truth, frame_k, arrays, gyro, accel):
+    """The run's per-frame series from the loop's log ``arrays`` (the filter's snapshots and update
+    statistics) at the frames' IMU samples ``frame_k``, the truth trajectory and the gyro and
+    accelerometer records: estimates and truths (lat, lon, h, v_n, q_nb, biases), ``error_state``
+    (F, n), ``error_sigma`` (F, n) = √diag P, ``position_error_m`` (F, 3) NED and ``nees``."""
+    k = frame_k
+    series = {"t": truth.t[k], "lat_true": truth.lat[k], "lon_true": truth.lon[k], "h_true": truth.h[k],
+              "v_n_true": truth.v_n[k], "q_nb_true": truth.q_nb[k], "gyro_bias_true": gyro.bias[k - 1],
+              "accel_bias_true": accel.bias[k - 1], **arrays}
+    P = series.pop("P")
+    error = error_state(series["lat"], series["lon"], series["h"], series["v_n"], series["q_nb"], series["gyro_bias"],
+                        series["accel_bias"], truth.lat[k], truth.lon[k], truth.h[k], truth.v_n[k], truth.q_nb[k],
+                        series["gyro_bias_true"], series["accel_bias_true"])
+    if P.shape[1] > error.shape[1]:  # scale-factor states: s_true = diag((I + S)(I + M)) − 1
+        true_scale = [np.diag(gyro.matrix) - 1.0, np.diag(accel.matrix) - 1.0]
+        error = np.concatenate([error, true_scale[0] - series["gyro_scale_factor"],
+                                true_scale[1] - series["accel_scale_factor"]], axis=1)
+    series["error_state"] = error
+    series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+    series["position_error_m"] = ned_metres(error[:, POSITION], series["lat_true"], series["h_true"])
+    series["nees"] = nees(P, error)
+    return series
+
+
+def magnitudes(series):
+    """{quantity: per-frame magnitude} of a navigation series: horizontal and vertical position [m]
+    and velocity [m/s] errors, tilt and heading errors [rad]."""
+    e, p = series["error_state"], series["position_error_m"]
+    return {"horizontal": np.hypot(p[:, 0], p[:, 1]), "vertical": np.abs(p[:, 2]),
+            "velocity_horizontal": np.hypot(e[:, 3], e[:, 4]), "velocity_vertical": np.abs(e[:, 5]),
+            "tilt": np.hypot(e[:, 0], e[:, 1]), "heading": np.abs(e[:, HEADING])}
+
+
+def summarize(scenario, seed, series, grid):
+    """The navigation run's :class:`~navsim.records.RunSummary` over the frames after ``settle_s``."""
+    t = series["t"]
+    steady = t >= scenario["settle_s"]
+    size = magnitudes(series)
+
+    def stats(x, scale=1.0):
+        x = x / scale
+        return {"final": float(x[-1]), "rms": float(np.sqrt(np.mean(x[steady] ** 2))), "max": float(np.max(x[steady]))}
+
+    nmi = stats(size["horizontal"], units.NAUTICAL_MILE)
+    nmi["final_per_hour"] = nmi["final"] / (float(t[-1]) / units.HOUR)
+    e, sigma = series["error_state"], series["error_sigma"]
+    nis_frames = np.isfinite(series["nis"]) & steady
+    measurements, accepted = int(series["n_measurements"].sum()), int(series["n_accepted"].sum())
+    aiding = [kind for kind, present in (("position", "position" in scenario["aiding"]), ("baro", "baro" in scenario.data))
+              if present]
+    return RunSummary(
+        scenario=scenario.name, seed=seed, duration_s=scenario["duration_s"], frames=int(t.size), settle_s=scenario["settle_s"],
+        navigation={"imu_rate_hz": scenario["imu"]["rate_hz"], "frame_rate_hz": 1.0 / (grid.ratio * grid.dt),
+                    "aiding": aiding, "filter_states": int(e.shape[1]), "epoch_utc": scenario["epoch_utc"]},
+        position_error_m={"horizontal": stats(size["horizontal"]), "vertical": stats(size["vertical"])},
+        position_error_nmi={"horizontal": nmi},
+        velocity_error_m_per_s={"horizontal": stats(size["velocity_horizontal"]), "vertical": stats(size["velocity_vertical"])},
+        tilt_error_arcsec=stats(size["tilt"], units.ARCSEC), heading_error_arcsec=stats(size["heading"], units.ARCSEC),
+        position_sigma_final_m=[float(v) for v in ned_sigma(sigma[-1], series["lat_true"][-1], series["h_true"][-1])],
+        bias_error_final_deg_per_h=[float(v) for v in units.rad_per_s_to_deg_per_h(e[-1, GYRO_BIAS])],
+        accel_bias_error_final_micro_g=[float(v) for v in e[-1, ACCEL_BIAS] / MICRO_G],
+        imu_calibration=imu_calibration(series),
+        nees=nees_statistics(series["nees"][steady], e.shape[1]),
+        nis={"mean_per_dof": float(np.sum(series["nis"][nis_frames]) / max(int(np.sum(series["nis_dof"][nis_frames])), 1))},
+        updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])),
+                 "measurements": measurements, "accepted": accepted, "rejected": measurements - accepted},
+    )
+
+
+def ned_sigma(sigma, lat, h):
+    """The position part of an error-state σ (n,) as NED σ [m] (3,) at (L, h)."""
+    return np.abs(ned_metres(sigma[POSITION], lat, h))
+
+
+def imu_calibration(series):
+    """The IMU error states at the end of the run: for each, truth, estimate and σ per axis and the
+    normalised error (estimate − truth)/σ (deg/h, µg, ppm)."""
+    e, sigma = series["error_state"][-1], series["error_sigma"][-1]
+    groups = [("gyro_bias_deg_per_h", GYRO_BIAS, series["gyro_bias"][-1], units.DEG / units.HOUR),
+              ("accel_bias_micro_g", ACCEL_BIAS, series["accel_bias"][-1], MICRO_G)]
+    if e.size > 15:
+        groups += [("gyro_scale_factor_ppm", GYRO_SCALE, series["gyro_scale_factor"][-1], units.PPM),
+                   ("accel_scale_factor_ppm", ACCEL_SCALE, series["accel_scale_factor"][-1], units.PPM)]
+    out = {}
+    for name, span, estimate, unit in groups:
+        true = estimate + e[span]  # the IMU error states are true − estimate
+        out[name] = {"true": [float(v) for v in true / unit], "estimate": [float(v) for v in estimate / unit],
+                     "sigma": [float(v) for v in sigma[span] / unit],
+                     "normalised_error": [float(v) for v in (estimate - true) / sigma[span]]}
+    return out

@@ -1,0 +1,126 @@
+"""Report figures of navigation runs and campaigns (the INS): the ground track on a map, the position,
+velocity and attitude errors with the filter's ±3σ, the IMU error estimates, and across a campaign the
+horizontal error percentiles (CEP) over time and the final errors with their CEP circles.
+
+Units at this edge: degrees of latitude and longitude, metres, m/s, arcsec, deg/h and µg; time in
+minutes. The error state and its σ are the filter's (:mod:`navsim.ins.summary`).
+"""
+
+import numpy as np
+
+from navsim.ins.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, ned_metres
+from navsim.report.figures import COLORS, new_figure
+from startrack import units
+
+NED = ("north", "east", "down")
+
+
+def _minutes(t):
+    return np.asarray(t) / 60.0
+
+
+def ground_track(run):
+    """The estimated and true ground tracks on a map (longitude, latitude [deg], equal scales at the
+    track's mean latitude), with the start and end marked."""
+    s = run.series
+    lat_t, lon_t = np.degrees(s["lat_true"]), np.degrees(s["lon_true"])
+    lat_e, lon_e = np.degrees(s["lat"]), np.degrees(s["lon"])
+    fig, axes = new_figure(4.6)
+    ax = axes[0, 0]
+    ax.plot(lon_t, lat_t, color="k", lw=1.2, label="truth")
+    ax.plot(lon_e, lat_e, color="tab:red", lw=0.8, ls="--", label="estimate")
+    ax.plot(lon_t[0], lat_t[0], "o", color="tab:green", ms=5, label="start")
+    ax.plot(lon_t[-1], lat_t[-1], "s", color="k", ms=4, label="end (truth)")
+    ax.plot(lon_e[-1], lat_e[-1], "s", color="tab:red", ms=4, mfc="none", label="end (estimate)")
+    ax.set_aspect(1.0 / np.cos(np.radians(np.mean(lat_t))), adjustable="datalim")
+    ax.set(xlabel="longitude [deg]", ylabel="latitude [deg]")
+    ax.legend(loc="best", ncols=2)
+    return fig
+
+
+def error_with_bounds(t, errors, sigmas, labels, unit, title=None):
+    """Three error components against time [min] with the filter's ±3σ."""
+    fig, axes = new_figure(4.2, 3, 1)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(_minutes(t), errors[:, i], color=COLORS[i], lw=0.8, label="error")
+        ax.plot(_minutes(t), 3.0 * sigmas[:, i], "k--", lw=0.7, label="±3σ (filter)")
+        ax.plot(_minutes(t), -3.0 * sigmas[:, i], "k--", lw=0.7)
+        ax.set_ylabel(f"{labels[i]} [{unit}]")
+        ax.legend(loc="upper right", ncols=2)
+    if title:
+        axes[0, 0].set_title(title)
+    axes[-1, 0].set_xlabel("time [min]")
+    return fig
+
+
+def position_errors(run):
+    """Position error north, east, down [m] with ±3σ."""
+    s = run.series
+    sigma = np.abs(ned_metres(s["error_sigma"][:, 6:9], s["lat_true"], s["h_true"]))
+    return error_with_bounds(s["t"], s["position_error_m"], sigma, [f"δ{a}" for a in NED], "m")
+
+
+def velocity_errors(run):
+    """Velocity error north, east, down [m/s] with ±3σ."""
+    s = run.series
+    return error_with_bounds(s["t"], s["error_state"][:, 3:6], s["error_sigma"][:, 3:6],
+                             [f"δv {a}" for a in NED], "m/s")
+
+
+def attitude_errors(run):
+    """Tilt about north and east and heading error (est − true = −φ_D) [arcsec] with ±3σ."""
+    s = run.series
+    phi = s["error_state"][:, 0:3] * np.array([1.0, 1.0, -1.0])
+    return error_with_bounds(s["t"], units.rad_to_arcsec(phi), units.rad_to_arcsec(s["error_sigma"][:, 0:3]),
+                             ["tilt φN", "tilt φE", "heading"], "arcsec")
+
+
+def imu_biases(run):
+    """Gyro [deg/h] and accelerometer [µg] bias: truth and estimate with the estimate's ±3σ; None
+    when the run did not log the truths."""
+    s = run.series
+    if "gyro_bias_true" not in s or "accel_bias_true" not in s:
+        return None
+    fig, axes = new_figure(4.6, 3, 2)
+    columns = (("gyro_bias", GYRO_BIAS, units.DEG / units.HOUR, "deg/h"), ("accel_bias", ACCEL_BIAS, MICRO_G, "µg"))
+    for col, (name, span, unit, label) in enumerate(columns):
+        true, est = s[f"{name}_true"] / unit, s[name] / unit
+        sigma3 = 3.0 * s["error_sigma"][:, span] / unit
+        for i, ax in enumerate(axes[:, col]):
+            ax.plot(_minutes(s["t"]), true[:, i], color="k", lw=1.0, label="truth")
+            ax.plot(_minutes(s["t"]), est[:, i], color=COLORS[i], lw=0.8, label="estimate")
+            ax.fill_between(_minutes(s["t"]), est[:, i] - sigma3[:, i], est[:, i] + sigma3[:, i], color=COLORS[i],
+                            alpha=0.15, lw=0, label="±3σ")
+            ax.set_ylabel(f"{name.split('_')[0]} {'xyz'[i]} [{label}]")
+        axes[0, col].legend(loc="upper right", ncols=3)
+        axes[-1, col].set_xlabel("time [min]")
+    return fig
+
+
+def horizontal_percentiles(percentiles):
+    """Horizontal position error over the runs against time: CEP50, CEP95, RMS and the filter's
+    mean 3σ (horizontal, √(σ_N² + σ_E²))."""
+    fig, axes = new_figure(2.8)
+    ax = axes[0, 0]
+    t = _minutes(percentiles.t)
+    ax.plot(t, percentiles.cep50, color="tab:blue", lw=0.9, label="CEP50 (median)")
+    ax.plot(t, percentiles.cep95, color="tab:red", lw=0.9, label="CEP95")
+    ax.plot(t, percentiles.rms, color="k", lw=0.7, ls=":", label="RMS over runs")
+    ax.plot(t, 3.0 * percentiles.sigma, "k--", lw=0.7, label="filter 3σ (mean P)")
+    ax.set(xlabel="time [min]", ylabel="horizontal error [m]", title=f"{percentiles.runs} runs")
+    ax.legend(loc="upper left", ncols=2)
+    return fig
+
+
+def final_scatter(final_ne, cep50, cep95):
+    """Final north/east position errors of the runs [m] with the CEP50 and CEP95 circles."""
+    fig, axes = new_figure(3.6)
+    ax = axes[0, 0]
+    ax.plot(final_ne[:, 1], final_ne[:, 0], ".", color="tab:blue", ms=4, label="runs")
+    angle = np.linspace(0.0, 2.0 * np.pi, 200)
+    for radius, color, label in ((cep50, "tab:green", "CEP50"), (cep95, "tab:red", "CEP95")):
+        ax.plot(radius * np.sin(angle), radius * np.cos(angle), color=color, lw=0.9, label=f"{label} {radius:.3g} m")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set(xlabel="final east error [m]", ylabel="final north error [m]")
+    ax.legend(loc="upper right")
+    return fig

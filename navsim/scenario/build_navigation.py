@@ -1,0 +1,105 @@
+"""From a validated navigation scenario (units in key names) to model objects in SI units: the
+trajectory, the IMU, the baro, the position-fix sensor, the gravity disturbance and the navigation
+filter with its initial covariance (datasheet in, filter model out)."""
+
+import numpy as np
+
+from navsim.earth.gravity import GravityDisturbance, normal_gravity
+from navsim.earth.wgs84 import OMEGA_IE, radii
+from navsim.estimation.nav_filter import BASE_STATES, ImuNoise, NavFilter
+from navsim.scenario.build import accelerometer_model, gyro_model
+from navsim.sensors.aiding import PositionFixSensor
+from navsim.sensors.baro import BaroModel
+from navsim.truth.segments import Profile
+from startrack import units
+
+#: Floors of the default initial σ, so that P0 stays positive definite with perfect sensors:
+#: tilt [rad], heading [rad], gyro bias [rad/s], accelerometer bias [m/s²], scale factor [-].
+FLOORS = {"tilt": units.ARCSEC, "heading": 10.0 * units.ARCSEC, "gyro_bias": 1e-4 * units.DEG / units.HOUR,
+          "accel_bias": units.micro_g_to_si(0.1), "scale_factor": units.PPM}
+#: Most initial heading σ taken from gyrocompassing [rad] (the error state is linear in φ).
+MAX_DEFAULT_HEADING = 10.0 * units.DEG
+
+
+def profile(scenario):
+    """The trajectory's :class:`~navsim.truth.segments.Profile`."""
+    return Profile.from_table(scenario["trajectory"])
+
+
+def imu(scenario):
+    """(gyro, accelerometer) models of ``scenario['imu']`` at the IMU rate."""
+    table = scenario["imu"]
+    return gyro_model(table["gyro"], table["rate_hz"]), accelerometer_model(table["accelerometer"], table["rate_hz"])
+
+
+def baro(scenario):
+    """The :class:`~navsim.sensors.baro.BaroModel` of ``scenario['baro']``, or None."""
+    table = scenario.data.get("baro")
+    if table is None:
+        return None
+    return BaroModel(rate_hz=table["rate_hz"], noise_sigma=table["noise_sigma_m"], bias_sigma=table["bias_sigma_m"],
+                     bias_rw=table["bias_rw_m_per_sqrt_h"] / np.sqrt(units.HOUR), lag_time_constant=table["lag_s"])
+
+
+def position_sensor(scenario, frame_hz):
+    """The :class:`~navsim.sensors.aiding.PositionFixSensor` of ``aiding.position`` on frames of
+    ``frame_hz``, or None (a free INS)."""
+    table = scenario["aiding"].get("position")
+    if table is None:
+        return None
+    return PositionFixSensor(every=int(round(frame_hz / table["rate_hz"])), sigma_ned=np.array(table["sigma_ned_m"]))
+
+
+def gravity_disturbance(scenario):
+    """The :class:`~navsim.earth.gravity.GravityDisturbance` of ``scenario['gravity']``, or None."""
+    table = scenario.data.get("gravity")
+    if table is None:
+        return None
+    xi, eta = units.arcsec_to_rad(table["xi_arcsec"]), units.arcsec_to_rad(table["eta_arcsec"])
+    anomaly = table["anomaly_mgal"] * units.MILLIGAL
+    if table["model"] == "constant":
+        return GravityDisturbance.constant(xi, eta, anomaly)
+    return GravityDisturbance.random(xi, eta, anomaly, table["correlation_length_m"])
+
+
+def estimates_scale_factors(scenario, gyro, accel):
+    """Whether the filter carries the six scale-factor states: the scenario's choice, else whenever
+    either sensor's datasheet has a scale-factor error."""
+    choice = scenario["filter"]["scale_factors"]
+    if choice is not None:
+        return choice == "estimate"
+    return gyro.scale_factor_sigma > 0.0 or accel.scale_factor_sigma > 0.0
+
+
+def initial_covariance(scenario, gyro, accel, lat, h):
+    """P0 (15x15 or 21x21) of the error state [φ, δv, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)] at (L, h).
+
+    Defaults from the datasheets: the tilt of levelling, σ_∇/γ, and the heading of gyrocompassing,
+    σ_ε/(ω_ie cos L) (at most 10 deg) (Titterton & Weston, 2nd ed., ch. 10), with σ the turn-on and
+    bias-instability σ in quadrature; the biases' and scale factors' own σ. Each is floored
+    (:data:`FLOORS`) so that P0 is positive definite with perfect sensors."""
+    f = scenario["filter"]
+    gyro_bias = max(float(np.hypot(gyro.bias_turn_on_sigma, gyro.bias_instability_sigma)), FLOORS["gyro_bias"])
+    accel_bias = max(float(np.hypot(accel.bias_turn_on_sigma, accel.bias_instability_sigma)), FLOORS["accel_bias"])
+    tilt = (units.arcsec_to_rad(f["initial_tilt_sigma_arcsec"]) if f["initial_tilt_sigma_arcsec"] is not None
+            else max(accel_bias / normal_gravity(lat, h), FLOORS["tilt"]))
+    heading = (units.deg_to_rad(f["initial_heading_sigma_deg"]) if f["initial_heading_sigma_deg"] is not None
+               else max(min(gyro_bias / (OMEGA_IE * np.cos(lat)), MAX_DEFAULT_HEADING), FLOORS["heading"]))
+    r_m, r_n = radii(lat)
+    position = f["initial_position_sigma_m"] / np.array([r_m + h, (r_n + h) * np.cos(lat), 1.0])
+    sigma = [tilt, tilt, heading, *[f["initial_velocity_sigma_m_per_s"]] * 3, *position, *[gyro_bias] * 3,
+             *[accel_bias] * 3]
+    if estimates_scale_factors(scenario, gyro, accel):
+        sigma += [max(gyro.scale_factor_sigma, FLOORS["scale_factor"])] * 3
+        sigma += [max(accel.scale_factor_sigma, FLOORS["scale_factor"])] * 3
+    return np.diag(np.square(np.array(sigma, dtype=float)))
+
+
+def nav_filter(scenario, gyro, accel, start, P0, dt):
+    """The :class:`~navsim.estimation.nav_filter.NavFilter` of ``scenario['filter']`` from ``start``
+    = (L, λ, h, v_n, q_nb), with zero IMU error estimates, P0 and the noise of the datasheets."""
+    f = scenario["filter"]
+    noise = ImuNoise(arw=gyro.arw, vrw=accel.vrw, gyro_bias_rw=gyro.filter_rrw, accel_bias_rw=accel.filter_bias_rw)
+    return NavFilter(*start, P0, noise, dt, estimate_scale_factors=P0.shape[0] > BASE_STATES,
+                     covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"],
+                     process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"])

@@ -1,0 +1,233 @@
+"""The navigation scenario kind: a scenario file with a ``[trajectory]`` table (docs/design.md, "The
+navigation scenario").
+
+Its own strict schema (:data:`SCHEMA`: units in the key names, every value bounded) and cross-key
+rules (:func:`validate`): the trajectory's segments of :mod:`navsim.truth.segments` (a
+segment that cannot be flown is named), the IMU (a gyro and an accelerometer, each a preset and/or
+datasheet fields), an optional baro, position aiding (none: a free INS), an optional gravity
+disturbance and the filter, whose noise and initial σ come from the datasheets unless given.
+Every problem is one :class:`~startrack.errors.InputError` naming the file, the key and what is wrong.
+"""
+
+import dataclasses
+
+from navsim.earth.frames import utc_epoch
+from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS
+from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
+from navsim.truth import segments
+from startrack.errors import InputError
+
+#: Bounds: speed [m/s], height [m] (the ellipsoid +/- ), latitude [deg] (the NED frame is singular
+#: at the poles), a segment's duration [s].
+MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 3000.0, 1e5, 89.0, 2.6e6
+#: What one run holds in memory: IMU samples (the truth trajectory and both sensors) and frames (each
+#: with the filter's covariance).
+MAX_IMU_SAMPLES, MAX_FRAMES = 1e7, 1e5
+#: A free vertical channel diverges (e-folding time √(a/2g) ≈ 570 s): longer runs need a baro.
+MAX_FREE_VERTICAL_S = 3600.0
+#: Frames per second of a run without aiding sensors (the run log's rate).
+FREE_FRAME_RATE_HZ = 1.0
+
+
+def _default(kind, name):
+    """The default of field ``name`` of segment class ``kind`` (one set of defaults: the dataclass's)."""
+    return next(f.default for f in dataclasses.fields(kind) if f.name == name)
+
+
+def _seconds(kind=None, name=None, maximum=1e4):
+    """A positive time [s]: required, or with the default of segment class ``kind``'s field ``name``."""
+    default = _default(kind, name) if kind is not None else REQUIRED
+    return Value("float", default=default, exclusive_minimum=0.0, maximum=maximum)
+
+
+def _ship():
+    ship = segments.ShipMotion
+    return Table({
+        "duration_s": _seconds(maximum=MAX_DURATION),
+        "roll_amplitude_deg": Value("float", default=_default(ship, "roll_amplitude_deg"), minimum=-45.0, maximum=45.0),
+        "roll_period_s": _seconds(ship, "roll_period_s"),
+        "pitch_amplitude_deg": Value("float", default=_default(ship, "pitch_amplitude_deg"), minimum=-30.0, maximum=30.0),
+        "pitch_period_s": _seconds(ship, "pitch_period_s"),
+        "heave_amplitude_m": Value("float", default=_default(ship, "heave_amplitude_m"), minimum=-100.0, maximum=100.0),
+        "heave_period_s": _seconds(ship, "heave_period_s"),
+        "ramp_s": _seconds(ship, "ramp_s"),
+    })
+
+
+#: One trajectory segment: its ``kind`` and that kind's keys (:mod:`navsim.truth.segments`).
+SEGMENT = Tagged("kind", {
+    "hold": Table({"duration_s": _seconds(maximum=MAX_DURATION)}),
+    "straight": Table({"duration_s": _seconds(maximum=MAX_DURATION)}),
+    "accelerate": Table({
+        "speed_m_per_s": Value("float", minimum=0.0, maximum=MAX_SPEED),
+        "acceleration_m_per_s2": Value("float", exclusive_minimum=0.0, maximum=100.0),
+        "ramp_s": _seconds(segments.Accelerate, "ramp_s"),
+    }),
+    "turn": Table({
+        "heading_change_deg": Value("float", minimum=-36000.0, maximum=36000.0),
+        "rate_deg_per_s": Value("float", exclusive_minimum=0.0, maximum=100.0),
+        "roll_in_s": _seconds(segments.Turn, "roll_in_s"),
+        "bank_deg": Value("float", default=None, minimum=-89.0, maximum=89.0,
+                          doc="checked against tan φ = V ψ̇ / g0 (within 1 %): a turn that cannot be flown is refused"),
+    }),
+    "climb": Table({
+        "height_change_m": Value("float", minimum=-MAX_HEIGHT, maximum=MAX_HEIGHT),
+        "rate_m_per_s": Value("float", exclusive_minimum=0.0, maximum=1000.0),
+        "transition_s": _seconds(segments.Climb, "transition_s"),
+    }),
+    "ship": _ship(),
+})
+
+SCHEMA = Table(
+    {
+        "name": Value("str"),
+        "description": Value("str", default=""),
+        "seed": Value("int", default=0, minimum=0, maximum=2**63 - 1),
+        "epoch_utc": Value("str", default="2000-01-01T12:00:00",
+                           doc="UTC calendar epoch of t = 0 (C_ei of pyerfa; the star sensor's sky)"),
+        "duration_s": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_DURATION,
+                            doc="default: the whole trajectory; shorter runs stop early"),
+        "settle_s": Value("float", default=None, minimum=0.0,
+                          doc="errors are summarised after this time (default: 10 % of the run)"),
+        "trajectory": Table({
+            "start": Table({
+                "lat_deg": Value("float", minimum=-MAX_LATITUDE, maximum=MAX_LATITUDE),
+                "lon_deg": Value("float", minimum=-360.0, maximum=360.0),
+                "height_m": Value("float", default=0.0, minimum=-1000.0, maximum=MAX_HEIGHT,
+                                  doc="above the WGS-84 ellipsoid; at most 1 km below it"),
+                "speed_m_per_s": Value("float", default=0.0, minimum=0.0, maximum=MAX_SPEED),
+                "heading_deg": Value("float", default=0.0, minimum=-360.0, maximum=360.0),
+            }),
+            "segments": ListOfTables(SEGMENT, required=True, min_length=1),
+        }),
+        "imu": Table({
+            "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e4),
+            "gyro": Table(dict(GYRO_ERRORS)),
+            "accelerometer": Table(dict(ACCELEROMETER_ERRORS)),
+        }),
+        "baro": Table({
+            "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
+            "noise_sigma_m": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e4),
+            "bias_sigma_m": Value("float", default=0.0, minimum=0.0, maximum=1e4),
+            "bias_rw_m_per_sqrt_h": Value("float", default=0.0, minimum=0.0, maximum=1e4),
+            "lag_s": Value("float", default=0.0, minimum=0.0, maximum=1e4),
+        }, optional=True, doc="a barometric altimeter: a height measurement of the filter at its rate"),
+        "aiding": Table({
+            "position": Table({
+                "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
+                "sigma_ned_m": Value("vector", exclusive_minimum=0.0, maximum=1e6,
+                                     doc="1σ of the fix's north, east and down errors"),
+            }, optional=True, doc="position fixes (GNSS-like): the truth plus white NED noise"),
+        }, doc="no table: a free INS"),
+        "gravity": Table({
+            "model": Value("str", choices=("constant", "random")),
+            "xi_arcsec": Value("float", default=0.0, minimum=-3600.0, maximum=3600.0,
+                               doc="north-south deflection of the vertical (constant) or its σ (random)"),
+            "eta_arcsec": Value("float", default=0.0, minimum=-3600.0, maximum=3600.0,
+                                doc="east-west deflection of the vertical (constant) or its σ (random)"),
+            "anomaly_mgal": Value("float", default=0.0, minimum=-1e4, maximum=1e4, doc="anomaly (constant) or its σ"),
+            "correlation_length_m": Value("float", default=None, exclusive_minimum=0.0, maximum=1e8,
+                                          doc="random: the correlation length along the track"),
+        }, optional=True, doc="a gravity disturbance of the truth, unknown to the INS"),
+        "filter": Table({
+            "initial_tilt_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0, maximum=36000.0,
+                                               doc="default: levelling's limit, accelerometer bias σ / g"),
+            "initial_heading_sigma_deg": Value("float", default=None, exclusive_minimum=0.0, maximum=30.0,
+                                               doc="default: gyrocompassing's limit, gyro bias σ / (ω_ie cos L), "
+                                                   "at most 10 deg"),
+            "initial_velocity_sigma_m_per_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=1e3),
+            "initial_position_sigma_m": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e5),
+            "scale_factors": Value("str", default=None, choices=("estimate", "ignore"),
+                                   doc="six scale-factor states (gyro and accelerometer); default: estimate when "
+                                       "either sensor has a scale-factor error"),
+            "covariance_interval": Value("int", default=20, minimum=1, maximum=100000,
+                                         doc="IMU intervals per covariance propagation"),
+            "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
+            "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
+            "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
+        }),
+    }
+)
+
+
+def validate(checked, source):
+    """The cross-key rules of a navigation scenario already checked against :data:`SCHEMA`; fills
+    the derived defaults (``duration_s``, ``settle_s``) and returns the checked dictionary."""
+    try:
+        utc_epoch(checked["epoch_utc"])
+        flown = segments.Profile.from_table(checked["trajectory"]).duration
+    except InputError as error:
+        raise InputError(f"{source}: {error}") from None
+    imu_hz = checked["imu"]["rate_hz"]
+    if checked["duration_s"] is None:
+        checked["duration_s"] = flown
+    if checked["duration_s"] > flown + 1e-9:
+        raise InputError(f"{source}: duration_s: {checked['duration_s']:g} s is longer than the trajectory "
+                         f"({flown:g} s of segments)")
+    if checked["duration_s"] * imu_hz < 1.0:
+        raise InputError(f"{source}: imu.rate_hz: {imu_hz:g} Hz gives no IMU interval in {checked['duration_s']:g} s")
+    frame_hz = frame_rate(checked, source)
+    _check_run_size(checked, frame_hz, source)
+    if "position" not in checked["aiding"] and "baro" not in checked and checked["duration_s"] > MAX_FREE_VERTICAL_S:
+        raise InputError(f"{source}: baro: a free INS of {checked['duration_s']:g} s needs a [baro] table (the free "
+                             f"vertical channel diverges, e-folding time 570 s; at most {MAX_FREE_VERTICAL_S:g} s without)")
+    _check_gravity(checked.get("gravity"), source)
+    if checked["settle_s"] is None:
+        checked["settle_s"] = 0.1 * checked["duration_s"]
+    if checked["settle_s"] >= checked["duration_s"]:
+        raise InputError(f"{source}: settle_s: must be shorter than duration_s")
+    return checked
+
+
+def aiding_rates(checked):
+    """{key: rate [Hz]} of the aiding sensors a navigation scenario has (position fix, baro)."""
+    rates = {}
+    if "position" in checked["aiding"]:
+        rates["aiding.position.rate_hz"] = checked["aiding"]["position"]["rate_hz"]
+    if "baro" in checked:
+        rates["baro.rate_hz"] = checked["baro"]["rate_hz"]
+    return rates
+
+
+def frame_rate(checked, source="<scenario>"):
+    """The rate of the run's frames [Hz]: the fastest aiding sensor's (1 Hz without one, or the IMU's
+    when slower). Every aiding rate must divide it and it must divide the IMU rate: an aiding sensor
+    faster than the IMU is refused."""
+    imu_hz = checked["imu"]["rate_hz"]
+    rates = aiding_rates(checked)
+    for key, rate in rates.items():
+        if rate > imu_hz * (1.0 + 1e-9):
+            raise InputError(f"{source}: {key}: {rate:g} Hz is faster than the IMU (imu.rate_hz = {imu_hz:g} Hz)")
+        if not is_multiple(imu_hz, rate):
+            raise InputError(f"{source}: {key}: {rate:g} Hz must divide imu.rate_hz = {imu_hz:g} Hz")
+    frame_hz = max(rates.values()) if rates else min(FREE_FRAME_RATE_HZ, imu_hz)
+    for key, rate in rates.items():
+        if not is_multiple(frame_hz, rate):
+            raise InputError(f"{source}: {key}: {rate:g} Hz must divide the fastest aiding rate, {frame_hz:g} Hz")
+    if not is_multiple(imu_hz, frame_hz):
+        raise InputError(f"{source}: imu.rate_hz: {imu_hz:g} Hz must be a multiple of the frame rate {frame_hz:g} Hz")
+    return frame_hz
+
+
+def _check_run_size(checked, frame_hz, source):
+    duration = checked["duration_s"]
+    samples, frames = duration * checked["imu"]["rate_hz"], duration * frame_hz
+    if samples > MAX_IMU_SAMPLES:
+        raise InputError(f"{source}: duration_s: {duration:g} s at imu.rate_hz = {checked['imu']['rate_hz']:g} Hz is "
+                         f"{samples:.3g} IMU samples, more than the {MAX_IMU_SAMPLES:.0e} one run holds in memory; "
+                         "lower the IMU rate or shorten the run")
+    if frames > MAX_FRAMES:
+        raise InputError(f"{source}: duration_s: {duration:g} s at {frame_hz:g} frames per second is {frames:.3g} frames, "
+                         f"more than the {MAX_FRAMES:.0e} one run logs; lower the aiding rate or shorten the run")
+
+
+def _check_gravity(gravity, source):
+    if gravity is None:
+        return
+    if gravity["model"] == "random" and gravity["correlation_length_m"] is None:
+        raise InputError(f"{source}: gravity.correlation_length_m: a random disturbance needs its correlation length")
+    if gravity["model"] == "constant" and gravity["correlation_length_m"] is not None:
+        raise InputError(f"{source}: gravity.correlation_length_m: only for model = \"random\" (the constant model "
+                         "has none)")
+    if gravity["model"] == "random" and min(gravity["xi_arcsec"], gravity["eta_arcsec"], gravity["anomaly_mgal"]) < 0.0:
+        raise InputError(f"{source}: gravity: a random disturbance takes σ >= 0 for xi_arcsec, eta_arcsec and anomaly_mgal")
