@@ -72,6 +72,17 @@ def rotate(q, v):
     return v + q[..., 3:4] * t + np.cross(u, t)
 
 
+def from_two_vectors(a, b):
+    """Quaternion (..., 4) of the smallest rotation taking unit vectors ``a`` to ``b`` (..., 3): about
+    a × b by the angle atan2(|a × b|, a · b) (undefined for opposite vectors)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    axis = np.cross(a, b)
+    s = np.linalg.norm(axis, axis=-1, keepdims=True)
+    angle = np.arctan2(s, np.sum(a * b, axis=-1, keepdims=True))
+    return from_rotation_vector(axis * (angle / np.where(s > 0.0, s, 1.0)))
+
+
 def attitude_error(q_est, q_true):
     """Small-angle error δθ (..., 3) [rad] in the estimate's axes: ``q_true = q_est ⊗ δq(δθ)``."""
     return to_rotation_vector(multiply(conjugate(q_est), q_true))

@@ -29,6 +29,16 @@ def c_en(lat, lon):
 
 
 @njit
+def q_en(lat, lon):
+    """The quaternion of :func:`c_en` as components (x, y, z, w) (scalars or arrays alike; compiled):
+    C_en = R_z(λ) R_y(−L − π/2), so q_en = q_z(λ) ⊗ q_y(−L − π/2)."""
+    sz, cz = np.sin(0.5 * lon), np.cos(0.5 * lon)
+    half = -0.5 * lat - 0.25 * np.pi
+    sy, cy = np.sin(half), np.cos(half)
+    return -sz * sy, cz * sy, sz * cy, cz * cy
+
+
+@njit
 def earth_rate_n(lat):
     """ω_ie^n = ω_ie [cos L, 0, −sin L] [rad/s] as (north, east, down) (Groves eq. 2.123)."""
     return OMEGA_IE * np.cos(lat), 0.0 * lat, -OMEGA_IE * np.sin(lat)

@@ -321,16 +321,17 @@ def joseph_update_attitude(P, R, z, estimated):
 
 
 @njit
-def star_residuals(x, ref_I, obs_S, n, mounting):
-    """Tangent-plane residuals of identified stars and their Jacobians.
+def star_residuals(q_IB, q_BS, ref_I, obs_S, n, mounting):
+    """Tangent-plane residuals of identified stars against the estimates q_IB, q_BS and their Jacobians.
 
     ŝ = R_SB R_IBᵀ r; T (2x3) spans the plane ⟂ ŝ; z = T (s − ŝ);
-    H = T [R_SB [b̂×], 0, …, ([ŝ×] in the last three columns when ``mounting``)].
+    H = T [R_SB [b̂×], 0, …, ([ŝ×] in the last three columns when ``mounting``)] for the body-axes
+    attitude error δθ (first three columns) and the mounting error δm (last three).
     Returns (z (N, 2), H (N, 2, n)).
     """
     m = ref_I.shape[0]
-    R_IB = quat_to_matrix(x[0:4])
-    R_SB = quat_to_matrix(x[16:20]).T
+    R_IB = quat_to_matrix(q_IB)
+    R_SB = quat_to_matrix(q_BS).T
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     for k in range(m):
@@ -378,6 +379,18 @@ def block_nis(H, P, z, variance):
 
 
 @njit
+def fix_residual(q_IB, q_BS, q_IS, R_S):
+    """An attitude fix q_IS (covariance R_S in sensor axes) against the estimates q_IB and q_BS:
+    z = δθ(q_IB, q_IS ⊗ q_BS⁻¹), the rotation vector of q_IB⁻¹ ⊗ q_IS ⊗ q_BS⁻¹ in body axes, with
+    z = δθ + R_BS δm to first order for q_IB,true = q_IB ⊗ δq(δθ) and q_BS,true = q_BS ⊗ δq(δm);
+    R = R_BS R_S R_BSᵀ. Returns (z (3,), R_BS, R)."""
+    conj = np.array([-1.0, -1.0, -1.0, 1.0])
+    z = rotation_vector(quat_multiply(q_IB * conj, quat_multiply(q_IS, q_BS * conj)))
+    R_BS = quat_to_matrix(q_BS)
+    return z, R_BS, mm_t(mm(R_BS, R_S), R_BS)
+
+
+@njit
 def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
     """Gated update with an attitude fix q_IS (covariance R_S in sensor axes), then the reset.
 
@@ -385,18 +398,13 @@ def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
     Returns (x, P, z, nis, accepted); the state is unchanged when rejected.
     """
     n = P.shape[0]
-    conj = np.array([-1.0, -1.0, -1.0, 1.0])
-    q_BS = x[16:20]
-    q_IB_measured = quat_multiply(q_IS, q_BS * conj)
-    z = rotation_vector(quat_multiply(x[0:4] * conj, q_IB_measured))
-    R_BS = quat_to_matrix(q_BS)
+    z, R_BS, R = fix_residual(x[0:4], x[16:20], q_IS, R_S)
     H = np.zeros((3, n))
     for i in range(3):
         H[i, i] = 1.0
         if model.mounting:
             for j in range(3):
                 H[i, n - 3 + j] = R_BS[i, j]
-    R = mm_t(mm(R_BS, R_S), R_BS)
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
     nis = 0.0
@@ -417,13 +425,23 @@ def stars_update(x, P, ref_I, obs_S, variance, gate, model, estimated):
     """Gated update with identified stars (see :func:`star_residuals`): each star's 2-dof NIS
     against the prior is compared with ``gate``; the accepted stars update together, then the
     reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
+    z, H = star_residuals(x[0:4], x[16:20], ref_I, obs_S, P.shape[0], model.mounting)
+    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, variance, gate)
+    if za.shape[0] == 0:
+        return x, P, z, nis, accepted
+    dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
+    return reset(x, dx, model), P_next, z, nis, accepted
+
+
+@njit
+def gate_stars(H, P, z, variance, gate):
+    """Each star's 2-dof NIS against the prior (:func:`block_nis`) compared with ``gate``; the accepted
+    stars stacked into one measurement. Returns (nis (N,), accepted (N,), H (2m, n), z (2m,),
+    R (2m, 2m)) for the m accepted stars."""
     n = P.shape[0]
-    z, H = star_residuals(x, ref_I, obs_S, n, model.mounting)
     nis = block_nis(H, P, z, variance)
     accepted = nis <= gate
     m = int(np.sum(accepted))
-    if m == 0:
-        return x, P, z, nis, accepted
     Ha = np.empty((2 * m, n))
     za = np.empty(2 * m)
     Ra = np.zeros((2 * m, 2 * m))
@@ -435,8 +453,7 @@ def stars_update(x, P, ref_I, obs_S, variance, gate, model, estimated):
                 za[row] = z[k, r]
                 Ra[row, row] = variance[k]
                 row += 1
-    dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
-    return reset(x, dx, model), P_next, z, nis, accepted
+    return nis, accepted, Ha, za, Ra
 
 
 @njit

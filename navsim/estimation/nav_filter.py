@@ -1,17 +1,23 @@
-"""Navigation error-state Kalman filter of the strapdown INS, aided here by position fixes and a baro.
+"""Navigation error-state Kalman filter of the strapdown INS, aided by position fixes, a baro and a
+star sensor (SINS/CNS).
 
 The filter owns the nominal navigation state (the strapdown ``nav`` vector of
-:mod:`navsim.ins.strapdown`: L, λ, h, v_n, q_nb), the IMU error estimates (gyro and accelerometer
-biases, optional scale factors) and the covariance P of the error state
-(:mod:`navsim.estimation.nav_kernels`, docs/design.md):
+:mod:`navsim.ins.strapdown`: L, λ, h, v_n, q_nb), its estimates beside it (gyro and accelerometer
+biases, optional scale factors, the star sensor's mounting q̂_BS) and the covariance P of the error
+state (:mod:`navsim.estimation.nav_kernels`, docs/design.md):
 
-    x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)],   C_nb,est = (I − [φ×]) C_nb,true.
+    x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg)],   C_nb,est = (I − [φ×]) C_nb,true,
 
-``predict(samples, dt)`` mechanizes the corrected IMU samples at the IMU rate and propagates P every
-``covariance_interval`` intervals with the discretised error dynamics (Φ, Q_d by series, tested
-against expm and Van Loan); ``update_position`` and ``update_baro`` gate each measurement by its
-chi-square NIS against the prior, update in Joseph form and reset the estimate into the nominal
-state; ``process_record`` is the compiled fast path over a whole aiding record, tested equal to the
+μ the star-sensor mounting error (estimated or a consider state) and δg the gravity disturbance the
+INS does not know (consider states: Schmidt). ``predict(samples, dt)`` mechanizes the corrected IMU
+samples at the IMU rate and propagates P every ``covariance_interval`` intervals (Φ, Q_d by series,
+tested against expm and Van Loan); the updates — ``update_position``, ``update_baro``,
+``update_attitude`` (a star-sensor fix) and ``update_stars`` (identified stars one by one,
+:mod:`navsim.estimation.celestial_kernels`) — gate each measurement by its chi-square NIS against
+the prior, update in Joseph form and reset the estimate into the nominal state. With a star sensor
+the filter also serves it (``sensor_prediction``: q̂_IS = q_ie ⊗ q_en ⊗ q_nb ⊗ q̂_BS and the rate in
+sensor axes) and takes its faults (``reinitialise`` from a fix after a lost track, ``disturb``).
+``process_record`` is the compiled fast path over a whole position/baro record, tested equal to the
 step-by-step loop of :mod:`navsim.closed_loop`. Nobody else writes the state or P: read them
 through the properties.
 """
@@ -20,15 +26,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.estimation import nav_kernels
+from navsim.earth.frames import q_en
+from navsim.earth.orientation import observer_velocity
+from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
+from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
 from navsim.estimation.updates import UpdateResult
 from navsim.ins import strapdown
+from navsim.sensors.apparent import fix_rotation
 from startrack import rotation as rot
+from startrack.aberration import aberrate
 from startrack.errors import InputError
 
-BASE_STATES = 15
-SCALE_STATES = 21
+#: How the mounting states are treated (as the attitude filter's groups).
+MOUNTING_TREATMENTS = ("estimate", "consider", "ignore")
 
 
 @dataclass(frozen=True)
@@ -42,13 +53,37 @@ class ImuNoise:
     accel_bias_rw: float = 0.0
     scale_factor_rw: float = 0.0
 
-    def spectral_densities(self, n):
-        """Diagonal continuous noise q_c (n,) of the error state."""
-        q = np.zeros(n)
+    def spectral_densities(self, layout):
+        """Diagonal continuous noise q_c (n,) of the error state of ``layout`` (the mounting constant;
+        the gravity disturbance's drive depends on the speed: :func:`nav_kernels.noise_densities`)."""
+        q = np.zeros(layout.n)
         q[0:3], q[3:6] = self.arw**2, self.vrw**2
         q[9:12], q[12:15] = self.gyro_bias_rw**2, self.accel_bias_rw**2
-        q[15:] = self.scale_factor_rw**2
+        if layout.scale >= 0:
+            q[layout.scale:layout.scale + 6] = self.scale_factor_rw**2
         return q
+
+
+@dataclass(frozen=True)
+class StarSensorModel:
+    """What the filter knows of its star sensor: the nominal mounting ``q_BS`` (S -> B), how it treats
+    the mounting error μ (``mounting``: estimate, consider or ignore), the Earth's orientation at the
+    frames (:class:`~navsim.earth.orientation.EarthOrientation`) and whether its processing
+    corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.sensors.apparent`)."""
+
+    q_BS: np.ndarray
+    mounting: str
+    orientation: object
+    correct_aberration: bool = True
+
+
+@dataclass(frozen=True)
+class GravityUncertainty:
+    """The filter's model of the gravity disturbance it does not know: σ (3,) of (δg_N, δg_E, δg_D)
+    [m/s²] and the correlation length along the track [m] (inf: constant)."""
+
+    sigma: np.ndarray
+    correlation_length: float
 
 
 class NavFilter:
@@ -56,17 +91,23 @@ class NavFilter:
     F, Φ, Q, H, R, K inside each compiled step.
 
     Parameters: the initial navigation state ``lat``, ``lon`` [rad], ``h`` [m], ``v_n`` (3,)
-    [m/s], ``q_nb``; ``P`` (15x15, or 21x21 with ``estimate_scale_factors``); ``noise``
-    (:class:`ImuNoise`); ``dt`` the IMU interval [s]; ``covariance_interval`` the number of
-    increments per covariance propagation; ``gate_probability`` of the chi-square gates;
-    ``process_noise_scale`` (multiplies Q) and ``measurement_noise_scale`` (multiplies each
-    measurement's σ) for tuning; ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
+    [m/s], ``q_nb``; ``P`` (n x n in the state order of the module docstring); ``noise``
+    (:class:`ImuNoise`); ``dt`` the IMU interval [s]; ``estimate_scale_factors``; ``star_sensor``
+    (:class:`StarSensorModel`, or None without one); ``gravity`` (:class:`GravityUncertainty` for the
+    three consider states, or None); ``covariance_interval`` the number of increments per covariance
+    propagation; ``gate_probability`` of the chi-square gates; ``process_noise_scale`` (multiplies Q)
+    and ``measurement_noise_scale`` (multiplies each measurement's σ) for tuning;
+    ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
     """
 
-    def __init__(self, lat, lon, h, v_n, q_nb, P, noise, dt, estimate_scale_factors=False,
-                 covariance_interval=20, gate_probability=0.9999, process_noise_scale=1.0,
+    def __init__(self, lat, lon, h, v_n, q_nb, P, noise, dt, estimate_scale_factors=False, star_sensor=None,
+                 gravity=None, covariance_interval=20, gate_probability=0.9999, process_noise_scale=1.0,
                  measurement_noise_scale=1.0, gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0)):
-        self.n = SCALE_STATES if estimate_scale_factors else BASE_STATES
+        mounting = "ignore" if star_sensor is None else star_sensor.mounting
+        if mounting not in MOUNTING_TREATMENTS:
+            raise InputError(f"filter.mounting: must be one of {', '.join(MOUNTING_TREATMENTS)}, got {mounting!r}")
+        self.layout = nav_kernels.layout(estimate_scale_factors, mounting != "ignore", gravity is not None)
+        self.n = self.layout.n
         if not dt > 0.0:
             raise InputError(f"imu.rate_hz: the IMU interval must be > 0, got {dt!r} s")
         if int(covariance_interval) < 1:
@@ -74,16 +115,36 @@ class NavFilter:
         P = np.array(P, dtype=float)
         if P.shape != (self.n, self.n):
             raise InputError(f"filter.P: must be {self.n}x{self.n} for the chosen states, got {P.shape}")
-        self.dt = float(dt)
-        self.covariance_interval = int(covariance_interval)
-        self.q_c = float(process_noise_scale) * noise.spectral_densities(self.n)
+        gm = np.zeros(4)
+        if gravity is not None:
+            gm[0:3], gm[3] = np.square(gravity.sigma), 1.0 / gravity.correlation_length
+        self.model = NavModel(q_c=float(process_noise_scale) * noise.spectral_densities(self.layout), gm=gm,
+                              dt=float(dt), every=int(covariance_interval), layout=self.layout)
+        self.star_sensor = star_sensor
+        self.estimated = np.ones(self.n, dtype=np.bool_)
+        if mounting == "consider":
+            self.estimated[self.layout.mounting:self.layout.mounting + 3] = False
+        if gravity is not None:
+            self.estimated[self.layout.gravity:] = False
         self.sigma_scale = float(measurement_noise_scale)
-        self.gates = np.array([chi2_quantile(gate_probability, dof) for dof in (3, 1)], dtype=float)
-        self._imu = np.zeros(12)
-        self._imu[0:3], self._imu[3:6] = gyro_bias, accel_bias
+        self.gates = np.array([chi2_quantile(gate_probability, dof) for dof in (3, 1, 2)], dtype=float)
+        self._calib = np.zeros(CALIB_SIZE)
+        self._calib[0:3], self._calib[3:6] = gyro_bias, accel_bias
+        self._calib[12:16] = (0.0, 0.0, 0.0, 1.0) if star_sensor is None else rot.normalize(star_sensor.q_BS)
         self._nav = strapdown.initial_state(lat, lon, h, v_n, q_nb)
         self._P = 0.5 * (P + P.T)
+        self._P0_attitude = self._P[0:3, 0:3].copy()
         self._acc = np.zeros(nav_kernels.ACC_SIZE)
+        self._intervals = 0
+
+    @property
+    def dt(self):
+        return self.model.dt
+
+    @property
+    def t(self):
+        """Time of the filter's state [s since the start]: the IMU intervals it has mechanized."""
+        return self._intervals * self.model.dt
 
     def predict(self, samples, dt):
         """Mechanize IMU samples (m, 6) of the filter's interval ``dt`` [s]: each row the interval means
@@ -91,22 +152,92 @@ class NavFilter:
         if dt != self.dt:
             raise ValueError(f"IMU interval {dt} s, the filter was built for {self.dt} s")
         samples = np.ascontiguousarray(np.atleast_2d(samples), dtype=float)
-        nav_kernels.predict(self._nav, self._imu, self._P, self._acc, samples, self.dt, self.q_c,
-                            self.covariance_interval)
+        nav_kernels.predict(self._nav, self._calib, self._P, self._acc, samples, self.model)
+        self._intervals += samples.shape[0]
 
     def update_position(self, lat, lon, h, sigma):
         """Update with a position fix (L, λ [rad], h [m]) of NED σ ``sigma`` (3,) [m], gated at 3 dof;
         the innovation is reported in NED metres."""
         sigma = np.broadcast_to(np.asarray(sigma, dtype=float), (3,)) * self.sigma_scale
-        z, nis, accepted = nav_kernels.position_update(self._nav, self._imu, self._P, self._acc, self.q_c, self.dt,
-                                                       np.array([lat, lon, h], dtype=float), sigma, self.gates[0])
-        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
+        z, nis, accepted = nav_kernels.position_update(self._nav, self._calib, self._P, self._acc, self.model,
+                                                       np.array([lat, lon, h], dtype=float), sigma, self.gates[0],
+                                                       self.estimated)
+        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m")
 
     def update_baro(self, h, sigma):
         """Update with a baro height ``h`` [m] of σ ``sigma`` [m], gated at 1 dof."""
-        z, nis, accepted = nav_kernels.baro_update(self._nav, self._imu, self._P, self._acc, self.q_c, self.dt,
+        z, nis, accepted = nav_kernels.baro_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                    float(h), float(sigma) * self.sigma_scale, self.gates[1])
+        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m")
+
+    def update_attitude(self, q_IS, R_S):
+        """Update with a star-sensor attitude fix q_IS and its covariance R_S (3, 3) in sensor axes, gated
+        at 3 dof (:func:`celestial_kernels.fix_update`); the fix is first turned back by the aberration
+        rotation of its boresight when the processing corrects aberration."""
+        j = self._frame()
+        q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
+        R = self.sigma_scale**2 * np.asarray(R_S, dtype=float)
+        z, nis, accepted = celestial_kernels.fix_update(self._nav, self._calib, self._P, self._acc, self.model,
+                                                        self.star_sensor.orientation.q_ie[j], q_IS, R, self.gates[0],
+                                                        self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
+
+    def update_stars(self, ref_I, obs_S, sigma):
+        """Update with identified stars: catalog unit vectors ``ref_I`` (N, 3) in ICRS, measured unit
+        vectors ``obs_S`` (N, 3) in S, direction σ (N,) or scalar [rad]; each star a 2-dof residual gated
+        alone (:func:`celestial_kernels.stars_update`). The catalog directions are made apparent with
+        the filter's own velocity and the ephemeris when the processing corrects aberration."""
+        j = self._frame()
+        ref_I = np.ascontiguousarray(ref_I, dtype=float)
+        if self.star_sensor.correct_aberration:
+            ref_I = np.ascontiguousarray(aberrate(ref_I, self._observer_velocity(j)))
+        variance = (self.sigma_scale**2 * np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (ref_I.shape[0],))).copy()
+        z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
+                                                          self.star_sensor.orientation.q_ie[j], ref_I,
+                                                          np.ascontiguousarray(obs_S, dtype=float), variance,
+                                                          self.gates[2], self.estimated)
+        return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
+
+    def sensor_prediction(self, last_sample):
+        """(q̂_IS, ω̂_S): the star sensor's attitude the INS predicts, q_ie ⊗ q_en ⊗ q_nb ⊗ q̂_BS, and the
+        inertial body rate of the corrected IMU sample ``last_sample`` (6,) in sensor axes [rad/s]."""
+        j = self._frame()
+        q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
+        a, b = np.empty(3), np.empty(3)
+        nav_kernels.correct(np.asarray(last_sample, dtype=float), self._calib, 1.0, self.layout.scale >= 0, a, b)
+        return rot.multiply(q_IB, self._calib[12:16]), rot.to_matrix(self._calib[12:16]).T @ a
+
+    def reinitialise(self, q_IS):
+        """Restart the attitude from a star-sensor fix q_IS after a lost track: q_nb = q_en⁻¹ ⊗ q_ie⁻¹ ⊗
+        q_IS ⊗ q̂_BS⁻¹ (the fix corrected like an update's), the attitude block of P back to its
+        initial value and its correlations cleared."""
+        j = self._frame()
+        q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
+        q_ni = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], np.array(q_en(self._nav[0], self._nav[1]))))
+        self._nav[6:10] = rot.normalize(rot.multiply(rot.multiply(q_ni, q_IS), rot.conjugate(self._calib[12:16])))
+        self._P[0:3, :] = 0.0
+        self._P[:, 0:3] = 0.0
+        self._P[0:3, 0:3] = self._P0_attitude
+
+    def disturb(self, rotation_vector):
+        """The attitude-jump fault: the estimate is knocked off by ``rotation_vector`` [rad] (body axes),
+        as by a disturbance the filter is not told about; P is left as it was."""
+        self._nav[6:10] = rot.normalize(rot.multiply(self._nav[6:10], rot.from_rotation_vector(rotation_vector)))
+
+    def _frame(self):
+        if self.star_sensor is None:
+            raise ValueError("this navigation filter has no star sensor")
+        return self.star_sensor.orientation.index(self.t)
+
+    def _observer_velocity(self, j):
+        o = self.star_sensor.orientation
+        return observer_velocity(o.c_ie[j], o.v_earth[j], self._nav[0], self._nav[1], self._nav[2], self._nav[3:6])
+
+    def _corrected_fix(self, q_IS, j):
+        if not self.star_sensor.correct_aberration:
+            return q_IS
+        boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
+        return rot.normalize(rot.multiply(fix_rotation(boresight, self._observer_velocity(j)), q_IS))
 
     def process_record(self, samples, ratio, dt, record):
         """The compiled fast path: the whole :class:`~navsim.sensors.aiding.AidingRecord` at once
@@ -114,18 +245,32 @@ class NavFilter:
         :mod:`navsim.closed_loop` would have written. ``samples`` (F*ratio, 6) IMU samples."""
         if dt != self.dt:
             raise ValueError(f"IMU interval {dt} s, the filter was built for {self.dt} s")
-        out = nav_kernels.run_record(self._nav, self._imu, self._P, self._acc, np.ascontiguousarray(samples, dtype=float),
-                                     int(ratio), self.dt, self.q_c, self.covariance_interval,
-                                     np.ascontiguousarray(record.position), record.position_sigma * self.sigma_scale,
-                                     np.ascontiguousarray(record.baro), record.baro_sigma * self.sigma_scale, self.gates)
-        nav_log, imu_log, P_log = out[0], out[1], out[2]
+        out = nav_kernels.run_record(self._nav, self._calib, self._P, self._acc, np.ascontiguousarray(samples, dtype=float),
+                                     int(ratio), self.model, np.ascontiguousarray(record.position),
+                                     record.position_sigma * self.sigma_scale, np.ascontiguousarray(record.baro),
+                                     record.baro_sigma * self.sigma_scale, self.gates, self.estimated)
+        self._intervals += samples.shape[0]
+        nav_log, calib_log, P_log = out[0], out[1], out[2]
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[3:]))
-        return {**_snapshot_arrays(nav_log, imu_log, self.n), "P": P_log, **log}
+        return {**self._snapshot_arrays(nav_log, calib_log), "P": P_log, **log}
 
     def snapshot(self):
-        """What a run log keeps of the filter at an epoch: position, velocity, attitude, IMU error
-        estimates and P (copies)."""
-        return {**_snapshot_arrays(self._nav[0:10], self._imu, self.n), "P": self.P}
+        """What a run log keeps of the filter at an epoch: position, velocity, attitude, the estimates
+        beside them and P (copies)."""
+        return {**self._snapshot_arrays(self._nav[0:10], self._calib), "P": self.P}
+
+    def _snapshot_arrays(self, nav, calib):
+        """The snapshot's named parts (copies) of nav[0:10] and the estimates ``calib``, one row or (F, ·)
+        rows: lat, lon, h, v_n, q_nb, gyro_bias, accel_bias and, with scale-factor states,
+        gyro_scale_factor and accel_scale_factor, with a star sensor q_bs."""
+        out = {"lat": nav[..., 0].copy(), "lon": nav[..., 1].copy(), "h": nav[..., 2].copy(),
+               "v_n": nav[..., 3:6].copy(), "q_nb": nav[..., 6:10].copy(), "gyro_bias": calib[..., 0:3].copy(),
+               "accel_bias": calib[..., 3:6].copy()}
+        if self.layout.scale >= 0:
+            out["gyro_scale_factor"], out["accel_scale_factor"] = calib[..., 6:9].copy(), calib[..., 9:12].copy()
+        if self.star_sensor is not None:
+            out["q_bs"] = calib[..., 12:16].copy()
+        return out
 
     @property
     def P(self):
@@ -147,27 +292,21 @@ class NavFilter:
 
     @property
     def gyro_bias(self):
-        return self._imu[0:3].copy()
+        return self._calib[0:3].copy()
 
     @property
     def accel_bias(self):
-        return self._imu[3:6].copy()
+        return self._calib[3:6].copy()
 
     @property
     def scale_factors(self):
         """(ŝ_g, ŝ_a) estimates [-] (zero unless estimated)."""
-        return self._imu[6:9].copy(), self._imu[9:12].copy()
+        return self._calib[6:9].copy(), self._calib[9:12].copy()
 
-
-def _snapshot_arrays(nav, imu, n):
-    """The snapshot's named parts (copies) of nav[0:10] and the IMU estimates, one row or (F, ·) rows:
-    lat, lon, h, v_n, q_nb, gyro_bias, accel_bias and, with scale-factor states, gyro_scale_factor
-    and accel_scale_factor."""
-    out = {"lat": nav[..., 0].copy(), "lon": nav[..., 1].copy(), "h": nav[..., 2].copy(), "v_n": nav[..., 3:6].copy(),
-           "q_nb": nav[..., 6:10].copy(), "gyro_bias": imu[..., 0:3].copy(), "accel_bias": imu[..., 3:6].copy()}
-    if n > BASE_STATES:
-        out["gyro_scale_factor"], out["accel_scale_factor"] = imu[..., 6:9].copy(), imu[..., 9:12].copy()
-    return out
+    @property
+    def q_BS(self):
+        """The star-sensor mounting estimate q̂_BS (identity without a star sensor)."""
+        return self._calib[12:16].copy()
 
 
 def error_state(lat, lon, h, v_n, q_nb, gyro_bias, accel_bias, truth_lat, truth_lon, truth_h, truth_v_n,
@@ -178,3 +317,9 @@ def error_state(lat, lon, h, v_n, q_nb, gyro_bias, accel_bias, truth_lat, truth_
     dp = np.stack([np.asarray(lat) - truth_lat, np.asarray(lon) - truth_lon, np.asarray(h) - truth_h], axis=-1)
     return np.concatenate([phi, np.asarray(v_n) - truth_v_n, dp, np.asarray(truth_gyro_bias) - gyro_bias,
                            np.asarray(truth_accel_bias) - accel_bias], axis=-1)
+
+
+def mounting_error(q_bs, truth_q_bs):
+    """μ (..., 3) [rad] of the mounting estimate: q_BS,true = q̂_BS ⊗ δq(μ) (sensor axes)."""
+    return rot.to_rotation_vector(rot.multiply(rot.conjugate(q_bs), truth_q_bs))
+

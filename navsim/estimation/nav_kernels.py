@@ -1,14 +1,25 @@
 """Compiled kernels of the navigation error-state filter (numba): the continuous error dynamics F,
-their discretisation (Φ, Q_d), propagation over IMU increments, the measurement updates and the reset.
+their discretisation (Φ, Q_d), propagation over IMU increments, the position and baro updates and
+the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kernels`).
 
-Error state x (zero between updates; docs/design.md):
+Error state x (zero between updates; docs/design.md), each optional group where :class:`Layout`
+puts it:
 
-    [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) if scale factors]
+    [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) | μ (3) | δg (3)]
 
 with C_nb,est = (I − [φ×]) C_nb,true, δv = v_est − v_true, δL = L_est − L_true (…), ε = b_g,true −
-b̂_g and ∇ = b_a,true − b̂_a (the residual biases of the corrected increments), δs = s_true − ŝ.
+b̂_g and ∇ = b_a,true − b̂_a (the residual biases of the corrected increments), δs = s_true − ŝ, the
+star-sensor mounting error μ (q_BS,true = q̂_BS ⊗ δq(μ), μ in sensor axes) and the gravity
+disturbance of the truth δg = [−ξγ, −ηγ, Δg] (NED) that the INS does not know: a first-order
+Gauss-Markov process in travelled distance (σ, correlation length D: in time, 1/τ = V/D with V the
+horizontal speed; a random constant when D is infinite), kept as consider states (Schmidt).
 Corrected increments are (1 − ŝ)(Δθ̃ − b̂_g Δt) and (1 − ŝ_a)(Δṽ − b̂_a Δt).
+
+The filter's estimates beside the strapdown ``nav`` vector are ``calib`` (:data:`CALIB_SIZE`):
+[b̂_g (3), b̂_a (3), ŝ_g (3), ŝ_a (3), q̂_BS (4)].
 """
+
+from collections import namedtuple
 
 import numpy as np
 
@@ -22,6 +33,25 @@ from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, qua
 
 #: First index of the position error (δL, δλ, δh) in the error state.
 DP = 6
+#: The 15 states every navigation filter carries (attitude, velocity, position, the two biases).
+BASE_STATES = 15
+#: Size of the ``calib`` vector: biases, scale factors, mounting quaternion q̂_BS.
+CALIB_SIZE = 16
+#: Where each optional group of the error state starts (−1: absent), and the state count n.
+Layout = namedtuple("Layout", "n scale mounting gravity")
+#: What the kernels need of the filter's model: the constant continuous noise densities ``q_c`` (n,),
+#: the gravity disturbance's ``gm`` = (σ_N², σ_E², σ_D² [m²/s⁴], 1/D [1/m]), the IMU interval ``dt``
+#: [s], the covariance interval ``every`` [IMU intervals] and the :class:`Layout`.
+NavModel = namedtuple("NavModel", "q_c gm dt every layout")
+
+
+def layout(scale_factors=False, mounting=False, gravity=False):
+    """The :class:`Layout` of an error state with the chosen optional groups, in their fixed order."""
+    n, starts = BASE_STATES, []
+    for present, size in ((scale_factors, 6), (mounting, 3), (gravity, 3)):
+        starts.append(n if present else -1)
+        n += size if present else 0
+    return Layout(n, *starts)
 #: The states a baro height updates: the vertical channel δv_D, δh and the body-z accelerometer bias
 #: (down in level flight); for its update every other state is a consider state (Schmidt), so a baro
 #: damps the vertical channel and tells the filter nothing of the horizontal ones. (Estimating them
@@ -34,16 +64,18 @@ ACC_SIZE = 31
 
 
 @njit
-def continuous_f(lat, h, v, f_n, C, C_w, C_f, n):
+def continuous_f(lat, h, v, f_n, C, C_w, C_f, layout, inv_length):
     """Continuous error dynamics F (n x n) at (L, h, v_n) [rad, m, m/s] for the specific force f_n
     [m/s²] in n, the mean C_nb ``C``, and (for the scale-factor columns) C_nb diag(ω_b) ``C_w``
-    [rad/s] and C_nb diag(f_b) ``C_f`` [m/s²] (Titterton & Weston, 2nd ed., ch. 12; Groves,
-    2nd ed., §14.2.4, with this φ sign):
+    [rad/s] and C_nb diag(f_b) ``C_f`` [m/s²], the states of ``layout`` and the gravity
+    disturbance's 1/D [1/m] (Titterton & Weston, 2nd ed., ch. 12; Groves, 2nd ed., §14.2.4, with
+    this φ sign):
 
     φ̇ = −ω_in × φ + δω_in − C_nb (ε + diag(ω_b) δs_g),
-    δv̇ = f^n × φ + C_nb (∇ + diag(f_b) δs_a) − (2ω_ie + ω_en) × δv − (2δω_ie + δω_en) × v + δg,
+    δv̇ = f^n × φ + C_nb (∇ + diag(f_b) δs_a) − (2ω_ie + ω_en) × δv − (2δω_ie + δω_en) × v + δγ − δg,
     δL̇ = δv_N/(R_M+h) − v_N δh/(R_M+h)², δλ̇ = δv_E/((R_N+h) cos L) + v_E tan L δL/((R_N+h) cos L)
-    − v_E δh/((R_N+h)² cos L), δḣ = −δv_D; δg = [0, 0, ∂γ/∂L δL + ∂γ/∂h δh]; and the terms of
+    − v_E δh/((R_N+h)² cos L), δḣ = −δv_D; δγ = [0, 0, ∂γ/∂L δL + ∂γ/∂h δh]; the mounting constant;
+    the disturbance δ̇g = −(V/D) δg (the truth's gravity, so −δg in δv̇: the INS lacks it); and the terms of
     dR_M/dL = 3 R_M e² sin L cos L/(1 − e² sin²L), dR_N/dL = R_N e² sin L cos L/(1 − e² sin²L)
     in every δL column (usually neglected; kept so that F is the exact Jacobian).
     """
@@ -64,7 +96,7 @@ def continuous_f(lat, h, v, f_n, C, C_w, C_f, n):
     d_en_p[2, 0] = -v[1] / (rn * c * c) + v[1] * t * dr_n / rn**2
     d_en_p[0, 2], d_en_p[1, 2], d_en_p[2, 2] = -v[1] / rn**2, v[0] / rm**2, v[1] * t / rn**2
     V = skew(v)
-    F = np.zeros((n, n))
+    F = np.zeros((layout.n, layout.n))
     F[0:3, 0:3] = -skew(w_ie + w_en)
     F[0:3, 3:6] = d_en_v
     F[0:3, 6:9] = d_ie_p + d_en_p
@@ -79,9 +111,14 @@ def continuous_f(lat, h, v, f_n, C, C_w, C_f, n):
     F[7, 4], F[7, 8] = 1.0 / (rn * c), -v[1] / (rn * rn * c)
     F[7, 6] = v[1] * s / (rn * c * c) - v[1] * dr_n / (rn * rn * c)
     F[8, 5] = -1.0
-    if n > 15:
-        F[0:3, 15:18] = -C_w
-        F[3:6, 18:21] = C_f
+    if layout.scale >= 0:
+        F[0:3, layout.scale:layout.scale + 3] = -C_w
+        F[3:6, layout.scale + 3:layout.scale + 6] = C_f
+    if layout.gravity >= 0:
+        decay = np.hypot(v[0], v[1]) * inv_length
+        for i in range(3):
+            F[3 + i, layout.gravity + i] = -1.0
+            F[layout.gravity + i, layout.gravity + i] = -decay
     return F
 
 
@@ -127,16 +164,16 @@ def discretize(F, q_c, dt):
 
 
 @njit
-def correct(sample, imu, dt, n, a, b):
+def correct(sample, calib, dt, scale, a, b):
     """Write into ``a``, ``b`` the increments of one IMU ``sample`` (6,) (interval means: rate [rad/s],
-    specific force [m/s²]) corrected by the estimates ``imu`` = [b̂_g, b̂_a, ŝ_g, ŝ_a]:
-    (1 − ŝ_g)(ω̃ − b̂_g) Δt and (1 − ŝ_a)(f̃ − b̂_a) Δt."""
+    specific force [m/s²]) corrected by the estimates ``calib`` = [b̂_g, b̂_a, ŝ_g, ŝ_a, …]:
+    (1 − ŝ_g)(ω̃ − b̂_g) Δt and (1 − ŝ_a)(f̃ − b̂_a) Δt (the scale factors when ``scale``)."""
     for i in range(3):
-        a[i] = (sample[i] - imu[i]) * dt
-        b[i] = (sample[3 + i] - imu[3 + i]) * dt
-        if n > 15:
-            a[i] *= 1.0 - imu[6 + i]
-            b[i] *= 1.0 - imu[9 + i]
+        a[i] = (sample[i] - calib[i]) * dt
+        b[i] = (sample[3 + i] - calib[3 + i]) * dt
+        if scale:
+            a[i] *= 1.0 - calib[6 + i]
+            b[i] *= 1.0 - calib[9 + i]
 
 
 @njit
@@ -154,58 +191,75 @@ def accumulate(acc, q_nb, dtheta, dv):
 
 
 @njit
-def flush(nav, P, acc, q_c, dt):
+def noise_densities(nav, model):
+    """The continuous noise densities (n,) at the current speed: ``model.q_c`` with, for the gravity
+    disturbance, the Gauss-Markov drive 2σ²/τ = 2σ² V/D (zero at rest and for a constant field)."""
+    q = model.q_c.copy()
+    g = model.layout.gravity
+    if g >= 0:
+        rate = np.hypot(nav[3], nav[4]) * model.gm[3]
+        for i in range(3):
+            q[g + i] = 2.0 * model.gm[i] * rate
+    return q
+
+
+@njit
+def flush(nav, P, acc, model):
     """Propagate P over the accumulated intervals (P ← Φ P Φᵀ + Q_d, F at the current position and
     velocity with the interval means of f^n and C_nb) and empty the accumulator."""
     count = acc[0]
     if count == 0.0:
         return
-    span = count * dt
-    n = P.shape[0]
+    span = count * model.dt
     C = acc[4:13].reshape(3, 3) / count
     C_w = acc[13:22].reshape(3, 3) / span
     C_f = acc[22:31].reshape(3, 3) / span
-    F = continuous_f(nav[0], nav[2], nav[3:6], acc[1:4] / span, C, C_w, C_f, n)
-    Phi, Q = discretize(F, q_c, span)
+    F = continuous_f(nav[0], nav[2], nav[3:6], acc[1:4] / span, C, C_w, C_f, model.layout, model.gm[3])
+    Phi, Q = discretize(F, noise_densities(nav, model), span)
     P_next = mm(Phi, mm(Phi, P).T.copy()) + Q  # Φ (Φ P)ᵀ = Φ P Φᵀ with sparse left factors
     P[:, :] = 0.5 * (P_next + P_next.T)
     acc[:] = 0.0
 
 
 @njit
-def predict(nav, imu, P, acc, samples, dt, q_c, every):
-    """Mechanize the corrected IMU samples (M, 6) and propagate P every ``every`` intervals
+def predict(nav, calib, P, acc, samples, model):
+    """Mechanize the corrected IMU samples (M, 6) and propagate P every ``model.every`` intervals
     (the remainder stays in ``acc`` until the next call or update). All arrays change in place."""
-    n = P.shape[0]
     a, b = np.empty(3), np.empty(3)
+    scale = model.layout.scale >= 0
     for k in range(samples.shape[0]):
-        correct(samples[k], imu, dt, n, a, b)
+        correct(samples[k], calib, model.dt, scale, a, b)
         accumulate(acc, nav[6:10], a, b)
-        step(nav, a, b, dt)
-        if acc[0] >= every:
-            flush(nav, P, acc, q_c, dt)
+        step(nav, a, b, model.dt)
+        if acc[0] >= model.every:
+            flush(nav, P, acc, model)
 
 
 @njit
-def reset(nav, imu, dx, n):
+def reset(nav, calib, dx, layout):
     """Fold the error estimate dx into the nominal state (in place): C_nb ← exp([φ×]) C_nb,
-    v ← v − δv, (L, λ, h) ← − (δL, δλ, δh), b̂ ← b̂ + (ε, ∇), ŝ ← ŝ + δs."""
+    v ← v − δv, (L, λ, h) ← − (δL, δλ, δh), b̂ ← b̂ + (ε, ∇), ŝ ← ŝ + δs, q̂_BS ← q̂_BS ⊗ δq(μ)
+    (the gravity disturbance is a consider state: never estimated)."""
     q = quat_multiply(quat_from_rotation_vector(dx[0:3]), nav[6:10])
     nav[6:10] = q / np.sqrt(np.sum(q * q))
     nav[3:6] -= dx[3:6]
     nav[0:3] -= dx[6:9]
-    imu[0:6] += dx[9:15]
-    if n > 15:
-        imu[6:12] += dx[15:21]
+    calib[0:6] += dx[9:15]
+    if layout.scale >= 0:
+        calib[6:12] += dx[layout.scale:layout.scale + 6]
+    if layout.mounting >= 0:
+        m = layout.mounting
+        q = quat_multiply(calib[12:16], quat_from_rotation_vector(dx[m:m + 3]))
+        calib[12:16] = q / np.sqrt(np.sum(q * q))
 
 
 @njit
-def position_update(nav, imu, P, acc, q_c, dt, fix, sigma, gate):
+def position_update(nav, calib, P, acc, model, fix, sigma, gate, estimated):
     """Flush the covariance, then the gated update with a position fix ``fix`` = (L, λ, h) [rad, rad, m]
     of NED σ ``sigma`` (3,) [m]: z = (L̂, λ̂, ĥ) − fix, H = [0 0 I 0 …],
-    R = diag(σ_N²/(R_M+h)², σ_E²/((R_N+h) cos L)², σ_D²). Returns (z in NED metres (3,), nis,
-    accepted); the state, P and the nominal state change in place."""
-    flush(nav, P, acc, q_c, dt)
+    R = diag(σ_N²/(R_M+h)², σ_E²/((R_N+h) cos L)², σ_D²), the ``estimated`` states corrected.
+    Returns (z in NED metres (3,), nis, accepted); the state, P and the nominal state change in place."""
+    flush(nav, P, acc, model)
     n = P.shape[0]
     r_m, r_n = radii(nav[0])
     scale = np.array([r_m + nav[2], (r_n + nav[2]) * np.cos(nav[0]), -1.0])
@@ -217,15 +271,15 @@ def position_update(nav, imu, P, acc, q_c, dt, fix, sigma, gate):
         R[i, i] = (sigma[i] / scale[i]) ** 2
         z[i] = nav[i] - fix[i]
     z_m = z * scale
-    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, np.ones(n, dtype=np.bool_))  # every state estimated
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return z_m, nis, accepted
 
 
 @njit
-def baro_update(nav, imu, P, acc, q_c, dt, height, sigma, gate):
+def baro_update(nav, calib, P, acc, model, height, sigma, gate):
     """Flush the covariance, then the gated update of the vertical channel (:data:`BARO_STATES`) with
     a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""
-    flush(nav, P, acc, q_c, dt)
+    flush(nav, P, acc, model)
     n = P.shape[0]
     H = np.zeros((1, n))
     H[0, DP + 2] = 1.0
@@ -234,12 +288,15 @@ def baro_update(nav, imu, P, acc, q_c, dt, height, sigma, gate):
     estimated = np.zeros(n, dtype=np.bool_)
     for i in BARO_STATES:
         estimated[i] = True
-    nis, accepted = _gated_update(nav, imu, P, H, R, z, gate, estimated)
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return z, nis, accepted
 
 
 @njit
-def _gated_update(nav, imu, P, H, R, z, gate, estimated):
+def gated_update(nav, calib, P, H, R, z, gate, estimated, layout):
+    """The update with one measurement vector z = H x + v (v ~ N(0, R)), gated as a whole by its NIS
+    zᵀ S⁻¹ z against ``gate``: Joseph form with the ``estimated`` states corrected, then the reset.
+    Returns (nis, accepted)."""
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
     nis = 0.0
@@ -250,38 +307,38 @@ def _gated_update(nav, imu, P, H, R, z, gate, estimated):
         return nis, False
     dx, P_next = joseph_update(P, H, R, z, estimated)
     P[:, :] = P_next
-    reset(nav, imu, dx, P.shape[0])
+    reset(nav, calib, dx, layout)
     return nis, True
 
 
 @njit
-def run_record(nav, imu, P, acc, samples, ratio, dt, q_c, every, position, position_sigma, baro, baro_sigma, gates):
+def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sigma, baro, baro_sigma, gates, estimated):
     """The whole-record loop of the fast path: for each frame f, ``ratio`` IMU samples of ``samples``
     (F*ratio, 6) propagate the filter (:func:`predict`), then the frame's position fix (a row of
     ``position`` (F, 3), NaN: none) and baro height (``baro`` (F,), NaN: none) update it in that
     order, with ``gates`` = (3-dof, 1-dof) NIS gates. Returns the per-frame logs of the step-by-step
-    loop: nav[0:10] (F, 10), the IMU estimates (F, 12), P (F, n, n) and the frame's update
+    loop: nav[0:10] (F, 10), the estimates ``calib`` (F, 16), P (F, n, n) and the frame's update
     statistics (measurements, accepted, NIS sum, dof, innovation RMS [m])."""
     frames = position.shape[0]
     n = P.shape[0]
-    nav_log, imu_log, P_log = np.empty((frames, 10)), np.empty((frames, 12)), np.empty((frames, n, n))
+    nav_log, calib_log, P_log = np.empty((frames, 10)), np.empty((frames, CALIB_SIZE)), np.empty((frames, n, n))
     n_meas, n_acc, dof_log = np.zeros(frames, np.int32), np.zeros(frames, np.int32), np.zeros(frames, np.int32)
     nis_log, rms_log = np.full(frames, np.nan), np.full(frames, np.nan)
     for f in range(frames):
-        predict(nav, imu, P, acc, samples[f * ratio:(f + 1) * ratio], dt, q_c, every)
+        predict(nav, calib, P, acc, samples[f * ratio:(f + 1) * ratio], model)
         count, accepted, nis_sum, dof, squares = 0, 0, 0.0, 0, 0.0
         if not np.isnan(position[f, 0]):
-            z, nis, ok = position_update(nav, imu, P, acc, q_c, dt, position[f], position_sigma, gates[0])
+            z, nis, ok = position_update(nav, calib, P, acc, model, position[f], position_sigma, gates[0], estimated)
             count += 1
             if ok:
                 accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 3, squares + np.sum(z * z)
         if not np.isnan(baro[f]):
-            z, nis, ok = baro_update(nav, imu, P, acc, q_c, dt, baro[f], baro_sigma, gates[1])
+            z, nis, ok = baro_update(nav, calib, P, acc, model, baro[f], baro_sigma, gates[1])
             count += 1
             if ok:
                 accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 1, squares + z[0] * z[0]
-        nav_log[f], imu_log[f], P_log[f] = nav[0:10], imu, P
+        nav_log[f], calib_log[f], P_log[f] = nav[0:10], calib, P
         n_meas[f], n_acc[f], dof_log[f] = count, accepted, dof
         if accepted:
             nis_log[f], rms_log[f] = nis_sum, np.sqrt(squares / dof)
-    return nav_log, imu_log, P_log, n_meas, n_acc, nis_log, dof_log, rms_log
+    return nav_log, calib_log, P_log, n_meas, n_acc, nis_log, dof_log, rms_log

@@ -2,7 +2,7 @@
 
 A measurement is either one vector gated as a whole (an attitude fix, a position fix, a baro height)
 or, for identified stars, one 2-dof residual per star, each gated alone (``per_row``). A frame
-whose measurements are of several kinds (a position fix and a baro height) is logged with the
+whose measurements are of several kinds (stars, a position fix and a baro height) is logged with the
 statistics of all its updates together (:class:`FrameUpdate`).
 """
 
@@ -15,16 +15,17 @@ from navsim.estimation import kernels
 
 @dataclass(frozen=True)
 class UpdateResult:
-    """Outcome of one measurement update: innovations z (estimate − measurement, one row per
-    measurement), NIS per measurement against the prior, the accepted mask, whether each row is a
-    measurement of its own (stars) rather than the rows of one vector, and whether the state was
-    re-initialised from the sensor's own fix before it (a lost track)."""
+    """Outcome of one measurement update: innovations z (one row per measurement), NIS per
+    measurement against the prior, the accepted mask, whether each row is a measurement of its own
+    (stars) rather than the rows of one vector, whether the state was re-initialised from the
+    sensor's own fix before it (a lost track), and the unit of z ("rad" or "m")."""
 
     z: np.ndarray
     nis: np.ndarray
     accepted: np.ndarray
     per_row: bool = False
     reinitialised: bool = False
+    unit: str = "rad"
 
     @property
     def n_accepted(self):
@@ -46,8 +47,9 @@ class UpdateResult:
 
 @dataclass(frozen=True)
 class FrameUpdate:
-    """The updates of one frame with measurements of several kinds (each a vector gated as a whole),
-    logged together: accepted count, NIS and dof summed, the RMS over every accepted innovation."""
+    """The updates of one frame with measurements of several kinds, logged together: accepted count,
+    NIS and dof summed, the RMS over the accepted innovations of the unit of the first update with any
+    (a star sensor's [rad] before a baro's [m]; a position fix's and a baro's together [m])."""
 
     updates: tuple
 
@@ -65,12 +67,15 @@ class FrameUpdate:
 
     def statistics(self):
         """(accepted, NIS sum of the accepted, its dof, RMS of their innovations), NaN when none was accepted."""
-        accepted = [u for u in self.updates if u.accepted[0]]
-        if not accepted:
+        parts = [(u, u.statistics()) for u in self.updates]
+        parts = [(u, stats) for u, stats in parts if stats[0]]
+        if not parts:
             return 0, np.nan, 0, np.nan
-        nis, dof, squares = 0.0, 0, 0.0
-        for u in accepted:
-            nis += float(u.nis[0])
-            dof += u.z.shape[1]
-            squares += float(np.sum(u.z * u.z))
-        return len(accepted), nis, dof, float(np.sqrt(squares / dof))
+        unit = parts[0][0].unit
+        count, nis, dof, squares, dof_unit = 0, 0.0, 0, 0.0, 0
+        for u, (accepted, nis_u, dof_u, _) in parts:
+            count, nis, dof = count + accepted, nis + nis_u, dof + dof_u
+            if u.unit == unit:
+                squares += float(np.sum(u.z[u.accepted] * u.z[u.accepted]))
+                dof_unit += dof_u
+        return count, nis, dof, float(np.sqrt(squares / dof_unit))

@@ -6,7 +6,8 @@ import numpy as np
 
 from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.wgs84 import OMEGA_IE, radii
-from navsim.estimation.nav_filter import BASE_STATES, ImuNoise, NavFilter
+from navsim.estimation.nav_filter import ImuNoise, NavFilter
+from navsim.estimation.nav_kernels import BASE_STATES
 from navsim.scenario.build import accelerometer_model, gyro_model
 from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel

@@ -126,11 +126,13 @@ class RigidBody:
 
 @dataclass(frozen=True)
 class FrameTruth:
-    """The truth at one star-sensor frame: attitude q_IB (4,) and the mean body rate over the last
-    gyro interval omega_B (3,) [rad/s]."""
+    """The truth at one star-sensor frame: attitude q_IB (4,), the mean body rate over the last
+    gyro interval omega_B (3,) [rad/s] and, for a sensor on a vehicle near the Earth, the observer's
+    barycentric velocity v_I (3,) [m/s] that aberrates the stars (None: no aberration)."""
 
     q_IB: np.ndarray
     omega_B: np.ndarray
+    v_I: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

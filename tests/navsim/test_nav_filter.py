@@ -59,7 +59,7 @@ def test_f_is_the_linearisation_of_the_navigation_equations(n):
     """Each column of F equals the central difference of the nonlinear error rate (all signs of
     φ, Coriolis, transport rate, gravity gradient, bias and scale-factor columns)."""
     C = rot.to_matrix(Q_NB)
-    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, n)
+    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, nav_kernels.layout(n > 15), 0.0)
     scale = np.array([1e-6] * 3 + [1e-3] * 3 + [1e-7, 1e-7, 1e-2] + [1e-7] * 3 + [1e-5] * 3 + [1e-5] * (n - 15))
     numeric = np.empty((n, n))
     for j in range(n):
@@ -72,7 +72,7 @@ def test_f_is_the_linearisation_of_the_navigation_equations(n):
 
 def _f_and_q(n=21):
     C = rot.to_matrix(Q_NB)
-    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, n)
+    F = nav_kernels.continuous_f(LAT, H, V, C @ F_B, C, C * OMEGA_B, C * F_B, nav_kernels.layout(n > 15), 0.0)
     q_c = np.array([1e-9] * 3 + [1e-6] * 3 + [0.0] * 3 + [1e-14] * 3 + [1e-10] * 3 + [1e-12] * (n - 15))
     return F, q_c
 

@@ -1,0 +1,64 @@
+"""The Earth's orientation and the observer's velocity at the frames of a run.
+
+C_ie (ICRS axes from ITRS axes) is :func:`navsim.earth.frames.c_ei` (pyerfa's ``c2t06a``) and the
+barycentric velocity of the geocentre comes from the ephemeris of :mod:`startrack.aberration`
+(``erfa.epv00``); both depend on time only, so a scenario computes them once for its frame times
+(:class:`EarthOrientation`), for the truth and the filter alike. The observer's velocity relative
+to the solar-system barycentre, which sets the aberration of the stars it sees, is (ICRS axes)
+
+    v_I = v_⊕ + C_ie (ω_ie × r_e + C_en v_n)
+
+(the Earth's orbital velocity, the Earth's rotation at the observer and the vehicle's ground
+velocity; Groves, 2nd ed., eq. 2.145 for the rotating-frame term).
+"""
+
+from dataclasses import dataclass
+
+import erfa
+import numpy as np
+
+from navsim.earth.frames import c_ei, c_en, utc_epoch
+from navsim.earth.wgs84 import OMEGA_IE, geodetic_to_ecef
+from startrack import rotation as rot
+from startrack.aberration import earth_barycentric_velocity
+
+#: Tolerance [s] of :meth:`EarthOrientation.index` (frame times are multiples of the IMU interval).
+TIME_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class EarthOrientation:
+    """At the frame times ``t`` (F,) [s after the epoch]: ``q_ie`` (F, 4) and ``c_ie`` (F, 3, 3) (ICRS
+    from ITRS) and the geocentre's barycentric velocity ``v_earth`` (F, 3) [m/s] in ICRS axes."""
+
+    t: np.ndarray
+    q_ie: np.ndarray
+    c_ie: np.ndarray
+    v_earth: np.ndarray
+
+    @classmethod
+    def compute(cls, epoch_utc, t):
+        """The orientation at times ``t`` (F,) [s] after the UTC epoch ``epoch_utc`` (TDB taken as TT
+        for the ephemeris: they differ by < 2 ms)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        c_ie = np.swapaxes(c_ei(epoch_utc, t), -1, -2)
+        utc1, utc2 = utc_epoch(epoch_utc)
+        tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2 + t / 86400.0))
+        return cls(t=t, q_ie=rot.from_matrix(c_ie), c_ie=c_ie, v_earth=earth_barycentric_velocity(tt1, tt2))
+
+    def index(self, t):
+        """The frame index of time ``t`` [s]; a time that is not a frame time raises ValueError."""
+        j = int(np.searchsorted(self.t, t - TIME_TOLERANCE))
+        if j >= self.t.size or abs(self.t[j] - t) > TIME_TOLERANCE:
+            raise ValueError(f"t = {t} s is not a frame time of this Earth orientation")
+        return j
+
+
+def observer_velocity(c_ie, v_earth, lat, lon, h, v_n):
+    """v_I (..., 3) [m/s]: the observer's velocity relative to the barycentre in ICRS axes at
+    (L, λ, h) [rad, rad, m] with NED ground velocity v_n (..., 3), for C_ie (..., 3, 3) and the
+    geocentre's v_earth (..., 3) (module docstring)."""
+    x, y, _ = geodetic_to_ecef(lat, lon, h)
+    rotation = OMEGA_IE * np.stack([-np.asarray(y), np.asarray(x), np.zeros_like(x)], axis=-1)
+    v_e = np.einsum("...ij,...j->...i", c_en(lat, lon), v_n)
+    return v_earth + np.einsum("...ij,...j->...i", c_ie, rotation + v_e)

@@ -1,0 +1,105 @@
+"""Compiled star-sensor updates of the navigation filter (numba): the inertial attitude the INS
+implies, its error in terms of the navigation error state, and the gated updates with an attitude
+fix or with identified star vectors one by one.
+
+The INS's inertial attitude is C_ib = C_ie C_en(L̂, λ̂) C_nb (docs/design.md, frames i, e, n, b).
+With C_nb,est = (I − [φ×]) C_nb,true and the estimated navigation frame turned from the true one by
+
+    δθ_n = [δλ cos L, −δL, −δλ sin L]      (C_en(p̂) = C_en(p) (I + [δθ_n×]), from Ċ_en = C_en [ω_en^n×],
+                                           ω_en^n = [λ̇ cos L, −L̇, −λ̇ sin L]),
+
+the estimate is C_ib,est = C_ib,true (I − [δθ_b×]) to first order, with the body-axes error
+
+    δθ_b = C_bn (φ − δθ_n) = C_bn ψ,                                                           (1)
+
+ψ = φ − δθ_n the psi angle (Titterton & Weston, 2nd ed., §12.2.1: ψ̇ = −ω_in × ψ − C_nb ε, free of
+the velocity and position errors). Eq. (1) is the attitude-difference measurement of SINS/CNS: it
+couples the tilt φ with δL, δλ (the "mathematical horizon"; PSINS ``test_SINS_CNS_def``'s H of
+kfhk 184 in ENU; Yang et al. 2022), so the star sensor measures ψ, the accelerometers hold φ to
+the local vertical through the Schuler loop, and their difference is the position. Its attitude
+filter form — q_IB,true = q_IB ⊗ δq(δθ_b) — lets the star residuals and fix residuals of
+:mod:`navsim.estimation.kernels` serve the INS: their H for (δθ_b, δm) is chained through
+A = ∂δθ_b/∂x = C_bn [I₃ (φ), −∂δθ_n/∂(δL, δλ)].
+"""
+
+import numpy as np
+
+from navsim.earth.frames import q_en
+from navsim.estimation.kernels import fix_residual, gate_stars, joseph_update, mm, star_residuals
+from navsim.estimation.nav_kernels import DP, flush, gated_update, reset
+from startrack.jit import njit
+from startrack.rotation_jit import quat_multiply, quat_to_matrix
+
+
+@njit
+def inertial_attitude(nav, q_ie):
+    """q_IB of the INS, q_ie ⊗ q_en(L̂, λ̂) ⊗ q_nb (C_ib = C_ie C_en C_nb), for the navigation state
+    ``nav`` and the Earth's orientation q_ie (4,) at the time of the update."""
+    return quat_multiply(quat_multiply(q_ie, np.array(q_en(nav[0], nav[1]))), nav[6:10])
+
+
+@njit
+def attitude_jacobian(nav, n):
+    """A (3, n) with δθ_b = A x (eq. 1 of the module): C_bn in the φ columns and −C_bn ∂δθ_n/∂(δL, δλ)
+    = −C_bn [[0, cos L], [−1, 0], [0, −sin L]] in the δL, δλ columns."""
+    C_bn = quat_to_matrix(nav[6:10]).T
+    A = np.zeros((3, n))
+    c, s = np.cos(nav[0]), np.sin(nav[0])
+    for i in range(3):
+        for j in range(3):
+            A[i, j] = C_bn[i, j]
+        A[i, DP] = C_bn[i, 1]
+        A[i, DP + 1] = -(C_bn[i, 0] * c - C_bn[i, 2] * s)
+    return A
+
+
+@njit
+def _chain(H_att, A, mounting, out):
+    """out (r, n) = H_att[:, 0:3] A, plus H_att's mounting columns (its last three) at ``mounting``."""
+    k = H_att.shape[1]
+    out[:, :] = mm(H_att[:, 0:3].copy(), A)
+    if mounting >= 0:
+        for r in range(H_att.shape[0]):
+            for j in range(3):
+                out[r, mounting + j] += H_att[r, k - 3 + j]
+
+
+@njit
+def fix_update(nav, calib, P, acc, model, q_ie, q_IS, R_S, gate, estimated):
+    """Flush the covariance, then the gated update with a star-sensor attitude fix q_IS (covariance
+    R_S in sensor axes): z = δθ(q_IB, q_IS ⊗ q̂_BS⁻¹) in body axes (:func:`kernels.fix_residual`),
+    H = A (+ R_BS in the mounting columns), R = R_BS R_S R_BSᵀ. Returns (z (3,) [rad], nis, accepted)."""
+    flush(nav, P, acc, model)
+    layout = model.layout
+    z, R_BS, R = fix_residual(inertial_attitude(nav, q_ie), calib[12:16], q_IS, R_S)
+    H_att = np.zeros((3, 6))
+    for i in range(3):
+        H_att[i, i] = 1.0
+        for j in range(3):
+            H_att[i, 3 + j] = R_BS[i, j]
+    H = np.empty((3, layout.n))
+    _chain(H_att, attitude_jacobian(nav, layout.n), layout.mounting, H)
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, layout)
+    return z, nis, accepted
+
+
+@njit
+def stars_update(nav, calib, P, acc, model, q_ie, ref_I, obs_S, variance, gate, estimated):
+    """Flush the covariance, then the update with identified stars: catalog directions ``ref_I`` (N, 3)
+    (already apparent: aberrated as the processing sees them), measured ``obs_S`` (N, 3), direction
+    variance (N,) [rad²]. Each star's tangent-plane residual (:func:`kernels.star_residuals`) with
+    H chained to the navigation error state is gated alone by its 2-dof NIS; the accepted stars
+    update together (Joseph), then the reset. Returns (z (N, 2), nis (N,), accepted (N,))."""
+    flush(nav, P, acc, model)
+    layout = model.layout
+    z, H_att = star_residuals(inertial_attitude(nav, q_ie), calib[12:16], ref_I, obs_S, 6, True)
+    A = attitude_jacobian(nav, layout.n)
+    H = np.empty((z.shape[0], 2, layout.n))
+    for k in range(z.shape[0]):
+        _chain(H_att[k], A, layout.mounting, H[k])
+    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, variance, gate)
+    if za.shape[0] > 0:
+        dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
+        P[:, :] = P_next
+        reset(nav, calib, dx, layout)
+    return z, nis, accepted

@@ -1,0 +1,39 @@
+"""What the star sensor of a navigation run sees at its frames: the true inertial attitude of the body,
+q_IB = q_ie ⊗ q_en(L, λ) ⊗ q_nb (C_ib = C_ie C_en C_nb), the mean body rate ω_ib^b of the IMU
+interval the frame closes, and the observer's barycentric velocity in ICRS axes that aberrates the
+stars (:func:`navsim.earth.orientation.observer_velocity`)."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim.earth.frames import q_en
+from navsim.earth.orientation import observer_velocity
+from navsim.truth.profiles import FrameTruth
+from startrack import rotation as rot
+
+
+@dataclass(frozen=True)
+class SkyTruth:
+    """Per frame f (closing IMU interval k = (f + 1)·``ratio``): ``q_IB`` (F, 4), ``omega_B`` (F, 3)
+    [rad/s] and ``v_I`` (F, 3) [m/s]; ``at(k)`` is the :class:`~navsim.truth.profiles.FrameTruth`
+    the closed loop hands the star sensor."""
+
+    q_IB: np.ndarray
+    omega_B: np.ndarray
+    v_I: np.ndarray
+    ratio: int
+
+    @classmethod
+    def of(cls, trajectory, orientation, frame_k):
+        """The sky truth of a :class:`~navsim.truth.trajectory.Trajectory` at the frames' IMU samples
+        ``frame_k`` (F,) for the :class:`~navsim.earth.orientation.EarthOrientation` at those frames."""
+        lat, lon, h = trajectory.lat[frame_k], trajectory.lon[frame_k], trajectory.h[frame_k]
+        q_IB = rot.multiply(rot.multiply(orientation.q_ie, np.stack(q_en(lat, lon), axis=-1)), trajectory.q_nb[frame_k])
+        v_I = observer_velocity(orientation.c_ie, orientation.v_earth, lat, lon, h, trajectory.v_n[frame_k])
+        ratio = int(frame_k[0])
+        return cls(q_IB=q_IB, omega_B=trajectory.dtheta[frame_k - 1] / trajectory.dt, v_I=v_I, ratio=ratio)
+
+    def at(self, k):
+        f = k // self.ratio - 1
+        return FrameTruth(q_IB=self.q_IB[f], omega_B=self.omega_B[f], v_I=self.v_I[f])
