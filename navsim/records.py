@@ -129,7 +129,11 @@ class RunSummary(Record):
     each {final, rms, max} of the error's magnitude; ``position_error_nmi``: {horizontal: {final, rms,
     max, final_per_hour}}; ``tilt_error_arcsec``, ``heading_error_arcsec``: {final, rms, max};
     ``position_sigma_final_m`` (N, E, D); ``accel_bias_error_final_micro_g``; ``imu_calibration``:
-    the IMU error states at the end (biases [deg/h, µg], scale factors [ppm]) as ``gyro_calibration``.
+    the IMU error states at the end (biases [deg/h, µg], scale factors [ppm], the star-sensor mounting
+    [arcsec]) as ``gyro_calibration``. A star-aided run (SINS/CNS) adds ``celestial``
+    (:func:`navsim.ins.celestial.summary`: the star sensor, the analytic-horizon floor against the
+    Schuler-mean position error, the aberration and what skipping its correction costs, the
+    observability of each state) and, at image fidelity, ``identification``/``modes``.
     """
 
     FORMAT = RUN_FORMAT
@@ -160,6 +164,7 @@ class RunSummary(Record):
     position_sigma_final_m: list | None = None
     accel_bias_error_final_micro_g: list | None = None
     imu_calibration: dict | None = None
+    celestial: dict | None = None
     timing: dict = field(default_factory=dict)
     gyro_calibration: dict | None = None
     identification: dict | None = None

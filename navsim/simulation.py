@@ -22,6 +22,7 @@ from navsim.estimation.consistency import nees, nees_statistics
 from navsim.ins import simulation as navigation
 from navsim.records import RunResult, RunSummary
 from navsim.scenario import build, resolve_scenario
+from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors import faults
 from navsim.sensors.star_sensor import MODES
 from navsim.studies import STUDIES, StudyResult
@@ -59,7 +60,7 @@ def initial_attitude(scenario):
     if radec_roll is None:
         return rot.normalize(scenario["truth"]["initial_q_IB"])
     q_IS = quaternion_from_radec_roll(*units.deg_to_rad(radec_roll))
-    q_BS, _ = build.mounting(scenario)
+    q_BS, _ = mounting(scenario["star_sensor"])
     return rot.normalize(rot.multiply(q_IS, rot.conjugate(q_BS)))
 
 
@@ -68,17 +69,17 @@ def prepare(scenario, overrides=(), star_catalog=None):
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a simulation run")
     if scenario.is_navigation:
-        return navigation.prepare(scenario)
+        return navigation.prepare(scenario, star_catalog)
     gyro_hz = scenario["gyro"]["rate_hz"]
     ratio = int(round(gyro_hz / scenario["star_sensor"]["rate_hz"]))
     factor = int(round(scenario["truth"]["rate_hz"] / gyro_hz))
     n_gyro = int(round(scenario["duration_s"] * gyro_hz))
     truth = sample_truth(build.truth_profile(scenario), initial_attitude(scenario), n_gyro, gyro_hz, factor)
     if scenario["star_sensor"]["measurement"] == "stars" and star_catalog is None:
-        star_catalog = load_star_catalog(epoch=scenario["epoch_jyear"])
+        star_catalog = load_star_catalog(epoch=scenario.catalog_epoch)
     grid = FrameGrid(dt=1.0 / gyro_hz, ratio=ratio, n_frames=n_gyro // ratio)
     sensor = build.star_sensor(scenario, star_catalog, ratio * grid.dt)
-    q_BS, _ = build.mounting(scenario)
+    q_BS, _ = mounting(scenario["star_sensor"])
     return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=build.gyro_model(scenario["gyro"], gyro_hz), sensor=sensor,
                     observers=build.observers(scenario, sensor), bias_steps=faults.bias_steps(scenario["faults"]),
                     attitude_jumps=faults.attitude_jumps(scenario["faults"]), R_BS=rot.to_matrix(q_BS))

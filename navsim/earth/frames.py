@@ -64,6 +64,12 @@ def utc_epoch(text):
     return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
 
 
+def julian_year(epoch_utc):
+    """The Julian epoch [Julian year] (TT) of a UTC calendar epoch: the star catalog's epoch of a run."""
+    tt1, tt2 = erfa.taitt(*erfa.utctai(*utc_epoch(epoch_utc)))
+    return float(erfa.epj(tt1, tt2))
+
+
 def c_ei(epoch_utc, t=0.0, dut1=0.0):
     """C_ei (..., 3, 3): ICRS (GCRS axes) into ITRS at ``t`` [s] (scalar or array) after the UTC
     epoch ``epoch_utc``, with UT1 − UTC = ``dut1`` [s] and zero polar motion.

@@ -40,6 +40,9 @@ from startrack.errors import InputError
 
 #: How the mounting states are treated (as the attitude filter's groups).
 MOUNTING_TREATMENTS = ("estimate", "consider", "ignore")
+#: Which states a baro height updates: the vertical channel (:data:`nav_kernels.BARO_STATES`), or every
+#: estimated state (a white-noise height reference).
+BARO_CHOICES = ("vertical", "all")
 
 
 @dataclass(frozen=True)
@@ -96,13 +99,14 @@ class NavFilter:
     (:class:`StarSensorModel`, or None without one); ``gravity`` (:class:`GravityUncertainty` for the
     three consider states, or None); ``covariance_interval`` the number of increments per covariance
     propagation; ``gate_probability`` of the chi-square gates; ``process_noise_scale`` (multiplies Q)
-    and ``measurement_noise_scale`` (multiplies each measurement's σ) for tuning;
-    ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
+    and ``measurement_noise_scale`` (multiplies each measurement's σ) for tuning; ``baro_states``
+    (:data:`BARO_CHOICES`); ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
     """
 
     def __init__(self, lat, lon, h, v_n, q_nb, P, noise, dt, estimate_scale_factors=False, star_sensor=None,
                  gravity=None, covariance_interval=20, gate_probability=0.9999, process_noise_scale=1.0,
-                 measurement_noise_scale=1.0, gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0)):
+                 measurement_noise_scale=1.0, baro_states="vertical", gyro_bias=(0.0, 0.0, 0.0),
+                 accel_bias=(0.0, 0.0, 0.0)):
         mounting = "ignore" if star_sensor is None else star_sensor.mounting
         if mounting not in MOUNTING_TREATMENTS:
             raise InputError(f"filter.mounting: must be one of {', '.join(MOUNTING_TREATMENTS)}, got {mounting!r}")
@@ -126,6 +130,12 @@ class NavFilter:
             self.estimated[self.layout.mounting:self.layout.mounting + 3] = False
         if gravity is not None:
             self.estimated[self.layout.gravity:] = False
+        if baro_states not in BARO_CHOICES:
+            raise InputError(f"filter.baro_states: must be one of {', '.join(BARO_CHOICES)}, got {baro_states!r}")
+        self.baro_estimated = self.estimated.copy()
+        if baro_states == "vertical":
+            self.baro_estimated[:] = False
+            self.baro_estimated[list(nav_kernels.BARO_STATES)] = True
         self.sigma_scale = float(measurement_noise_scale)
         self.gates = np.array([chi2_quantile(gate_probability, dof) for dof in (3, 1, 2)], dtype=float)
         self._calib = np.zeros(CALIB_SIZE)
@@ -165,9 +175,11 @@ class NavFilter:
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m")
 
     def update_baro(self, h, sigma):
-        """Update with a baro height ``h`` [m] of σ ``sigma`` [m], gated at 1 dof."""
+        """Update with a baro height ``h`` [m] of σ ``sigma`` [m], gated at 1 dof; it corrects the
+        vertical channel, or every estimated state (``baro_states``)."""
         z, nis, accepted = nav_kernels.baro_update(self._nav, self._calib, self._P, self._acc, self.model,
-                                                   float(h), float(sigma) * self.sigma_scale, self.gates[1])
+                                                   float(h), float(sigma) * self.sigma_scale, self.gates[1],
+                                                   self.baro_estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m")
 
     def update_attitude(self, q_IS, R_S):
@@ -248,7 +260,8 @@ class NavFilter:
         out = nav_kernels.run_record(self._nav, self._calib, self._P, self._acc, np.ascontiguousarray(samples, dtype=float),
                                      int(ratio), self.model, np.ascontiguousarray(record.position),
                                      record.position_sigma * self.sigma_scale, np.ascontiguousarray(record.baro),
-                                     record.baro_sigma * self.sigma_scale, self.gates, self.estimated)
+                                     record.baro_sigma * self.sigma_scale, self.gates, self.estimated,
+                                     self.baro_estimated)
         self._intervals += samples.shape[0]
         nav_log, calib_log, P_log = out[0], out[1], out[2]
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[3:]))
@@ -307,6 +320,19 @@ class NavFilter:
     def q_BS(self):
         """The star-sensor mounting estimate q̂_BS (identity without a star sensor)."""
         return self._calib[12:16].copy()
+
+
+def state_names(layout):
+    """The names of the error state's components in order (timeseries ``state_names``)."""
+    names = ["phi_N", "phi_E", "phi_D", "dv_N", "dv_E", "dv_D", "dlat", "dlon", "dh", "eps_x", "eps_y", "eps_z",
+             "nabla_x", "nabla_y", "nabla_z"]
+    if layout.scale >= 0:
+        names += ["dsg_x", "dsg_y", "dsg_z", "dsa_x", "dsa_y", "dsa_z"]
+    if layout.mounting >= 0:
+        names += ["mu_x", "mu_y", "mu_z"]
+    if layout.gravity >= 0:
+        names += ["dg_N", "dg_E", "dg_D"]
+    return names
 
 
 def error_state(lat, lon, h, v_n, q_nb, gyro_bias, accel_bias, truth_lat, truth_lon, truth_h, truth_v_n,

@@ -52,11 +52,13 @@ def layout(scale_factors=False, mounting=False, gravity=False):
         starts.append(n if present else -1)
         n += size if present else 0
     return Layout(n, *starts)
-#: The states a baro height updates: the vertical channel δv_D, δh and the body-z accelerometer bias
-#: (down in level flight); for its update every other state is a consider state (Schmidt), so a baro
-#: damps the vertical channel and tells the filter nothing of the horizontal ones. (Estimating them
-#: all, the filter would draw horizontal information from a white-noise height through the Coriolis
-#: and v²/R couplings of the vertical channel, which no biased, lagging baro really carries.)
+#: The states a baro height updates by default: the vertical channel δv_D, δh and the body-z
+#: accelerometer bias (down in level flight); for its update every other state is a consider state
+#: (Schmidt), so a baro damps the vertical channel and tells the filter nothing of the horizontal ones.
+#: (Estimating them all, the filter draws horizontal information from the height through the Coriolis
+#: and v²/R couplings of the vertical channel and f^n × φ in manoeuvres, which no biased, lagging baro
+#: really carries; a white-noise height reference does, and the filter may then update every state:
+#: ``NavFilter(baro_states="all")``, as PSINS's SINS/CNS height measurement.)
 BARO_STATES = (5, DP + 2, 14)
 #: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
 #: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].
@@ -276,18 +278,14 @@ def position_update(nav, calib, P, acc, model, fix, sigma, gate, estimated):
 
 
 @njit
-def baro_update(nav, calib, P, acc, model, height, sigma, gate):
-    """Flush the covariance, then the gated update of the vertical channel (:data:`BARO_STATES`) with
-    a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""
+def baro_update(nav, calib, P, acc, model, height, sigma, gate, estimated):
+    """Flush the covariance, then the gated update of the ``estimated`` states (:data:`BARO_STATES`, or
+    all) with a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""
     flush(nav, P, acc, model)
-    n = P.shape[0]
-    H = np.zeros((1, n))
+    H = np.zeros((1, P.shape[0]))
     H[0, DP + 2] = 1.0
     R = np.full((1, 1), sigma * sigma)
     z = np.array([nav[2] - height])
-    estimated = np.zeros(n, dtype=np.bool_)
-    for i in BARO_STATES:
-        estimated[i] = True
     nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return z, nis, accepted
 
@@ -312,11 +310,13 @@ def gated_update(nav, calib, P, H, R, z, gate, estimated, layout):
 
 
 @njit
-def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sigma, baro, baro_sigma, gates, estimated):
+def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sigma, baro, baro_sigma, gates, estimated,
+               baro_estimated):
     """The whole-record loop of the fast path: for each frame f, ``ratio`` IMU samples of ``samples``
     (F*ratio, 6) propagate the filter (:func:`predict`), then the frame's position fix (a row of
     ``position`` (F, 3), NaN: none) and baro height (``baro`` (F,), NaN: none) update it in that
-    order, with ``gates`` = (3-dof, 1-dof) NIS gates. Returns the per-frame logs of the step-by-step
+    order (the fix correcting the ``estimated`` states, the baro the ``baro_estimated``), with ``gates`` =
+    (3-dof, 1-dof) NIS gates. Returns the per-frame logs of the step-by-step
     loop: nav[0:10] (F, 10), the estimates ``calib`` (F, 16), P (F, n, n) and the frame's update
     statistics (measurements, accepted, NIS sum, dof, innovation RMS [m])."""
     frames = position.shape[0]
@@ -333,7 +333,7 @@ def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sig
             if ok:
                 accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 3, squares + np.sum(z * z)
         if not np.isnan(baro[f]):
-            z, nis, ok = baro_update(nav, calib, P, acc, model, baro[f], baro_sigma, gates[1])
+            z, nis, ok = baro_update(nav, calib, P, acc, model, baro[f], baro_sigma, gates[1], baro_estimated)
             count += 1
             if ok:
                 accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 1, squares + z[0] * z[0]

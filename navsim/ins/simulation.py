@@ -1,36 +1,51 @@
 """Navigation runs (a scenario with a ``[trajectory]`` table): the INS through the closed loop.
 
 :func:`prepare` computes the seed-free part once (the truth trajectory with its exactly consistent
-IMU increments, the sensor models, the frame grid); :func:`simulate` is one seeded run: the IMU and
-aiding measurements are drawn, the navigation filter starts from an error drawn from its P0 and runs
-through :func:`navsim.closed_loop.run_loop` (its compiled fast path for the open-loop aiding), and
-the run's series and :class:`~navsim.records.RunSummary` follow (:mod:`navsim.ins.summary`).
+IMU increments, the sensor models, the frame grid and, with a star sensor, the Earth's orientation at
+the frames and the star sensor); :func:`simulate` is one seeded run: the IMU and aiding measurements
+are drawn, the navigation filter starts from an error drawn from its P0 and runs through
+:func:`navsim.closed_loop.run_loop` (its compiled fast path for the open-loop position and baro
+aiding; frame by frame with a star sensor, which sees the sky from the truth and, at image
+fidelity, points itself with the filter's prediction), and the run's series and
+:class:`~navsim.records.RunSummary` follow (:mod:`navsim.ins.summary`, :mod:`navsim.ins.celestial`).
 
-Random sub-streams (``SeedSequence(seed).spawn(6)``, in this fixed order): 0 gyro, 1 accelerometer,
+Random sub-streams (``SeedSequence(seed).spawn(7)``, in this fixed order): 0 gyro, 1 accelerometer,
 2 the filter's initial error, 3 position fixes, 4 baro, 5 a random gravity disturbance (the truth
-is then generated per run).
+is then generated per run), 6 the star sensor (at vector fidelity its noise directly; at image
+fidelity it spawns three, all before the first frame: 0 attitude jumps, 1 false-star storms,
+2 rendering).
 """
 
+import dataclasses
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.closed_loop import FrameGrid, run_loop
+from navsim.closed_loop import FrameGrid, mode_statistics, mode_timing, run_loop
 from navsim.earth.gravity import GravityDisturbance
+from navsim.earth.orientation import EarthOrientation
+from navsim.ins import celestial
 from navsim.ins.summary import navigation_series, summarize
 from navsim.records import RunResult
 from navsim.scenario import build_navigation as build
 from navsim.scenario.navigation import frame_rate
+from navsim.scenario.star_sensor_fields import mounting
+from navsim.sensors import faults
 from navsim.sensors.aiding import AidingRun, draw_record
+from navsim.sensors.celestial_aiding import CelestialAidingRun
+from navsim.sensors.star_sensor import MODES
 from navsim.truth import trajectory
+from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
+from startrack.star_catalog import load_star_catalog
 
 
 @dataclass(frozen=True)
 class NavigationPrepared:
     """The seed-free part of a navigation scenario: the truth (None when a random gravity disturbance
-    makes it the run's own), the frame grid, the IMU, baro and position-fix models."""
+    makes it the run's own), the frame grid, the IMU, baro and position-fix models, the star sensor
+    (None without one) with the Earth's orientation at the frames, and the faults."""
 
     scenario: object
     truth: trajectory.Trajectory | None
@@ -41,23 +56,36 @@ class NavigationPrepared:
     baro_every: int
     position_sensor: object
     disturbance: GravityDisturbance | None
+    star_sensor: object = None
+    orientation: EarthOrientation | None = None
+    bias_steps: tuple = ()
+    attitude_jumps: tuple = ()
 
 
-def prepare(scenario):
-    """The :class:`NavigationPrepared` of a validated navigation scenario."""
+def prepare(scenario, star_catalog=None):
+    """The :class:`NavigationPrepared` of a validated navigation scenario; ``star_catalog`` (a
+    startrack StarCatalog) is loaded at the scenario's epoch when a star sensor needs it."""
     imu_hz = scenario["imu"]["rate_hz"]
     frame_hz = frame_rate(scenario.data, scenario.source)
     ratio = int(round(imu_hz / frame_hz))
     n_frames = int(round(scenario["duration_s"] * imu_hz)) // ratio
+    grid = FrameGrid(dt=1.0 / imu_hz, ratio=ratio, n_frames=n_frames)
     disturbance = build.gravity_disturbance(scenario)
     random_field = disturbance is not None and disturbance.correlation_length > 0.0
     truth = None if random_field else _truth(scenario, disturbance, None)
     gyro, accel = build.imu(scenario)
     baro = build.baro(scenario)
-    return NavigationPrepared(scenario=scenario, truth=truth, grid=FrameGrid(dt=1.0 / imu_hz, ratio=ratio, n_frames=n_frames),
-                              gyro=gyro, accel=accel, baro=baro,
+    star_sensor = orientation = None
+    if "star_sensor" in scenario.data:
+        star_catalog = star_catalog or load_star_catalog(epoch=scenario.catalog_epoch)
+        star_sensor = build.star_sensor(scenario, star_catalog)
+        orientation = EarthOrientation.compute(scenario["epoch_utc"], grid.frame_k * grid.dt)
+    return NavigationPrepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
                               baro_every=0 if baro is None else int(round(frame_hz / baro.rate_hz)),
-                              position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance)
+                              position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
+                              star_sensor=star_sensor, orientation=orientation,
+                              bias_steps=faults.bias_steps(scenario["faults"]),
+                              attitude_jumps=faults.attitude_jumps(scenario["faults"]))
 
 
 def _truth(scenario, disturbance, seed):
@@ -70,19 +98,53 @@ def simulate(prepared, seed, compiled=True):
     keeps the step-by-step loop where the filter's fast path would run."""
     started = time.perf_counter()
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
-    gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss = np.random.SeedSequence(seed).spawn(6)
+    gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss, star_ss = np.random.SeedSequence(seed).spawn(7)
     truth = p.truth if p.truth is not None else _truth(scenario, p.disturbance, gravity_ss)
     n = grid.n_frames * grid.ratio
     gyro = p.gyro.measure(truth.dtheta[:n] / grid.dt, gyro_ss)
+    omega, bias = faults.apply_bias_steps(gyro.omega, gyro.bias, truth.t[1:n + 1], p.bias_steps)
+    gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
     accel = p.accel.measure(truth.dv[:n] / grid.dt, accel_ss)
+    gravity = build.gravity_uncertainty(scenario, truth.lat[0], truth.h[0])
     P0 = build.initial_covariance(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0])
-    filt = build.nav_filter(scenario, p.gyro, p.accel, _start(truth, P0, init_ss), P0, grid.dt)
+    filt = build.nav_filter(scenario, p.gyro, p.accel, _start(truth, P0, init_ss), P0, grid.dt, p.orientation, gravity)
     record = draw_record(truth, grid.frame_k, p.position_sensor, p.baro, p.baro_every, position_ss, baro_ss)
-    log = run_loop(filt, AidingRun(record), np.hstack([gyro.omega, accel.force]), truth, grid, compiled=compiled)
-    series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel)
+    sensor_run, loop_truth, jumps, sky = AidingRun(record), truth, None, None
+    if p.star_sensor is not None:
+        sky = SkyTruth.of(truth, p.orientation, grid.frame_k)
+        star_run, jumps = _star_run(p, sky, star_ss)
+        sensor_run, loop_truth = CelestialAidingRun(star_run, sensor_run), sky
+    log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, compiled=compiled)
+    q_BS_true = mounting(scenario["star_sensor"])[1] if p.star_sensor is not None else None
+    series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true)
+    series["error_sigma_initial"] = np.sqrt(np.diag(P0))
+    if p.star_sensor is not None:
+        series["mounting_true"] = np.broadcast_to(rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
+                                                                                      q_BS_true)), (grid.n_frames, 3)).copy()
+        series["mounting_estimate"] = rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
+                                                                          series["q_bs"]))
     summary = summarize(scenario, seed, series, grid)
-    summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4)})
-    return RunResult(summary=summary, series=series, scenario=scenario.data)
+    timing = {}
+    if p.star_sensor is not None:
+        summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true))
+        if log.logs_modes:
+            summary = summary.replace(identification=mode_statistics(series, log.transitions), modes=list(MODES))
+            timing = mode_timing(series["mode"], log.timing)
+    summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
+    return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,
+                     timing_series=log.timing)
+
+
+def _star_run(prepared, sky, seed):
+    """(the star sensor's run, its attitude jumps or None) for the sky truth ``sky``: at vector fidelity
+    every frame drawn from ``seed``; at image fidelity the streams of jumps, storms and rendering."""
+    sensor, grid = prepared.star_sensor, prepared.grid
+    if prepared.scenario["star_sensor"]["fidelity"] != "image":
+        return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), None
+    jump_ss, storm_ss, render_ss = seed.spawn(3)
+    run = sensor.start(np.random.default_rng(storm_ss), np.random.default_rng(render_ss), grid.n_frames)
+    jumps = faults.AttitudeJumps(prepared.attitude_jumps, np.random.default_rng(jump_ss)) if prepared.attitude_jumps else None
+    return run, jumps
 
 
 def _start(truth, P0, seed):

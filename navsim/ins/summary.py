@@ -2,23 +2,24 @@
 and its :class:`~navsim.records.RunSummary` (position, velocity, tilt and heading errors, the IMU
 error states, NEES over the filter's own error state).
 
-The error state is the filter's (docs/design.md): x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)],
-est − true except the IMU errors (true − est), with C_nb,est = (I − [φ×]) C_nb,true, so φ_N, φ_E are
-the tilts and the heading error (est − true) is −φ_D. The position error in NED metres is
-(δL (R_M + h), δλ (R_N + h) cos L, −δh).
+The error state is the filter's (docs/design.md): x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ)
+(, δg)], est − true except the IMU and star-sensor errors and the gravity disturbance (true − est),
+with C_nb,est = (I − [φ×]) C_nb,true, so φ_N, φ_E are the tilts and the heading error (est − true) is
+−φ_D. The position error in NED metres is (δL (R_M + h), δλ (R_N + h) cos L, −δh).
 """
 
 import numpy as np
 
 from navsim.earth.wgs84 import radii
 from navsim.estimation.consistency import nees, nees_statistics
-from navsim.estimation.nav_filter import error_state
+from navsim.estimation.nav_filter import error_state, mounting_error, state_names
 from navsim.records import RunSummary
 from startrack import units
 
-#: Slices of the error state: tilt (φ_N, φ_E), heading (φ_D), velocity, position, biases, scale factors.
+#: Slices of the error state: tilt (φ_N, φ_E), heading (φ_D), velocity, position, biases; the optional
+#: groups are found by their names (:func:`group`).
 TILT, HEADING, VELOCITY, POSITION = slice(0, 2), 2, slice(3, 6), slice(6, 9)
-GYRO_BIAS, ACCEL_BIAS, GYRO_SCALE, ACCEL_SCALE = slice(9, 12), slice(12, 15), slice(15, 18), slice(18, 21)
+GYRO_BIAS, ACCEL_BIAS = slice(9, 12), slice(12, 15)
 #: The accelerometer-bias unit of the summaries [m/s²].
 MICRO_G = 1e-6 * units.STANDARD_GRAVITY
 
@@ -30,11 +31,20 @@ def ned_metres(delta_position, lat, h):
                      -delta_position[..., 2]], axis=-1)
 
 
-def navigation_series(truth, frame_k, arrays, gyro, accel):
+def group(series, first, size=3):
+    """The slice of the error state whose first component is named ``first`` (``state_names``), or None."""
+    names = list(series["state_names"])
+    return slice(names.index(first), names.index(first) + size) if first in names else None
+
+
+def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=None):
     """The run's per-frame series from the loop's log ``arrays`` (the filter's snapshots and update
     statistics) at the frames' IMU samples ``frame_k``, the truth trajectory and the gyro and
-    accelerometer records: estimates and truths (lat, lon, h, v_n, q_nb, biases), ``error_state``
-    (F, n), ``error_sigma`` (F, n) = √diag P, ``position_error_m`` (F, 3) NED and ``nees``."""
+    accelerometer records, for the filter's error-state ``layout`` (and the true star-sensor mounting
+    ``q_BS_true``): estimates and truths (lat, lon, h, v_n, q_nb, biases), ``state_names``,
+    ``error_state`` (F, n), ``error_sigma`` (F, n) = √diag P, ``covariance_final`` (n, n) (P at the
+    last frame), ``position_error_m`` (F, 3) NED, ``nees`` and the truth's gravity disturbance
+    ``gravity_disturbance_true`` (F, 3) [m/s²] (zero without one)."""
     k = frame_k
     series = {"t": truth.t[k], "lat_true": truth.lat[k], "lon_true": truth.lon[k], "h_true": truth.h[k],
               "v_n_true": truth.v_n[k], "q_nb_true": truth.q_nb[k], "gyro_bias_true": gyro.bias[k - 1],
@@ -43,12 +53,18 @@ def navigation_series(truth, frame_k, arrays, gyro, accel):
     error = error_state(series["lat"], series["lon"], series["h"], series["v_n"], series["q_nb"], series["gyro_bias"],
                         series["accel_bias"], truth.lat[k], truth.lon[k], truth.h[k], truth.v_n[k], truth.q_nb[k],
                         series["gyro_bias_true"], series["accel_bias_true"])
-    if P.shape[1] > error.shape[1]:  # scale-factor states: s_true = diag((I + S)(I + M)) − 1
-        true_scale = [np.diag(gyro.matrix) - 1.0, np.diag(accel.matrix) - 1.0]
-        error = np.concatenate([error, true_scale[0] - series["gyro_scale_factor"],
-                                true_scale[1] - series["accel_scale_factor"]], axis=1)
-    series["error_state"] = error
+    parts = [error]
+    if layout.scale >= 0:  # scale-factor states: s_true = diag((I + S)(I + M)) − 1
+        parts += [np.diag(gyro.matrix) - 1.0 - series["gyro_scale_factor"], np.diag(accel.matrix) - 1.0 - series["accel_scale_factor"]]
+    if layout.mounting >= 0:
+        parts.append(mounting_error(series["q_bs"], q_BS_true))
+    series["gravity_disturbance_true"] = truth.gravity_disturbance[k]
+    if layout.gravity >= 0:  # consider states: the truth itself
+        parts.append(series["gravity_disturbance_true"])
+    series["state_names"] = np.array(state_names(layout))
+    series["error_state"] = np.concatenate(parts, axis=1)
     series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+    series["covariance_final"] = P[-1].copy()
     series["position_error_m"] = ned_metres(error[:, POSITION], series["lat_true"], series["h_true"])
     series["nees"] = nees(P, error)
     return series
@@ -78,7 +94,8 @@ def summarize(scenario, seed, series, grid):
     e, sigma = series["error_state"], series["error_sigma"]
     nis_frames = np.isfinite(series["nis"]) & steady
     measurements, accepted = int(series["n_measurements"].sum()), int(series["n_accepted"].sum())
-    aiding = [kind for kind, present in (("position", "position" in scenario["aiding"]), ("baro", "baro" in scenario.data))
+    aiding = [kind for kind, present in (("star_sensor", "star_sensor" in scenario.data),
+                                         ("position", "position" in scenario["aiding"]), ("baro", "baro" in scenario.data))
               if present]
     return RunSummary(
         scenario=scenario.name, seed=seed, duration_s=scenario["duration_s"], frames=int(t.size), settle_s=scenario["settle_s"],
@@ -105,14 +122,17 @@ def ned_sigma(sigma, lat, h):
 
 
 def imu_calibration(series):
-    """The IMU error states at the end of the run: for each, truth, estimate and σ per axis and the
-    normalised error (estimate − truth)/σ (deg/h, µg, ppm)."""
+    """The IMU error states and the star-sensor mounting at the end of the run: for each, truth,
+    estimate and σ per axis and the normalised error (estimate − truth)/σ (deg/h, µg, ppm, arcsec;
+    the mounting's estimate and truth are its misalignment from the nominal mounting)."""
     e, sigma = series["error_state"][-1], series["error_sigma"][-1]
     groups = [("gyro_bias_deg_per_h", GYRO_BIAS, series["gyro_bias"][-1], units.DEG / units.HOUR),
               ("accel_bias_micro_g", ACCEL_BIAS, series["accel_bias"][-1], MICRO_G)]
-    if e.size > 15:
-        groups += [("gyro_scale_factor_ppm", GYRO_SCALE, series["gyro_scale_factor"][-1], units.PPM),
-                   ("accel_scale_factor_ppm", ACCEL_SCALE, series["accel_scale_factor"][-1], units.PPM)]
+    if group(series, "dsg_x") is not None:
+        groups += [("gyro_scale_factor_ppm", group(series, "dsg_x"), series["gyro_scale_factor"][-1], units.PPM),
+                   ("accel_scale_factor_ppm", group(series, "dsa_x"), series["accel_scale_factor"][-1], units.PPM)]
+    if group(series, "mu_x") is not None:
+        groups.append(("mounting_arcsec", group(series, "mu_x"), series["mounting_estimate"][-1], units.ARCSEC))
     out = {}
     for name, span, estimate, unit in groups:
         true = estimate + e[span]  # the IMU error states are true − estimate

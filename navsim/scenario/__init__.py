@@ -20,6 +20,7 @@ from navsim.estimation.attitude_filter import TREATMENTS
 from navsim.scenario import navigation
 from navsim.scenario.inertial_fields import GYRO_ERRORS, MAX_ARCSEC, MAX_ARW, MAX_BIAS, MAX_RATE, MAX_RRW
 from navsim.scenario.schema import ListOfTables, Table, Value, is_multiple
+from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor
 from navsim.studies import STUDIES
 from startrack.errors import InputError
 
@@ -82,83 +83,10 @@ SCHEMA = Table(
         ),
         "gyro": Table({"preset": GYRO_ERRORS["preset"], "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e5),
                        **GYRO_ERRORS}),
-        "star_sensor": Table(
-            {
-                "fidelity": Value("str", default="vector", choices=("vector", "image"),
-                                  doc="vector: noisy star vectors or fixes; image: rendered frames through "
-                                      "detection, identification and (dim stars) stacking"),
-                "measurement": Value("str", default="stars", choices=("stars", "attitude")),
-                "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
-                "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
-                                 doc="full cone angle of the circular field"),
-                "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0),
-                "max_stars": Value("int", default=10, minimum=1, maximum=1000),
-                "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC,
-                                           doc="1σ direction error per star and tangent axis"),
-                "attitude_sigma_cross_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
-                "attitude_sigma_roll_arcsec": Value("float", default=40.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
-                "mounting_rotvec_deg": Value("vector", default=[0.0, 0.0, 0.0], minimum=-360.0, maximum=360.0,
-                                             doc="nominal R_BS (sensor to body) as a rotation vector"),
-                "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0], minimum=-MAX_ARCSEC, maximum=MAX_ARCSEC,
-                                             doc="true, unknown mounting error (rotation vector in S)"),
-                "image": Table(
-                    {
-                        "width_px": Value("int", default=1024, minimum=16, maximum=8192),
-                        "height_px": Value("int", default=1024, minimum=16, maximum=8192),
-                        "field": Value("str", default="circular", choices=("circular", "rectangular"),
-                                       doc="circular: the circle of diameter fov_deg inscribed in the width"),
-                        "psf_sigma_px": Value("float", default=0.671, exclusive_minimum=0.0, maximum=10.0),
-                        "exposure_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=10.0),
-                        "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0, maximum=1e15),
-                        "read_noise_e": Value("float", default=20.0, minimum=0.0, maximum=1e6),
-                        "render_mag_limit": Value("float", default=7.0, minimum=-2.0, maximum=12.0,
-                                                  doc="faintest star drawn into the frames"),
-                        "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
-                                                  doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
-                        "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0, maximum=100.0,
-                                                   doc="centroid error the identification assumes (its gates); the filter takes each star's σ from its detection"),
-                        "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
-                                            doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
-                        "catalog_max_pointing_error_deg": Value("float", default=2.0, exclusive_minimum=0.0,
-                                                                doc="max(δ) of eq. 6 of 000"),
-                        "tracking_window_px": Value("int", default=5, minimum=2, maximum=50,
-                                                    doc="half-width of the readout windows while tracking"),
-                        "max_identified_stars": Value("int", default=12, minimum=3, maximum=1000),
-                        "dim_star_stacking": Value("bool", default=True,
-                                                   doc="stack the predicted dim star over 4 frames when < 3 stars"),
-                        "sky_hip": Value("ints", default=[], minimum=1, maximum=10**6,
-                                         doc="render only these Hipparcos stars (004 §3 renders four); "
-                                             "empty: the whole catalog"),
-                        "start_tracking": Value("bool", default=False,
-                                                doc="the sensor starts in tracking, with the filter's initial "
-                                                    "attitude as prior (004's set-up)"),
-                        "compare_without_stacking": Value("bool", default=False,
-                                                          doc="also run a shadow filter that never gets the "
-                                                              "stacked star, for the paired comparison of 004"),
-                        "camera_file": Value("str", default=None,
-                                             doc="camera file (startrack solve --write-camera), relative to the "
-                                                 "scenario file: sets the camera's size, focal length, principal "
-                                                 "point and distortion (fov_deg still sizes the catalog)"),
-                    },
-                    optional=True,
-                ),
-            }
-        ),
+        "star_sensor": Table(dict(STAR_SENSOR)),
         "faults": Table(
             {
-                "outages": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
-                                               "end_s": Value("float", minimum=0.0),
-                                               "reason": Value("str", default="Sun in the field")})),
-                "attitude_jumps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
-                                                      "angle_deg": Value("float", exclusive_minimum=0.0, maximum=180.0)}),
-                                               doc="the filter's attitude is knocked off by this angle "
-                                                   "(tracking loss); the sensor must re-acquire"),
-                "false_star_storms": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
-                                                        "end_s": Value("float", minimum=0.0),
-                                                        "count": Value("int", minimum=1, maximum=1000)})),
-                "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
-                                                       "step_deg_per_h": Value("vector", minimum=-MAX_BIAS, maximum=MAX_BIAS)})),
-                "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
+                **FAULTS,
                 "tracking_failure_probes": Table(
                     {"count": Value("int", minimum=1, maximum=100000),
                      "angle_3sigma_deg": Value("float", exclusive_minimum=0.0, maximum=90.0)},
@@ -247,6 +175,15 @@ class Scenario:
             raise InputError(f"{self.source}: a static study (study.kind = {self.data['study']['kind']!r}) cannot be "
                              f"used for {action}: it has no trajectory; run it with `navsim run` "
                              "(Python: navsim.run_study)")
+
+    @property
+    def catalog_epoch(self):
+        """The star catalog's epoch [Julian year]: ``epoch_jyear``, or a navigation scenario's ``epoch_utc``."""
+        if self.is_navigation:
+            from navsim.earth.frames import julian_year
+
+            return julian_year(self.data["epoch_utc"])
+        return self.data["epoch_jyear"]
 
     @property
     def study_parameters(self):
@@ -343,20 +280,10 @@ def validate(data, source="<scenario>"):
                 f"less than duration_s = {checked['duration_s']:g} s"
             )
     sensor = checked["star_sensor"]
-    if sensor["fidelity"] == "image":
-        if sensor["measurement"] != "stars":
-            raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
-        if "image" not in sensor:
-            sensor["image"] = SCHEMA.entries["star_sensor"].entries["image"].check("star_sensor.image", {})
-        _apply_camera_file(sensor["image"], source)
-    if sensor["fidelity"] == "vector":
-        for kind in ("attitude_jumps", "false_star_storms", "tracking_failure_probes"):
-            if checked["faults"].get(kind):
-                raise InputError(f"{source}: faults.{kind}: needs star_sensor.fidelity = 'image' (it acts on frames)")
-    for kind in ("outages", "false_star_storms"):
-        for k, interval in enumerate(checked["faults"][kind]):
-            if interval["end_s"] <= interval["start_s"]:
-                raise InputError(f"{source}: faults.{kind}[{k}]: end_s must be after start_s")
+    check_star_sensor(sensor, source)
+    if checked["faults"].get("tracking_failure_probes") and sensor["fidelity"] != "image":
+        raise InputError(f"{source}: faults.tracking_failure_probes: needs star_sensor.fidelity = 'image' (it acts on frames)")
+    check_faults(checked["faults"], sensor["fidelity"], source)
     if checked["settle_s"] is None:
         checked["settle_s"] = 0.1 * checked["duration_s"]
     if checked["settle_s"] >= checked["duration_s"]:
@@ -379,20 +306,6 @@ def _check_run_size(checked, source):
             raise InputError(f"{source}: duration_s: {duration:g} s at {key} = {checked[key.split('.')[0]]['rate_hz']:g} Hz "
                              f"is {count:.3g} {what}, more than the {limit:.0e} one run holds in memory; shorten the "
                              "run (a campaign of shorter runs covers more) or lower the rate")
-
-
-def _apply_camera_file(image, source):
-    """A given ``star_sensor.image.camera_file`` is read now (one InputError for a missing or bad file)
-    and sets ``width_px`` and ``height_px``; build.py takes the camera from it."""
-    if image.get("camera_file") is None:
-        return
-    from startrack.camera import Camera
-
-    try:
-        camera = Camera.from_file(image["camera_file"])
-    except InputError as error:
-        raise InputError(f"{source}: star_sensor.image.camera_file: {error}") from None
-    image["width_px"], image["height_px"] = camera.width, camera.height
 
 
 def _checked(schema, data, source):

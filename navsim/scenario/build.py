@@ -6,6 +6,7 @@ import numpy as np
 import scipy.linalg
 
 from navsim.estimation.attitude_filter import AttitudeFilter
+from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.accelerometer import AccelerometerModel
 from navsim.sensors.faults import SensorFaults
 from navsim.sensors.gyro import GyroModel, bias_instability_to_sigma
@@ -13,7 +14,6 @@ from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
 from navsim.studies import observers as observer_kinds
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
-from startrack import rotation as rot
 from startrack import units
 from startrack.camera import Camera
 from startrack.errors import InputError
@@ -92,20 +92,12 @@ def _bias_instability(deg_per_h):
     return bias_instability_to_sigma(units.deg_per_h_to_rad_per_s(deg_per_h))
 
 
-def mounting(scenario):
-    """(q_BS nominal, q_BS true) from the sensor's mounting rotation vector and misalignment."""
-    sensor = scenario["star_sensor"]
-    q_BS = rot.from_rotation_vector(units.deg_to_rad(sensor["mounting_rotvec_deg"]))
-    q_BS_true = rot.multiply(q_BS, rot.from_rotation_vector(units.arcsec_to_rad(sensor["misalignment_arcsec"])))
-    return q_BS, q_BS_true
-
-
 def star_sensor(scenario, star_catalog, frame_interval):
     """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with the faults that
     act on it; ``star_catalog`` a :class:`startrack.star_catalog.StarCatalog` (stars measured or
     rendered), ``frame_interval`` the time between frames [s]."""
     sensor = scenario["star_sensor"]
-    _, q_BS_true = mounting(scenario)
+    _, q_BS_true = mounting(scenario["star_sensor"])
     sensor_faults = SensorFaults.from_scenario(scenario["faults"], frame_interval)
     if sensor["fidelity"] == "image":
         return image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults)
@@ -141,7 +133,7 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults):
                         zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"])
     params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],
                                      max_delta=float(units.deg_to_rad(image["catalog_max_pointing_error_deg"])),
-                                     epoch=scenario["epoch_jyear"])
+                                     epoch=scenario.catalog_epoch)
     identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera,
                                 centroid_sigma_px=image["centroid_sigma_px"], max_stars=image["max_identified_stars"])
     stars = _rendered_stars(star_catalog, image)
@@ -209,7 +201,7 @@ def filter_states(scenario, gyro):
 def attitude_filter(scenario, gyro, q0, P0):
     """The MEKF of ``scenario['filter']`` starting from attitude q0, zero bias and P0."""
     f = scenario["filter"]
-    q_BS, _ = mounting(scenario)
+    q_BS, _ = mounting(scenario["star_sensor"])
     states = filter_states(scenario, gyro)
     arw = gyro.arw if f["arw_deg_per_sqrt_h"] is None else float(units.arw_to_si(f["arw_deg_per_sqrt_h"]))
     rrw = gyro.rrw if states["bias_instability"] != "ignore" else gyro.filter_rrw

@@ -1,14 +1,16 @@
 """From a validated navigation scenario (units in key names) to model objects in SI units: the
-trajectory, the IMU, the baro, the position-fix sensor, the gravity disturbance and the navigation
-filter with its initial covariance (datasheet in, filter model out)."""
+trajectory, the IMU, the baro, the position-fix sensor, the star sensor, the gravity disturbance and
+the navigation filter with its initial covariance and its models of the star sensor and of the
+gravity disturbance (datasheet in, filter model out)."""
 
 import numpy as np
 
 from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.wgs84 import OMEGA_IE, radii
-from navsim.estimation.nav_filter import ImuNoise, NavFilter
-from navsim.estimation.nav_kernels import BASE_STATES
+from navsim.estimation.nav_filter import GravityUncertainty, ImuNoise, NavFilter, StarSensorModel
+from navsim.scenario import build
 from navsim.scenario.build import accelerometer_model, gyro_model
+from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel
 from navsim.truth.segments import Profile
@@ -20,6 +22,9 @@ FLOORS = {"tilt": units.ARCSEC, "heading": 10.0 * units.ARCSEC, "gyro_bias": 1e-
           "accel_bias": units.micro_g_to_si(0.1), "scale_factor": units.PPM}
 #: Most initial heading σ taken from gyrocompassing [rad] (the error state is linear in φ).
 MAX_DEFAULT_HEADING = 10.0 * units.DEG
+#: Floors of the filter's gravity σ taken from a constant disturbance (a component of zero value still
+#: gets a positive σ): deflection [rad], anomaly [m/s²].
+GRAVITY_FLOORS = (0.01 * units.ARCSEC, 0.1 * units.MILLIGAL)
 
 
 def profile(scenario):
@@ -63,6 +68,51 @@ def gravity_disturbance(scenario):
     return GravityDisturbance.random(xi, eta, anomaly, table["correlation_length_m"])
 
 
+def star_sensor(scenario, star_catalog):
+    """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with its faults, seeing
+    the stars of ``star_catalog`` (:func:`navsim.scenario.build.star_sensor`), or None."""
+    if "star_sensor" not in scenario.data:
+        return None
+    return build.star_sensor(scenario, star_catalog, 1.0 / scenario["star_sensor"]["rate_hz"])
+
+
+def star_sensor_model(scenario, orientation):
+    """The filter's :class:`~navsim.estimation.nav_filter.StarSensorModel` (nominal mounting, treatment
+    of its error, the Earth's orientation at the frames, aberration correction), or None."""
+    if "star_sensor" not in scenario.data:
+        return None
+    sensor = scenario["star_sensor"]
+    q_BS, _ = mounting(sensor)
+    return StarSensorModel(q_BS=q_BS, mounting=scenario["filter"]["mounting"], orientation=orientation,
+                           correct_aberration=sensor["aberration_correction"])
+
+
+def gravity_uncertainty(scenario, lat, h):
+    """The filter's :class:`~navsim.estimation.nav_filter.GravityUncertainty` at (L, h) [rad, m], or None
+    (``filter.gravity = "ignore"``, or neither a [gravity] table nor a filter σ). Each σ and the
+    correlation length come from the filter's keys, else from [gravity]: a random field's σ and D,
+    a constant one's magnitudes (floored) and an infinite D."""
+    f, table = scenario["filter"], scenario.data.get("gravity")
+    keys = (f["deflection_sigma_arcsec"], f["anomaly_sigma_mgal"], f["gravity_correlation_length_m"])
+    if f["gravity"] == "ignore" or (table is None and all(k is None for k in keys)):
+        return None
+    table = table or {"model": "constant", "xi_arcsec": 0.0, "eta_arcsec": 0.0, "anomaly_mgal": 0.0}
+    random = table["model"] == "random"
+    xi, eta = (units.arcsec_to_rad(abs(table[k])) for k in ("xi_arcsec", "eta_arcsec"))
+    anomaly = abs(table["anomaly_mgal"]) * units.MILLIGAL
+    if not random:
+        xi, eta, anomaly = max(xi, GRAVITY_FLOORS[0]), max(eta, GRAVITY_FLOORS[0]), max(anomaly, GRAVITY_FLOORS[1])
+    if keys[0] is not None:
+        xi = eta = units.arcsec_to_rad(keys[0])
+    if keys[1] is not None:
+        anomaly = keys[1] * units.MILLIGAL
+    length = keys[2] or (table["correlation_length_m"] if random else np.inf)
+    gamma = normal_gravity(lat, h)
+    sigma = np.array([xi * gamma, eta * gamma, anomaly], dtype=float)
+    return GravityUncertainty(sigma=np.maximum(sigma, [GRAVITY_FLOORS[0] * gamma] * 2 + [GRAVITY_FLOORS[1]]),
+                              correlation_length=float(length))
+
+
 def estimates_scale_factors(scenario, gyro, accel):
     """Whether the filter carries the six scale-factor states: the scenario's choice, else whenever
     either sensor's datasheet has a scale-factor error."""
@@ -73,12 +123,13 @@ def estimates_scale_factors(scenario, gyro, accel):
 
 
 def initial_covariance(scenario, gyro, accel, lat, h):
-    """P0 (15x15 or 21x21) of the error state [φ, δv, δL, δλ, δh, ε, ∇ (, δs_g, δs_a)] at (L, h).
+    """P0 (n x n, diagonal) of the error state [φ, δv, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg)] at (L, h).
 
     Defaults from the datasheets: the tilt of levelling, σ_∇/γ, and the heading of gyrocompassing,
     σ_ε/(ω_ie cos L) (at most 10 deg) (Titterton & Weston, 2nd ed., ch. 10), with σ the turn-on and
-    bias-instability σ in quadrature; the biases' and scale factors' own σ. Each is floored
-    (:data:`FLOORS`) so that P0 is positive definite with perfect sensors."""
+    bias-instability σ in quadrature; the biases' and scale factors' own σ; the mounting's
+    ``filter.initial_mounting_sigma_arcsec``; the gravity disturbance's σ (:func:`gravity_uncertainty`).
+    Each is floored (:data:`FLOORS`) so that P0 is positive definite with perfect sensors."""
     f = scenario["filter"]
     gyro_bias = max(float(np.hypot(gyro.bias_turn_on_sigma, gyro.bias_instability_sigma)), FLOORS["gyro_bias"])
     accel_bias = max(float(np.hypot(accel.bias_turn_on_sigma, accel.bias_instability_sigma)), FLOORS["accel_bias"])
@@ -93,14 +144,24 @@ def initial_covariance(scenario, gyro, accel, lat, h):
     if estimates_scale_factors(scenario, gyro, accel):
         sigma += [max(gyro.scale_factor_sigma, FLOORS["scale_factor"])] * 3
         sigma += [max(accel.scale_factor_sigma, FLOORS["scale_factor"])] * 3
+    if "star_sensor" in scenario.data and f["mounting"] != "ignore":
+        sigma += [units.arcsec_to_rad(f["initial_mounting_sigma_arcsec"])] * 3
+    gravity = gravity_uncertainty(scenario, lat, h)
+    if gravity is not None:
+        sigma += list(gravity.sigma)
     return np.diag(np.square(np.array(sigma, dtype=float)))
 
 
-def nav_filter(scenario, gyro, accel, start, P0, dt):
+def nav_filter(scenario, gyro, accel, start, P0, dt, orientation=None, gravity=None):
     """The :class:`~navsim.estimation.nav_filter.NavFilter` of ``scenario['filter']`` from ``start``
-    = (L, λ, h, v_n, q_nb), with zero IMU error estimates, P0 and the noise of the datasheets."""
+    = (L, λ, h, v_n, q_nb), with zero IMU error estimates, P0, the noise of the datasheets, its star
+    sensor (with the Earth's ``orientation`` at the frames) and ``gravity`` model
+    (:func:`gravity_uncertainty`, the one P0 was built with)."""
     f = scenario["filter"]
     noise = ImuNoise(arw=gyro.arw, vrw=accel.vrw, gyro_bias_rw=gyro.filter_rrw, accel_bias_rw=accel.filter_bias_rw)
-    return NavFilter(*start, P0, noise, dt, estimate_scale_factors=P0.shape[0] > BASE_STATES,
+    return NavFilter(*start, P0, noise, dt, estimate_scale_factors=estimates_scale_factors(scenario, gyro, accel),
+                     star_sensor=star_sensor_model(scenario, orientation),
+                     gravity=gravity,
                      covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"],
-                     process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"])
+                     process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"],
+                     baro_states=f["baro_states"])

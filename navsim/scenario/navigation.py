@@ -4,22 +4,29 @@ navigation scenario").
 Its own strict schema (:data:`SCHEMA`: units in the key names, every value bounded) and cross-key
 rules (:func:`validate`): the trajectory's segments of :mod:`navsim.truth.segments` (a
 segment that cannot be flown is named), the IMU (a gyro and an accelerometer, each a preset and/or
-datasheet fields), an optional baro, position aiding (none: a free INS), an optional gravity
-disturbance and the filter, whose noise and initial σ come from the datasheets unless given.
+datasheet fields), an optional baro, position aiding (none: a free INS), an optional star sensor
+(SINS/CNS: the attitude kind's star-sensor keys and its faults), an optional gravity disturbance and
+the filter, whose noise and initial σ come from the datasheets unless given.
 Every problem is one :class:`~startrack.errors.InputError` naming the file, the key and what is wrong.
 """
 
 import dataclasses
 
+import numpy as np
+
 from navsim.earth.frames import utc_epoch
-from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS
+from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
-from navsim.truth import segments
+from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor, mounting
+from navsim.truth import segments, trajectory
+from startrack import rotation as rot
 from startrack.errors import InputError
 
-#: Bounds: speed [m/s], height [m] (the ellipsoid +/- ), latitude [deg] (the NED frame is singular
-#: at the poles), a segment's duration [s].
-MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 3000.0, 1e5, 89.0, 2.6e6
+#: Bounds: speed [m/s] (below orbital speed), height [m] (the ellipsoid +/- ), latitude [deg] (the NED
+#: frame is singular at the poles), a segment's duration [s].
+MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 7500.0, 1e5, 89.0, 2.6e6
+#: Samples of the flight on which the star sensor's boresight elevation is checked.
+ELEVATION_SAMPLES = 2000
 #: What one run holds in memory: IMU samples (the truth trajectory and both sensors) and frames (each
 #: with the filter's covariance).
 MAX_IMU_SAMPLES, MAX_FRAMES = 1e7, 1e5
@@ -119,6 +126,14 @@ SCHEMA = Table(
                                      doc="1σ of the fix's north, east and down errors"),
             }, optional=True, doc="position fixes (GNSS-like): the truth plus white NED noise"),
         }, doc="no table: a free INS"),
+        "star_sensor": Table({
+            **STAR_SENSOR,
+            "aberration_correction": Value("bool", default=True,
+                                           doc="the processing aberrates the catalog stars with the INS's velocity and "
+                                               "the ephemeris (the truth always sees apparent stars)"),
+        }, optional=True, doc="a star sensor aiding the INS (SINS/CNS) at its rate, vector or image fidelity"),
+        "faults": Table(dict(FAULTS), doc="outages, dropped frames, false-star storms and attitude jumps of the star "
+                                          "sensor; gyro bias steps"),
         "gravity": Table({
             "model": Value("str", choices=("constant", "random")),
             "xi_arcsec": Value("float", default=0.0, minimum=-3600.0, maximum=3600.0,
@@ -145,6 +160,25 @@ SCHEMA = Table(
             "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
             "process_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
             "measurement_noise_scale": Value("float", default=1.0, exclusive_minimum=0.0, maximum=1e6),
+            "baro_states": Value("str", default="vertical", choices=("vertical", "all"),
+                                 doc="the states a baro height updates: the vertical channel (δv_D, δh, the body-z "
+                                     "accelerometer bias), or all (a white-noise height reference: its Coriolis and "
+                                     "manoeuvre couplings then inform the horizontal channels, as in PSINS)"),
+            "mounting": Value("str", default="estimate", choices=("estimate", "consider", "ignore"),
+                              doc="the star-sensor mounting error μ (star_sensor.misalignment_arcsec is its truth): "
+                                  "three states estimated, consider states (Schmidt) or ignored"),
+            "initial_mounting_sigma_arcsec": Value("float", default=60.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
+            "gravity": Value("str", default="consider", choices=("consider", "ignore"),
+                             doc="the gravity disturbance as three consider states (Schmidt) when the filter has a "
+                                 "gravity model (its σ below, default from [gravity]), or ignored"),
+            "deflection_sigma_arcsec": Value("float", default=None, exclusive_minimum=0.0, maximum=3600.0,
+                                             doc="σ of each deflection of the vertical the filter assumes (default: "
+                                                 "[gravity]'s σ, or the magnitude of a constant one)"),
+            "anomaly_sigma_mgal": Value("float", default=None, exclusive_minimum=0.0, maximum=1e4,
+                                        doc="σ of the gravity anomaly the filter assumes (default from [gravity])"),
+            "gravity_correlation_length_m": Value("float", default=None, exclusive_minimum=0.0, maximum=1e8,
+                                                  doc="correlation length the filter assumes (default: [gravity]'s; "
+                                                      "a constant disturbance: infinite)"),
         }),
     }
 )
@@ -172,6 +206,8 @@ def validate(checked, source):
         raise InputError(f"{source}: baro: a free INS of {checked['duration_s']:g} s needs a [baro] table (the free "
                              f"vertical channel diverges, e-folding time 570 s; at most {MAX_FREE_VERTICAL_S:g} s without)")
     _check_gravity(checked.get("gravity"), source)
+    _check_star_sensor(checked, source)
+    _check_baro_states(checked, source)
     if checked["settle_s"] is None:
         checked["settle_s"] = 0.1 * checked["duration_s"]
     if checked["settle_s"] >= checked["duration_s"]:
@@ -180,8 +216,10 @@ def validate(checked, source):
 
 
 def aiding_rates(checked):
-    """{key: rate [Hz]} of the aiding sensors a navigation scenario has (position fix, baro)."""
+    """{key: rate [Hz]} of the aiding sensors a navigation scenario has (star sensor, position fix, baro)."""
     rates = {}
+    if "star_sensor" in checked:
+        rates["star_sensor.rate_hz"] = checked["star_sensor"]["rate_hz"]
     if "position" in checked["aiding"]:
         rates["aiding.position.rate_hz"] = checked["aiding"]["position"]["rate_hz"]
     if "baro" in checked:
@@ -190,9 +228,9 @@ def aiding_rates(checked):
 
 
 def frame_rate(checked, source="<scenario>"):
-    """The rate of the run's frames [Hz]: the fastest aiding sensor's (1 Hz without one, or the IMU's
-    when slower). Every aiding rate must divide it and it must divide the IMU rate: an aiding sensor
-    faster than the IMU is refused."""
+    """The rate of the run's frames [Hz]: the star sensor's, else the fastest aiding sensor's (1 Hz
+    without one, or the IMU's when slower). Every aiding rate must divide it and it must divide the
+    IMU rate: an aiding sensor faster than the IMU is refused."""
     imu_hz = checked["imu"]["rate_hz"]
     rates = aiding_rates(checked)
     for key, rate in rates.items():
@@ -200,10 +238,12 @@ def frame_rate(checked, source="<scenario>"):
             raise InputError(f"{source}: {key}: {rate:g} Hz is faster than the IMU (imu.rate_hz = {imu_hz:g} Hz)")
         if not is_multiple(imu_hz, rate):
             raise InputError(f"{source}: {key}: {rate:g} Hz must divide imu.rate_hz = {imu_hz:g} Hz")
-    frame_hz = max(rates.values()) if rates else min(FREE_FRAME_RATE_HZ, imu_hz)
+    star_hz = rates.get("star_sensor.rate_hz")
+    frame_hz = star_hz or (max(rates.values()) if rates else min(FREE_FRAME_RATE_HZ, imu_hz))
     for key, rate in rates.items():
         if not is_multiple(frame_hz, rate):
-            raise InputError(f"{source}: {key}: {rate:g} Hz must divide the fastest aiding rate, {frame_hz:g} Hz")
+            what = "the star sensor's rate (the run's frames)" if star_hz else "the fastest aiding rate"
+            raise InputError(f"{source}: {key}: {rate:g} Hz must divide {what}, {frame_hz:g} Hz")
     if not is_multiple(imu_hz, frame_hz):
         raise InputError(f"{source}: imu.rate_hz: {imu_hz:g} Hz must be a multiple of the frame rate {frame_hz:g} Hz")
     return frame_hz
@@ -219,6 +259,53 @@ def _check_run_size(checked, frame_hz, source):
     if frames > MAX_FRAMES:
         raise InputError(f"{source}: duration_s: {duration:g} s at {frame_hz:g} frames per second is {frames:.3g} frames, "
                          f"more than the {MAX_FRAMES:.0e} one run logs; lower the aiding rate or shorten the run")
+
+
+def _check_baro_states(checked, source):
+    """``filter.baro_states = "all"`` needs a white-noise baro: a bias, its random walk or a lag would be
+    taken for horizontal information (the baro's σ holds its bias as if it were white)."""
+    baro = checked.get("baro")
+    if checked["filter"]["baro_states"] != "all" or baro is None:
+        return
+    coloured = [key for key in ("bias_sigma_m", "bias_rw_m_per_sqrt_h", "lag_s") if baro[key] > 0.0]
+    if coloured:
+        raise InputError(f"{source}: filter.baro_states: \"all\" needs a white-noise baro (baro.{coloured[0]} = "
+                         f"{baro[coloured[0]]:g}): a bias or lag would pass for horizontal information")
+
+
+def _check_star_sensor(checked, source):
+    """The star sensor's and the faults' rules: those of the attitude kind, faults only with a star sensor
+    (but gyro bias steps), an outage no longer than the flight, a boresight above the horizon at some
+    time of the flight."""
+    sensor = checked.get("star_sensor")
+    faults = checked["faults"]
+    if sensor is None:
+        for kind, value in faults.items():
+            if value and kind != "gyro_bias_steps":
+                raise InputError(f"{source}: faults.{kind}: needs a [star_sensor] (it acts on the star sensor)")
+        return
+    check_star_sensor(sensor, source)
+    check_faults(faults, sensor["fidelity"], source)
+    duration = checked["duration_s"]
+    for k, outage in enumerate(faults["outages"]):
+        length = min(outage["end_s"], duration) - max(outage["start_s"], 0.0)
+        if outage["end_s"] - outage["start_s"] > duration or length >= duration:
+            raise InputError(f"{source}: faults.outages[{k}]: the outage ({outage['start_s']:g}-{outage['end_s']:g} s) is "
+                             f"longer than the flight (duration_s = {duration:g} s): the star sensor would never see a star")
+    highest = boresight_elevation(checked).max()
+    if highest < 0.0:
+        raise InputError(f"{source}: star_sensor.mounting_rotvec_deg: the boresight points below the horizon for the whole "
+                         f"flight (highest elevation {np.degrees(highest):.1f} deg): the star sensor would see the ground")
+
+
+def boresight_elevation(checked, samples=ELEVATION_SAMPLES):
+    """The star sensor's boresight elevation above the local horizon [rad] at ``samples`` times of the
+    flight: asin(−b_D) of b_n = C_nb R_BS e_z (nominal mounting and misalignment)."""
+    profile = segments.Profile.from_table(checked["trajectory"])
+    q_nb = trajectory.attitude(profile.channels(np.linspace(0.0, checked["duration_s"], samples)))
+    _, q_BS_true = mounting(checked["star_sensor"])
+    boresight = rot.rotate(rot.multiply(q_nb, q_BS_true), np.array([0.0, 0.0, 1.0]))
+    return np.arcsin(np.clip(-boresight[:, 2], -1.0, 1.0))
 
 
 def _check_gravity(gravity, source):

@@ -3,7 +3,8 @@
 Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_IS and rate:
 
 1. the predicted boresight gives the sub-catalog address (eq. 7-8 of 000), logged every frame;
-2. the frame is rendered from the true attitude (true mounting, smear from the true body rate):
+2. the frame is rendered from the true attitude (true mounting, smear from the true body rate) and,
+   on a vehicle near the Earth, the stars' apparent directions (:mod:`navsim.sensors.apparent`):
    windows around the predicted stars while tracking, the full frame otherwise — windows sized to
    hold the smear trail the predicted rate implies;
 3. detection and centroids; identification with the prediction as prior — tracking first, then the
@@ -28,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim import kinematics
+from navsim.sensors.apparent import field_stars
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame
 from startrack import rotation as rot
 from startrack.detection import detect, detect_windows
@@ -76,6 +78,23 @@ class ImageStarSensor:
     @property
     def catalog(self):
         return self.identifier.catalog
+
+    @property
+    def field_radius(self):
+        """Angle [rad] from the boresight within which a star may fall on the detector: the half
+        diagonal, plus 1 deg for the smear and the aberration."""
+        c = self.camera
+        return float(np.arctan(0.5 * np.hypot(c.width, c.height) / c.focal_px) + np.radians(1.0))
+
+    def sky(self, q_IS_true, v_I):
+        """(directions (N, 3), V magnitudes (N,)) of the stars drawn into a frame of true attitude
+        q_IS_true: the catalog's, or near the boresight their apparent directions for the observer
+        velocity ``v_I`` [m/s] (None: no aberration)."""
+        if v_I is None:
+            return self.stars_I, self.stars_mag
+        index, apparent = field_stars(self.stars_I, rot.rotate(q_IS_true, np.array([0.0, 0.0, 1.0])),
+                                      self.field_radius, v_I)
+        return apparent, self.stars_mag[index]
 
     def start(self, storm_rng, render_rng, n_frames, full_frames=frozenset()):
         """A run's sensor; ``full_frames``: frame indices read in full whatever the mode (observers')."""
@@ -163,7 +182,8 @@ class ImageRun:
             smear_px = np.hypot(request.omega_S_pred[0], request.omega_S_pred[1]) * model.exposure_s * camera.focal_px
             half = max(s.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
             windows = Windows.around(uv_predicted, half, camera.height, camera.width)
-        frame = render_star_field(camera, model, q_IS_true, s.stars_I, s.stars_mag, self._render_rng,
+        stars_I, stars_mag = s.sky(q_IS_true, request.truth.v_I)
+        frame = render_star_field(camera, model, q_IS_true, stars_I, stars_mag, self._render_rng,
                                   omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
                                   extra_sources=self._false_stars(request.t))
         b, sigma_n = model.background_dn, model.noise_dn

@@ -50,7 +50,8 @@ class StarFrame:
     ``R_S`` in sensor axes. ``fix_q_IS``: the attitude of a sub-catalog or full-sky identification,
     from which the filter may be re-initialised when it rejects the stars (a lost track).
     ``info``: the per-frame log quantities (``log_fields``); ``diagnostics``: what observers read
-    (detections, the stacked star, the true sensor attitude)."""
+    (detections, the stacked star, the true sensor attitude); ``aiding``: the measurements of the other
+    sensors of the same frame (an INS's baro and position fixes), fused after the star sensor's."""
 
     mode: str
     reason: str = ""
@@ -63,12 +64,18 @@ class StarFrame:
     fix_q_IS: np.ndarray | None = None
     info: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
+    aiding: tuple = ()
 
     @property
-    def measurements(self):
-        """((kind, arguments of the filter's update),) of the frame: an attitude fix, stars or nothing."""
+    def star_measurements(self):
+        """((kind, arguments of the filter's update),) of the star sensor: an attitude fix, stars or nothing."""
         if self.q_IS is not None:
             return (("attitude", (self.q_IS, self.R_S)),)
         if len(self.ref_I):
             return (("stars", (self.ref_I, self.obs_S, self.sigma)),)
         return ()
+
+    @property
+    def measurements(self):
+        """((kind, arguments of the filter's update), ...) of the frame: the star sensor's, then ``aiding``."""
+        return self.star_measurements + self.aiding

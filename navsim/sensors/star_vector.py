@@ -7,19 +7,24 @@ Two measurement models (docs/design.md, fidelity ``vector``):
 - :class:`AttitudeFixSensor` returns a noisy attitude q_IS with its covariance in S
   (cross-boresight σ on x and y, roll σ about the boresight z).
 
-Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S). Their
-noise does not depend on the filter, so a run draws every frame's measurements when it starts
-(:meth:`StarVectorSensor.start`): the loop reads them frame by frame (:class:`VectorRun`), or the
-filter takes the whole :class:`Record` at once on its compiled fast path.
+Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S) and, on a
+vehicle near the Earth (``v_I``: the observer's barycentric velocity at each frame), the apparent
+stars (:mod:`navsim.sensors.apparent`): the star vectors are the aberrated directions, the fix is
+turned by the aberration rotation of its boresight; the reported catalog directions stay the
+catalog's. Their noise does not depend on the filter, so a run draws every frame's measurements
+when it starts (:meth:`StarVectorSensor.start`): the loop reads them frame by frame
+(:class:`VectorRun`), or the filter takes the whole :class:`Record` at once on its compiled fast path.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.sensors.apparent import fix_rotation
 from navsim.sensors.recorded_run import RecordedRun
 from navsim.sensors.star_sensor import StarFrame
 from startrack import rotation as rot
+from startrack.aberration import aberrate
 
 
 def tangent_basis(s):
@@ -64,17 +69,19 @@ class StarVectorSensor:
     q_BS_true: np.ndarray
     faults: object  # navsim.sensors.faults.SensorFaults
 
-    def start(self, seed, q_IB_frames, t_frames):
-        """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames."""
-        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed))
+    def start(self, seed, q_IB_frames, t_frames, v_I=None):
+        """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames
+        (and observer velocities ``v_I`` (F, 3) [m/s], None: no aberration)."""
+        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I)
         return VectorRun(Record(available=self.faults.available(t_frames), stars=stars, sigma=self.sigma))
 
-    def observe_frames(self, q_IB_true, rng, chunk=512):
+    def observe_frames(self, q_IB_true, rng, v_I=None, chunk=512):
         """Noisy star vectors for every true attitude q_IB_true (F, 4) -> :class:`StarFrames`.
 
         A star is seen when its angle from the boresight is at most fov/2; the ``max_stars``
-        brightest are reported, brightest first; the direction noise is isotropic in the plane
-        perpendicular to the true direction.
+        brightest are reported, brightest first; each is measured at its apparent direction for the
+        frame's observer velocity ``v_I`` (F, 3) (None: its catalog direction) with a direction noise
+        isotropic in the plane perpendicular to it.
         """
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         order = np.argsort(self.star_mags, kind="stable")
@@ -91,7 +98,8 @@ class StarVectorSensor:
         frame = np.concatenate(frames)
         index = order[np.concatenate(stars)]
         ref_I = self.star_vectors[index]
-        s_true = rot.rotate(rot.conjugate(q_IS[frame]), ref_I)
+        seen_I = ref_I if v_I is None else aberrate(ref_I, np.asarray(v_I)[frame])
+        s_true = rot.rotate(rot.conjugate(q_IS[frame]), seen_I)
         noise = np.einsum("nij,ni->nj", tangent_basis(s_true), self.sigma * rng.standard_normal((len(index), 2)))
         obs = s_true + noise
         obs /= np.linalg.norm(obs, axis=1, keepdims=True)
@@ -108,18 +116,24 @@ class AttitudeFixSensor:
     q_BS_true: np.ndarray
     faults: object  # navsim.sensors.faults.SensorFaults
 
-    def start(self, seed, q_IB_frames, t_frames):
-        """A run's sensor: every frame's fix drawn from ``seed`` for the true attitudes q_IB_frames."""
-        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed))
+    def start(self, seed, q_IB_frames, t_frames, v_I=None):
+        """A run's sensor: every frame's fix drawn from ``seed`` for the true attitudes q_IB_frames (and
+        observer velocities ``v_I`` (F, 3) [m/s], None: no aberration)."""
+        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I)
         return VectorRun(Record(available=self.faults.available(t_frames), fixes=fixes, R_S=self.R_S))
 
     @property
     def R_S(self):
         return np.diag([self.sigma_cross**2, self.sigma_cross**2, self.sigma_roll**2])
 
-    def observe_frames(self, q_IB_true, rng):
-        """Measured q_IS = q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true (F, 4)."""
+    def observe_frames(self, q_IB_true, rng, v_I=None):
+        """Measured q_IS = q_R⁻¹ ⊗ q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true
+        (F, 4): q_R the aberration rotation of the boresight for the observer velocities ``v_I`` (F, 3)
+        (:func:`navsim.sensors.apparent.fix_rotation`; None: no aberration)."""
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
+        if v_I is not None:
+            q_R = fix_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])), np.asarray(v_I))
+            q_IS = rot.multiply(rot.conjugate(q_R), q_IS)
         sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
         nu = sigma * rng.standard_normal((len(q_IS), 3))
         return rot.multiply(q_IS, rot.from_rotation_vector(nu))

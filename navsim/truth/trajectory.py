@@ -99,7 +99,7 @@ def generate(profile, rate_hz, disturbance=None, seed=None, duration=None):
     dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
     for lo, hi in _chunks(n):
         dtheta[lo:hi], dv[lo:hi] = _increments(profile, t, lo, hi, (lat, lon, h), v_samples, gamma_components)
-    q_nb = _attitude(at_samples)
+    q_nb = attitude(at_samples)
     delta_g = np.zeros((n + 1, 3))
     if gamma_components is not None:
         delta_g = disturbance_n(gamma_components, normal_gravity(lat, h))
@@ -128,7 +128,7 @@ def _velocity_rate(ch):
                      ch.speed_rate * s + ch.speed * c * ch.heading_rate, -ch.climb_rate], axis=-1)
 
 
-def _attitude(ch):
+def attitude(ch):
     """q_nb (..., 4) of yaw ψ, pitch θ, roll φ (ZYX): q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)."""
     zero = np.zeros_like(ch.heading)
     q_yaw = rot.from_rotation_vector(np.stack([zero, zero, ch.heading], axis=-1))
@@ -209,7 +209,7 @@ def _increments(profile, t, lo, hi, position, v_samples, components):
         # linear in time between the two samples
         c = components[lo:hi, None, :] * (1.0 - NODES)[:, None] + components[lo + 1:hi + 1, None, :] * NODES[:, None]
         g_n += disturbance_n(c.reshape(-1, 3), gamma)
-    C_bn = np.swapaxes(rot.to_matrix(_attitude(ch)), -1, -2)
+    C_bn = np.swapaxes(rot.to_matrix(attitude(ch)), -1, -2)
     omega = np.einsum("nij,nj->ni", C_bn, w_ie + w_en) + _body_rate_from_euler(ch)
     force = np.einsum("nij,nj->ni", C_bn, v_dot + np.cross(2.0 * w_ie + w_en, v_n) - g_n)
     weights = dt * WEIGHTS[:, None]

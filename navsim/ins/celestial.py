@@ -1,0 +1,109 @@
+"""What a star-aided navigation run (SINS/CNS) adds to its summary (``celestial``): the star sensor,
+the analytic-horizon floor, the aberration and what skipping its correction costs, and the
+observability of each state.
+
+Analytic horizon. The star sensor measures the psi angle ψ = φ − δθ_n (the inertial attitude of the
+INS, :mod:`navsim.estimation.celestial_kernels`), which obeys ψ̇ = −ω_in × ψ − C_nb ε whatever the
+velocity and position errors (Titterton & Weston, 2nd ed., §12.2.1): stars fix ψ and the gyro
+biases, not the position. The horizontal channels keep their Schuler dynamics, driven in level flight
+by δv̇_N = g φ_E + ∇_N − δg_N, δv̇_E = −g φ_N + ∇_E − δg_E (δg the truth's gravity disturbance the INS
+lacks); with ψ held at zero, φ = δθ_n, and the position error oscillates at the Schuler period
+about its equilibrium
+
+    δN = (R_M + h) (∇_N − δg_N)/γ,   δE = (R_N + h) (∇_E − δg_E)/γ,                      (1)
+
+the floor R·∇/g of the accelerometer bias (100 µg: 637 m) plus R times the deflection of the vertical
+(δg_N = −ξγ: 1" gives 31 m); gyro drift, now estimated, no longer grows it. The summary compares the
+Schuler mean of the horizontal error (its mean over the steady frames) with eq. (1) for the true bias
+and disturbance (``horizon_floor``).
+
+Aberration. An attitude from apparent stars is turned by the rotation r of the boresight's
+aberration (:func:`navsim.sensors.apparent.fix_rotation`); uncorrected, the filter takes its
+horizontal part r_h (navigation axes) for a tilt and settles R·r_h away (20" -> ~600 m).
+
+Observability. Per state the ratio of the filter's σ at the end to its initial σ, and the
+eigen-decomposition of the final covariance normalised by the initial σ (Ham & Brown 1983): an
+eigenvalue near 1 is a direction the measurements left as it was, one near 0 is observed.
+"""
+
+import numpy as np
+
+from navsim.earth.frames import q_en
+from navsim.earth.gravity import normal_gravity
+from navsim.earth.wgs84 import radii
+from navsim.sensors.apparent import fix_rotation
+from startrack import rotation as rot
+from startrack import units
+
+#: Schuler period at the Earth's surface [s] (2π √(R/g)), for the number of periods a mean covers.
+SCHULER_PERIOD_S = 5063.0
+#: Components listed per eigenvector of the normalised covariance.
+EIGEN_COMPONENTS = 3
+
+
+def summary(scenario, series, sky, orientation, q_BS_true):
+    """The ``celestial`` block of a star-aided run's summary (module docstring)."""
+    sensor = scenario["star_sensor"]
+    steady = series["t"] >= scenario["settle_s"]
+    return {"star_sensor": {"fidelity": sensor["fidelity"], "measurement": sensor["measurement"],
+                            "rate_hz": sensor["rate_hz"], "aberration_correction": sensor["aberration_correction"],
+                            "frames_with_stars": int(np.count_nonzero(series["n_measurements"]))},
+            "horizon_floor": horizon_floor(series, steady),
+            "aberration": aberration(series, sky, orientation, q_BS_true, sensor["aberration_correction"], steady),
+            "observability": observability(series)}
+
+
+def floor_ned(series):
+    """(accelerometer-bias part, gravity part) (F, 2) [m] of eq. (1): the true bias resolved in the
+    navigation frame and the truth's gravity disturbance, north and east."""
+    lat, h = series["lat_true"], series["h_true"]
+    r_m, r_n = radii(lat)
+    scale = np.stack([r_m + h, r_n + h], axis=-1) / normal_gravity(lat, h)[:, None]
+    bias_n = rot.rotate(series["q_nb_true"], series["accel_bias_true"])
+    return scale * bias_n[:, :2], -scale * series["gravity_disturbance_true"][:, :2]
+
+
+def horizon_floor(series, steady):
+    """The Schuler mean of the horizontal position error against eq. (1) over the steady frames [m]:
+    north and east means and magnitudes of the error, of the floor and of its two parts."""
+    bias, gravity = (part[steady].mean(axis=0) for part in floor_ned(series))
+    error = series["position_error_m"][steady, :2].mean(axis=0)
+    span = float(series["t"][steady][-1] - series["t"][steady][0])
+    return {"position_error_mean_ne_m": [float(v) for v in error], "position_error_mean_m": float(np.hypot(*error)),
+            "floor_ne_m": [float(v) for v in bias + gravity], "floor_m": float(np.hypot(*(bias + gravity))),
+            "accel_bias_m": float(np.hypot(*bias)), "gravity_m": float(np.hypot(*gravity)),
+            "schuler_periods": span / SCHULER_PERIOD_S}
+
+
+def aberration(series, sky, orientation, q_BS_true, corrected, steady):
+    """The aberration at the true boresight: the annual part (the Earth's orbit) and the whole (with the
+    Earth's rotation and the vehicle) [arcsec, mean and max], its horizontal part in the navigation
+    frame, and the position error R·r_h that skipping the correction costs [m] (module docstring)."""
+    boresight = rot.rotate(rot.multiply(sky.q_IB, q_BS_true), np.array([0.0, 0.0, 1.0]))
+    annual = rot.to_rotation_vector(fix_rotation(boresight, orientation.v_earth))
+    total = rot.to_rotation_vector(fix_rotation(boresight, sky.v_I))
+    q_in = rot.multiply(orientation.q_ie, np.stack(q_en(series["lat_true"], series["lon_true"]), axis=-1))
+    total_n = rot.rotate(rot.conjugate(q_in), total)
+    r_m, r_n = radii(series["lat_true"])
+    cost = np.stack([-total_n[:, 1] * (r_m + series["h_true"]), total_n[:, 0] * (r_n + series["h_true"])], axis=-1)
+
+    def arcsec(v):
+        size = np.linalg.norm(v[steady], axis=-1) / units.ARCSEC
+        return {"mean": float(size.mean()), "max": float(size.max())}
+
+    return {"corrected": bool(corrected), "annual_arcsec": arcsec(annual), "total_arcsec": arcsec(total),
+            "horizontal_arcsec": arcsec(total_n[:, :2]),
+            "uncorrected_position_m": float(np.hypot(*cost[steady].mean(axis=0)))}
+
+
+def observability(series):
+    """Per state σ_end/σ_0 and the spectrum of the final covariance normalised by the initial σ
+    (eigenvalues ascending, each with its largest components: state name and weight)."""
+    names, sigma0 = list(series["state_names"]), series["error_sigma_initial"]
+    normalised = series["covariance_final"] / np.outer(sigma0, sigma0)
+    values, vectors = np.linalg.eigh(0.5 * (normalised + normalised.T))
+    modes = []
+    for value, vector in zip(values, vectors.T):
+        top = np.argsort(-np.abs(vector))[:EIGEN_COMPONENTS]
+        modes.append({"eigenvalue": float(value), "components": [[names[i], float(vector[i])] for i in top]})
+    return {"states": names, "sigma_ratio_final": [float(v) for v in series["error_sigma"][-1] / sigma0], "spectrum": modes}

@@ -1,0 +1,136 @@
+"""Scenario keys of the star sensor and of the faults, shared by the attitude and navigation schemas
+(units in the key names), and the cross-key rules both kinds apply to them."""
+
+from navsim.scenario.inertial_fields import MAX_ARCSEC, MAX_BIAS
+from navsim.scenario.schema import ListOfTables, Table, Value
+from startrack import rotation as rot
+from startrack import units
+from startrack.errors import InputError
+
+#: The star sensor's keys: fidelity, measurement, rate, field, noise, mounting and the image table.
+STAR_SENSOR = {
+    "fidelity": Value("str", default="vector", choices=("vector", "image"),
+                      doc="vector: noisy star vectors or fixes; image: rendered frames through "
+                          "detection, identification and (dim stars) stacking"),
+    "measurement": Value("str", default="stars", choices=("stars", "attitude")),
+    "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
+    "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
+                     doc="full cone angle of the circular field"),
+    "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0),
+    "max_stars": Value("int", default=10, minimum=1, maximum=1000),
+    "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC,
+                               doc="1σ direction error per star and tangent axis"),
+    "attitude_sigma_cross_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
+    "attitude_sigma_roll_arcsec": Value("float", default=40.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
+    "mounting_rotvec_deg": Value("vector", default=[0.0, 0.0, 0.0], minimum=-360.0, maximum=360.0,
+                                 doc="nominal R_BS (sensor to body) as a rotation vector"),
+    "misalignment_arcsec": Value("vector", default=[0.0, 0.0, 0.0], minimum=-MAX_ARCSEC, maximum=MAX_ARCSEC,
+                                 doc="true, unknown mounting error (rotation vector in S)"),
+    "image": Table(
+        {
+            "width_px": Value("int", default=1024, minimum=16, maximum=8192),
+            "height_px": Value("int", default=1024, minimum=16, maximum=8192),
+            "field": Value("str", default="circular", choices=("circular", "rectangular"),
+                           doc="circular: the circle of diameter fov_deg inscribed in the width"),
+            "psf_sigma_px": Value("float", default=0.671, exclusive_minimum=0.0, maximum=10.0),
+            "exposure_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=10.0),
+            "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0, maximum=1e15),
+            "read_noise_e": Value("float", default=20.0, minimum=0.0, maximum=1e6),
+            "render_mag_limit": Value("float", default=7.0, minimum=-2.0, maximum=12.0,
+                                      doc="faintest star drawn into the frames"),
+            "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
+                                      doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
+            "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0, maximum=100.0,
+                                       doc="centroid error the identification assumes (its gates); the filter takes each star's σ from its detection"),
+            "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
+                                doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
+            "catalog_max_pointing_error_deg": Value("float", default=2.0, exclusive_minimum=0.0,
+                                                    doc="max(δ) of eq. 6 of 000"),
+            "tracking_window_px": Value("int", default=5, minimum=2, maximum=50,
+                                        doc="half-width of the readout windows while tracking"),
+            "max_identified_stars": Value("int", default=12, minimum=3, maximum=1000),
+            "dim_star_stacking": Value("bool", default=True,
+                                       doc="stack the predicted dim star over 4 frames when < 3 stars"),
+            "sky_hip": Value("ints", default=[], minimum=1, maximum=10**6,
+                             doc="render only these Hipparcos stars (004 §3 renders four); "
+                                 "empty: the whole catalog"),
+            "start_tracking": Value("bool", default=False,
+                                    doc="the sensor starts in tracking, with the filter's initial "
+                                        "attitude as prior (004's set-up)"),
+            "compare_without_stacking": Value("bool", default=False,
+                                              doc="also run a shadow filter that never gets the "
+                                                  "stacked star, for the paired comparison of 004"),
+            "camera_file": Value("str", default=None,
+                                 doc="camera file (startrack solve --write-camera), relative to the "
+                                     "scenario file: sets the camera's size, focal length, principal "
+                                     "point and distortion (fov_deg still sizes the catalog)"),
+        },
+        optional=True,
+    ),
+}
+
+#: The faults both kinds of run take: outages, attitude jumps, false-star storms, gyro bias steps and
+#: dropped frames.
+FAULTS = {
+    "outages": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
+                                   "end_s": Value("float", minimum=0.0),
+                                   "reason": Value("str", default="Sun in the field")})),
+    "attitude_jumps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
+                                          "angle_deg": Value("float", exclusive_minimum=0.0, maximum=180.0)}),
+                                   doc="the filter's attitude is knocked off by this angle "
+                                       "(tracking loss); the sensor must re-acquire"),
+    "false_star_storms": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
+                                            "end_s": Value("float", minimum=0.0),
+                                            "count": Value("int", minimum=1, maximum=1000)})),
+    "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
+                                           "step_deg_per_h": Value("vector", minimum=-MAX_BIAS, maximum=MAX_BIAS)})),
+    "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
+}
+
+#: The faults that act on frames, which only image fidelity has.
+FRAME_FAULTS = ("attitude_jumps", "false_star_storms")
+
+
+def mounting(sensor):
+    """(q_BS nominal, q_BS true) of a ``star_sensor`` table: its mounting rotation vector, then the
+    true misalignment δm (sensor axes): q_BS,true = q_BS ⊗ δq(δm)."""
+    q_BS = rot.from_rotation_vector(units.deg_to_rad(sensor["mounting_rotvec_deg"]))
+    q_BS_true = rot.multiply(q_BS, rot.from_rotation_vector(units.arcsec_to_rad(sensor["misalignment_arcsec"])))
+    return q_BS, q_BS_true
+
+
+def check_star_sensor(sensor, source):
+    """Cross-key rules of a checked ``star_sensor`` table: image fidelity measures stars, gets its
+    image table's defaults when absent and reads its camera file now."""
+    if sensor["fidelity"] == "image":
+        if sensor["measurement"] != "stars":
+            raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
+        if "image" not in sensor:
+            sensor["image"] = STAR_SENSOR["image"].check("star_sensor.image", {})
+        _apply_camera_file(sensor["image"], source)
+
+
+def check_faults(faults, fidelity, source):
+    """Cross-key rules of a checked ``faults`` table for a star sensor of ``fidelity`` (None: none):
+    faults acting on frames need image fidelity, intervals end after they start."""
+    for kind in FRAME_FAULTS:
+        if faults.get(kind) and fidelity != "image":
+            raise InputError(f"{source}: faults.{kind}: needs star_sensor.fidelity = 'image' (it acts on frames)")
+    for kind in ("outages", "false_star_storms"):
+        for k, interval in enumerate(faults[kind]):
+            if interval["end_s"] <= interval["start_s"]:
+                raise InputError(f"{source}: faults.{kind}[{k}]: end_s must be after start_s")
+
+
+def _apply_camera_file(image, source):
+    """A given ``star_sensor.image.camera_file`` is read now (one InputError for a missing or bad file)
+    and sets ``width_px`` and ``height_px``; build.py takes the camera from it."""
+    if image.get("camera_file") is None:
+        return
+    from startrack.camera import Camera
+
+    try:
+        camera = Camera.from_file(image["camera_file"])
+    except InputError as error:
+        raise InputError(f"{source}: star_sensor.image.camera_file: {error}") from None
+    image["width_px"], image["height_px"] = camera.width, camera.height
