@@ -17,10 +17,12 @@ from dataclasses import dataclass
 import erfa
 import numpy as np
 
-from navsim.earth.frames import c_ei, c_en, utc_epoch
+from navsim.earth.frames import c_ei, q_en, utc_epoch
 from navsim.earth.wgs84 import OMEGA_IE, geodetic_to_ecef
 from startrack import rotation as rot
 from startrack.aberration import earth_barycentric_velocity
+from startrack.jit import njit
+from startrack.rotation_jit import quat_to_matrix
 
 #: Tolerance [s] of :meth:`EarthOrientation.index` (frame times are multiples of the IMU interval).
 TIME_TOLERANCE = 1e-6
@@ -54,11 +56,11 @@ class EarthOrientation:
         return j
 
 
+@njit
 def observer_velocity(c_ie, v_earth, lat, lon, h, v_n):
-    """v_I (..., 3) [m/s]: the observer's velocity relative to the barycentre in ICRS axes at
-    (L, λ, h) [rad, rad, m] with NED ground velocity v_n (..., 3), for C_ie (..., 3, 3) and the
-    geocentre's v_earth (..., 3) (module docstring)."""
+    """v_I (3,) [m/s]: the observer's velocity relative to the barycentre in ICRS axes at (L, λ, h)
+    [rad, rad, m] with NED ground velocity v_n (3,), for C_ie (3, 3) and the geocentre's v_earth (3,)
+    (module docstring)."""
     x, y, _ = geodetic_to_ecef(lat, lon, h)
-    rotation = OMEGA_IE * np.stack([-np.asarray(y), np.asarray(x), np.zeros_like(x)], axis=-1)
-    v_e = np.einsum("...ij,...j->...i", c_en(lat, lon), v_n)
-    return v_earth + np.einsum("...ij,...j->...i", c_ie, rotation + v_e)
+    v_e = quat_to_matrix(np.array(q_en(lat, lon))) @ v_n + np.array([-OMEGA_IE * y, OMEGA_IE * x, 0.0])
+    return v_earth + c_ie @ v_e

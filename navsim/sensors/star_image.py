@@ -7,8 +7,10 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    on a vehicle near the Earth, the stars' apparent directions (:mod:`navsim.sensors.apparent`):
    windows around the predicted stars while tracking, the full frame otherwise — windows sized to
    hold the smear trail the predicted rate implies;
-3. detection and centroids; identification with the prediction as prior — tracking first, then the
-   predicted sub-catalog with its 4 redundant neighbours, then full-sky lost-in-space
+3. detection and centroids; identification with the prediction as prior — while tracking, the
+   predicted attitude (tracking windows, then the predicted sub-catalog); after a lost track (an
+   outage, a dropped frame, a rejected frame), the predicted boresight only: the predicted
+   sub-catalog with its 4 redundant neighbours, then full-sky lost-in-space
    (:class:`startrack.identify.StarIdentifier`); while tracking, stars the identifier leaves are
    window-matched to their predictions;
 4. with fewer than 3 stars identified while tracking, the brightest undetected predicted star is
@@ -144,7 +146,7 @@ class ImageRun:
         full = (not self._tracking or len(predicted) == 0 or request.index == self._sample_at
                 or request.index in self._full_frames)
         image, windows, found = self._read(request, q_IS_true, uv_pred[predicted], full)
-        result = s.identifier.solve(found.uv, found.flux, prior=Prior(q_IS=request.q_IS_pred))
+        result = s.identifier.solve(found.uv, found.flux, prior=self._prior(request, info))
         ref_I, obs_S, detected, mode, reason = self._identified(result, found, uv_pred, predicted)
         info |= {"n_detected": len(found), "n_identified": len(ref_I), "id_ms": result.solve_ms}
         diagnostics = {"q_IS_true": q_IS_true, "detections": found}
@@ -165,6 +167,14 @@ class ImageRun:
                          fix_q_IS=result.q_IS if mode in ("subcatalog", "lost_in_space") else None,
                          info=info | {"mode": MODE_CODE[mode], "n_stacked": int(stacked is not None)},
                          diagnostics=diagnostics)
+
+    def _prior(self, request, info):
+        """The identification's prior: while tracking, the predicted attitude (tracking windows, then the
+        sub-catalog); after a lost track, only the predicted boresight (re-acquisition through its
+        sub-catalog and 4 redundant neighbours, then lost-in-space; 000 §3)."""
+        if self._tracking:
+            return Prior(q_IS=request.q_IS_pred)
+        return Prior(boresight=info["boresight_radec"])
 
     def _address(self, q_IS_pred):
         """Predicted boresight (RA, Dec) [rad] and its sub-catalog address and flat index (eq. 7-8 of 000)."""

@@ -30,7 +30,9 @@ class SkyTruth:
         ``frame_k`` (F,) for the :class:`~navsim.earth.orientation.EarthOrientation` at those frames."""
         lat, lon, h = trajectory.lat[frame_k], trajectory.lon[frame_k], trajectory.h[frame_k]
         q_IB = rot.multiply(rot.multiply(orientation.q_ie, np.stack(q_en(lat, lon), axis=-1)), trajectory.q_nb[frame_k])
-        v_I = observer_velocity(orientation.c_ie, orientation.v_earth, lat, lon, h, trajectory.v_n[frame_k])
+        v_n = trajectory.v_n[frame_k]
+        v_I = np.array([observer_velocity(orientation.c_ie[f], orientation.v_earth[f], lat[f], lon[f], h[f], v_n[f])
+                        for f in range(frame_k.size)])
         ratio = int(frame_k[0])
         return cls(q_IB=q_IB, omega_B=trajectory.dtheta[frame_k - 1] / trajectory.dt, v_I=v_I, ratio=ratio)
 
