@@ -76,11 +76,13 @@ def horizon_floor(series, steady):
 
 
 def aberration(series, sky, orientation, q_BS_true, corrected, steady):
-    """The aberration at the true boresight: the annual part (the Earth's orbit) and the whole (with the
-    Earth's rotation and the vehicle) [arcsec, mean and max], its horizontal part in the navigation
-    frame, and the position error R·r_h that skipping the correction costs [m] (module docstring)."""
+    """The aberration at the true boresight: the annual part (the Earth's orbit), the vehicle's (the
+    Earth's rotation and the vehicle's ground velocity) and the whole [arcsec, mean and max], the
+    whole's horizontal part in the navigation frame, and the position error R·r_h that skipping the
+    correction costs [m] (module docstring)."""
     boresight = rot.rotate(rot.multiply(sky.q_IB, q_BS_true), np.array([0.0, 0.0, 1.0]))
     annual = rot.to_rotation_vector(fix_rotation(boresight, orientation.v_earth))
+    vehicle = rot.to_rotation_vector(fix_rotation(boresight, sky.v_I - orientation.v_earth))
     total = rot.to_rotation_vector(fix_rotation(boresight, sky.v_I))
     q_in = rot.multiply(orientation.q_ie, np.stack(q_en(series["lat_true"], series["lon_true"]), axis=-1))
     total_n = rot.rotate(rot.conjugate(q_in), total)
@@ -91,7 +93,8 @@ def aberration(series, sky, orientation, q_BS_true, corrected, steady):
         size = np.linalg.norm(v[steady], axis=-1) / units.ARCSEC
         return {"mean": float(size.mean()), "max": float(size.max())}
 
-    return {"corrected": bool(corrected), "annual_arcsec": arcsec(annual), "total_arcsec": arcsec(total),
+    return {"corrected": bool(corrected), "annual_arcsec": arcsec(annual), "vehicle_arcsec": arcsec(vehicle),
+            "total_arcsec": arcsec(total),
             "horizontal_arcsec": arcsec(total_n[:, :2]),
             "uncorrected_position_m": float(np.hypot(*cost[steady].mean(axis=0)))}
 
