@@ -11,6 +11,7 @@ import erfa
 import numpy as np
 
 from navsim.earth.wgs84 import OMEGA_IE, radii
+from startrack.aberration import earth_barycentric_velocity
 from startrack.errors import InputError
 from startrack.jit import njit
 
@@ -54,6 +55,18 @@ def utc_epoch(text):
     return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
 
 
+def _utc(epoch_utc, t):
+    """Two-part UTC Julian date of ``t`` [s] after the UTC epoch (uniform seconds, no leap inserted)."""
+    utc1, utc2 = utc_epoch(epoch_utc)
+    return utc1, utc2 + np.asarray(t, dtype=float) / 86400.0
+
+
+def tt_epoch(epoch_utc, t=0.0):
+    """Two-part TT Julian date (tt1, tt2) of ``t`` [s] after the UTC epoch ``epoch_utc`` (TT is TDB
+    within 2 ms: what :func:`startrack.aberration.earth_barycentric_velocity` takes)."""
+    return erfa.taitt(*erfa.utctai(*_utc(epoch_utc, t)))
+
+
 def c_ei(epoch_utc, t=0.0, dut1=0.0):
     """C_ei (..., 3, 3): ICRS (GCRS axes) into ITRS at ``t`` [s] (scalar or array) after the UTC
     epoch ``epoch_utc``, with UT1 − UTC = ``dut1`` [s] and zero polar motion.
@@ -63,8 +76,22 @@ def c_ei(epoch_utc, t=0.0, dut1=0.0):
     motion; IERS Conventions 2010, eq. 5.1). ``t`` is added to UTC as uniform seconds (a leap
     second inside the span is not inserted).
     """
-    utc1, utc2 = utc_epoch(epoch_utc)
-    utc2 = utc2 + np.asarray(t, dtype=float) / 86400.0
+    utc1, utc2 = _utc(epoch_utc, t)
     tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
     ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
     return erfa.c2t06a(tt1, tt2, ut11, ut12, 0.0, 0.0)
+
+
+def observer_velocity_i(epoch_utc, t, r_e, v_e, dut1=0.0):
+    """Barycentric velocity v_i (..., 3) [m/s], ICRS axes, of a vehicle at ECEF position ``r_e`` [m]
+    moving at ``v_e`` = ṙ_e [m/s] (ECEF axes; C_en v_n), ``t`` [s] after the UTC epoch: what the
+    aberration of its star directions takes (:func:`startrack.aberration.aberrate`).
+
+    v_i = v_Earth + C_ie (ω_ie^e × r_e + v_e): the Earth's barycentric velocity (erfa.epv00) plus the
+    vehicle's inertial velocity relative to the geocentre, ω_ie^e = [0, 0, ω_ie] (up to 465 m/s, 0.32"
+    of aberration, on the equator). The rates of precession-nutation and polar motion (< 1e-4 m/s)
+    are left out. ``t``, ``r_e`` and ``v_e`` broadcast together.
+    """
+    c_ie = np.swapaxes(c_ei(epoch_utc, t, dut1), -1, -2)
+    relative_e = np.cross([0.0, 0.0, OMEGA_IE], r_e) + np.asarray(v_e, dtype=float)
+    return earth_barycentric_velocity(*tt_epoch(epoch_utc, t)) + np.einsum("...ij,...j->...i", c_ie, relative_e)
