@@ -3,13 +3,15 @@
 Hipparcos star catalog, navigation catalog (guide stars, k-vector pairs, sub-catalogs and their
 address index), camera and rendering, detection and centroiding, dim-star stacking, attitude
 determination and the boresight solves, star identification (full-sky lost-in-space, predicted
-sub-catalog, tracking; and the plate solver for images of an unknown camera). Knows nothing of vehicles or filters (never imports
+sub-catalog, tracking; and the plate solver for images of an unknown camera), apparent star directions
+(aberration). Knows nothing of vehicles or filters (never imports
 ``navsim``). Units: radians inside; degrees only at the command line.
 """
 
 from startrack.lazy import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "startrack.aberration": ("aberrate", "earth_barycentric_velocity", "unaberrate"),
     "startrack.attitude": ("SOLVERS", "AttitudeSolution", "cramer_rao_covariance", "get_solver"),
     "startrack.attitude_angles": ("quaternion_from_radec_roll", "radec_roll_from_quaternion"),
     "startrack.boresight": ("BoresightSolution",),

@@ -10,3 +10,16 @@ def _isolated_cache(tmp_path_factory):
     if "STARTRACK_CACHE_DIR" not in os.environ:
         os.environ["STARTRACK_CACHE_DIR"] = str(tmp_path_factory.mktemp("startrack-cache"))
     yield
+
+
+@pytest.fixture(scope="session")
+def skyfield_sky():
+    """skyfield's built-in timescale and JPL's DE421 ephemeris as shipped by the skyfield-data
+    package (a test dependency): the independent reference of the apparent-place tests; nothing is
+    downloaded."""
+    from importlib.resources import files
+
+    from skyfield.api import Loader
+
+    load = Loader(str(files("skyfield_data") / "data"), verbose=False)
+    return load.timescale(builtin=True), load("de421.bsp")

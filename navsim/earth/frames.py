@@ -64,10 +64,21 @@ def utc_epoch(text):
     return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
 
 
+def _utc(epoch_utc, t):
+    """Two-part UTC Julian date of ``t`` [s] after the UTC epoch (uniform seconds, no leap inserted)."""
+    utc1, utc2 = utc_epoch(epoch_utc)
+    return utc1, utc2 + np.asarray(t, dtype=float) / 86400.0
+
+
+def tt_epoch(epoch_utc, t=0.0):
+    """Two-part TT Julian date (tt1, tt2) of ``t`` [s] after the UTC epoch ``epoch_utc`` (TT is TDB
+    within 2 ms: what :func:`startrack.aberration.earth_barycentric_velocity` takes)."""
+    return erfa.taitt(*erfa.utctai(*_utc(epoch_utc, t)))
+
+
 def julian_year(epoch_utc):
     """The Julian epoch [Julian year] (TT) of a UTC calendar epoch: the star catalog's epoch of a run."""
-    tt1, tt2 = erfa.taitt(*erfa.utctai(*utc_epoch(epoch_utc)))
-    return float(erfa.epj(tt1, tt2))
+    return float(erfa.epj(*tt_epoch(epoch_utc)))
 
 
 def c_ei(epoch_utc, t=0.0, dut1=0.0):
@@ -79,8 +90,7 @@ def c_ei(epoch_utc, t=0.0, dut1=0.0):
     motion; IERS Conventions 2010, eq. 5.1). ``t`` is added to UTC as uniform seconds (a leap
     second inside the span is not inserted).
     """
-    utc1, utc2 = utc_epoch(epoch_utc)
-    utc2 = utc2 + np.asarray(t, dtype=float) / 86400.0
+    utc1, utc2 = _utc(epoch_utc, t)
     tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
     ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
     return erfa.c2t06a(tt1, tt2, ut11, ut12, 0.0, 0.0)

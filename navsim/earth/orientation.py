@@ -14,10 +14,9 @@ velocity; Groves, 2nd ed., eq. 2.145 for the rotating-frame term).
 
 from dataclasses import dataclass
 
-import erfa
 import numpy as np
 
-from navsim.earth.frames import c_ei, q_en, utc_epoch
+from navsim.earth.frames import c_ei, q_en, tt_epoch
 from navsim.earth.wgs84 import OMEGA_IE, geodetic_to_ecef
 from startrack import rotation as rot
 from startrack.aberration import earth_barycentric_velocity
@@ -39,14 +38,13 @@ class EarthOrientation:
     v_earth: np.ndarray
 
     @classmethod
-    def compute(cls, epoch_utc, t):
-        """The orientation at times ``t`` (F,) [s] after the UTC epoch ``epoch_utc`` (TDB taken as TT
-        for the ephemeris: they differ by < 2 ms)."""
+    def compute(cls, epoch_utc, t, dut1=0.0):
+        """The orientation at times ``t`` (F,) [s] after the UTC epoch ``epoch_utc``, UT1 − UTC =
+        ``dut1`` [s] (TDB taken as TT for the ephemeris: they differ by < 2 ms)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        c_ie = np.swapaxes(c_ei(epoch_utc, t), -1, -2)
-        utc1, utc2 = utc_epoch(epoch_utc)
-        tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2 + t / 86400.0))
-        return cls(t=t, q_ie=rot.from_matrix(c_ie), c_ie=c_ie, v_earth=earth_barycentric_velocity(tt1, tt2))
+        c_ie = np.swapaxes(c_ei(epoch_utc, t, dut1), -1, -2)
+        v_earth = earth_barycentric_velocity(*tt_epoch(epoch_utc, t))
+        return cls(t=t, q_ie=rot.from_matrix(c_ie), c_ie=c_ie, v_earth=v_earth)
 
     def index(self, t):
         """The frame index of time ``t`` [s]; a time that is not a frame time raises ValueError."""

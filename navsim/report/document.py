@@ -449,111 +449,121 @@ def study_report(study) -> bytes:
 
 def campaign_report(campaign) -> bytes:
     """The PDF (bytes) of a Monte Carlo campaign directory's report."""
-    first = campaign.runs[0]
     name = campaign.campaign.get("scenario")
     if not isinstance(name, str) or not name:
-        name = scenario_name(first.summary, campaign.scenario, campaign.directory)
+        name = scenario_name(campaign.runs[0].summary, campaign.scenario, campaign.directory)
     env = stats.envelopes(campaign)
     avg = stats.averaged_nees(campaign)
     success, criterion = stats.identification_success(campaign)
     metrics = stats.metric_table(campaign)
-    m = len(campaign.runs)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim Monte Carlo report: {name}", f"navsim Monte Carlo · {name}")
         doc.title(f"Monte Carlo campaign report: {name}", str(campaign.directory))
-        requested = campaign.campaign.get("runs")
-        doc.paragraph(markup(
-            f"Campaign directory {campaign.directory}: {m} finished runs, {len(campaign.failed)} failed"
-            + (f", {general(requested)} requested" if requested is not None else "")
-            + (f"; backend {general(campaign.campaign['backend'])}" if "backend" in campaign.campaign else "")
-            + f"; {env.t.size} frames per run over {number(float(env.t[-1]), 1)} s."))
-
+        doc.paragraph(markup(campaign_headline(campaign, f"{env.t.size} frames per run over {number(float(env.t[-1]), 1)} s")))
         doc.heading("Key results")
-        sentences = []
-        by_label = {r.label: r for r in metrics}
-        if "cross-boresight RMS" in by_label:
-            r = by_label["cross-boresight RMS"]
-            sentences.append(f"Across the {r.runs} runs the cross-boresight RMS error is {number(r.mean)} arcsec on "
-                             f"average (σ {number(r.std)}, median {number(r.median)}, 95th percentile "
-                             f"{number(r.p95)}, worst {number(r.maximum)} arcsec).")
-        if "roll RMS" in by_label:
-            r = by_label["roll RMS"]
-            sentences.append(f"The roll RMS error is {number(r.mean)} arcsec on average (worst {number(r.maximum)}).")
-        final_rms = (env.final**2).mean(axis=0) ** 0.5
-        sentences.append(f"The RMS over runs of the final error is {xyz(final_rms)} arcsec"
-                         + (f" against a mean filter 1σ of {xyz(env.final_sigma_filter)} arcsec."
-                            if env.final_sigma_filter is not None else "."))
-        if avg is not None:
-            sentences.append(f"The NEES averaged over the {avg.runs} runs has mean {number(avg.mean_after_settle)} "
-                             f"after {number(avg.settle_s, 1)} s and {number(100 * avg.fraction_in_band, 1)} % of "
-                             f"those frames lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] "
-                             f"for {avg.runs} runs of {avg.dof} dof.")
-        if success:
-            sentences.append(f"Success ({criterion}): " + "; ".join(
-                f"{r.name} {number(100 * r.fraction, 1)} % ({r.identified} of {r.frames} frames)" for r in success)
-                + ".")
-        doc.paragraph(*(markup(x) for x in sentences))
-
-        doc.heading("Campaign")
-        settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}  # scenario: next section
-        doc.add(table(("Setting", "Value"), [(k, short(general(v))) for k, v in flatten(settings)],
-                      ("left", "left")))
-        scenario_section(doc, campaign.scenario)
-
-        doc.heading("Statistics across runs")
-        doc.paragraph(markup("Per-run metrics from each run's summary.json (after its settling time), "
-                             "with their distribution over the finished runs."))
-        if metrics:
-            doc.add(table(("Metric", "Unit", "Runs", "Mean", "σ", "Median", "95 %", "Max"),
-                          [(r.label, r.unit, str(r.runs), number(r.mean, 3), number(r.std, 3), number(r.median, 3),
-                            number(r.p95, 3), number(r.maximum, 3)) for r in metrics],
-                          ("left", "left", "right", "right", "right", "right", "right", "right")))
-
-        doc.heading("Attitude error envelopes")
-        doc.paragraph(markup(
-            "At each frame: the mean of the error over the runs with ± one run-to-run standard deviation, the "
-            "5-95 % percentile envelope, the RMS over runs, and the filter's ±3σ from the covariance averaged over "
-            "the runs. A consistent filter keeps the RMS curve near one third of the dashed bound."))
-        doc.figure(figures.error_envelopes(env), f"Attitude error envelopes over {m} runs per body axis, arcsec.")
-
-        if avg is not None:
-            doc.heading("Filter consistency over runs")
-            doc.paragraph(markup(
-                f"The average of M independent NEES values times M follows a chi-square law with M n degrees of "
-                f"freedom; with M = {avg.runs} and n = {avg.dof} the 95 % band of the average is "
-                f"[{number(avg.band[0])}, {number(avg.band[1])}]."))
-            doc.figure(figures.nees_band(avg), "NEES averaged over the runs with the 95 % chi-square band for M runs.")
-
-        doc.heading("Final errors")
-        rows = [(a, number(float(final_rms[i])),
-                 number(float(env.final_sigma_filter[i])) if env.final_sigma_filter is not None else "n/a",
-                 number(float(final_rms[i] / env.final_sigma_filter[i]))
-                 if env.final_sigma_filter is not None else "n/a") for i, a in enumerate("xyz")]
-        doc.add(table(("Axis", "RMS of final error [arcsec]", "filter σ [arcsec]", "ratio"), rows))
-        doc.figure(figures.final_error_histogram(env),
-                   "Histogram of the final attitude error over the runs with the normal law of the filter's σ.")
-
+        doc.paragraph(*(markup(x) for x in _campaign_sentences(env, avg, metrics, success, criterion)))
+        campaign_tables(doc, campaign, metrics)
+        _campaign_figures(doc, env, avg, len(campaign.runs))
         if success:
             doc.heading("Identification success per mode")
             doc.paragraph(markup(f"Success counts {criterion}, pooled over all runs."))
             doc.add(table(("Mode", "Frames", "Identified", "Success [%]"),
                           [(r.name, str(r.frames), str(r.identified), number(100 * r.fraction, 1)) for r in success]))
             doc.figure(figures.identification_success(success, criterion), "Identification success per mode.")
-
-        if campaign.summary:
-            rows = [(k, short(general(v))) for k, v in flatten(campaign.summary.to_json())]
-            if rows:
-                doc.heading("Aggregate summary")
-                doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner."))
-                doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
-            comparison_section(doc, campaign.summary)
-            _notes_section(doc, campaign.summary)
-
-        if campaign.failed:
-            doc.heading("Failed runs")
-            doc.add(table(("Run", "Error"), [(f.name, short(f.message, 160)) for f in campaign.failed],
-                          ("left", "left")))
+        campaign_summary_section(doc, campaign, "The campaign's own aggregate (summary.json), as written by the campaign runner.")
         return doc.compile()
+
+
+def campaign_headline(campaign, span):
+    """The opening sentence of a campaign report: runs finished, failed and requested, backend, ``span``."""
+    requested = campaign.campaign.get("runs")
+    return (f"Campaign directory {campaign.directory}: {len(campaign.runs)} finished runs, {len(campaign.failed)} failed"
+            + (f", {general(requested)} requested" if requested is not None else "")
+            + (f"; backend {general(campaign.campaign['backend'])}" if "backend" in campaign.campaign else "")
+            + f"; {span}.")
+
+
+def _campaign_sentences(env, avg, metrics, success, criterion):
+    """The key results of an attitude campaign, one sentence each."""
+    sentences = []
+    by_label = {r.label: r for r in metrics}
+    if "cross-boresight RMS" in by_label:
+        r = by_label["cross-boresight RMS"]
+        sentences.append(f"Across the {r.runs} runs the cross-boresight RMS error is {number(r.mean)} arcsec on "
+                         f"average (σ {number(r.std)}, median {number(r.median)}, 95th percentile "
+                         f"{number(r.p95)}, worst {number(r.maximum)} arcsec).")
+    if "roll RMS" in by_label:
+        r = by_label["roll RMS"]
+        sentences.append(f"The roll RMS error is {number(r.mean)} arcsec on average (worst {number(r.maximum)}).")
+    final_rms = (env.final**2).mean(axis=0) ** 0.5
+    sentences.append(f"The RMS over runs of the final error is {xyz(final_rms)} arcsec"
+                     + (f" against a mean filter 1σ of {xyz(env.final_sigma_filter)} arcsec."
+                        if env.final_sigma_filter is not None else "."))
+    if avg is not None:
+        sentences.append(f"The NEES averaged over the {avg.runs} runs has mean {number(avg.mean_after_settle)} "
+                         f"after {number(avg.settle_s, 1)} s and {number(100 * avg.fraction_in_band, 1)} % of "
+                         f"those frames lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] "
+                         f"for {avg.runs} runs of {avg.dof} dof.")
+    if success:
+        sentences.append(f"Success ({criterion}): " + "; ".join(
+            f"{r.name} {number(100 * r.fraction, 1)} % ({r.identified} of {r.frames} frames)" for r in success) + ".")
+    return sentences
+
+
+def campaign_tables(doc, campaign, metrics):
+    """The campaign's settings, its scenario and the per-run metrics' distribution over the runs."""
+    doc.heading("Campaign")
+    settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}  # scenario: next section
+    doc.add(table(("Setting", "Value"), [(k, short(general(v))) for k, v in flatten(settings)], ("left", "left")))
+    scenario_section(doc, campaign.scenario)
+    doc.heading("Statistics across runs")
+    doc.paragraph(markup("Per-run metrics from each run's summary.json (after its settling time), "
+                         "with their distribution over the finished runs."))
+    if metrics:
+        doc.add(table(("Metric", "Unit", "Runs", "Mean", "σ", "Median", "95 %", "Max"),
+                      [(r.label, r.unit, str(r.runs), number(r.mean, 3), number(r.std, 3), number(r.median, 3),
+                        number(r.p95, 3), number(r.maximum, 3)) for r in metrics],
+                      ("left", "left", "right", "right", "right", "right", "right", "right")))
+
+
+def _campaign_figures(doc, env, avg, m):
+    """Attitude error envelopes, NEES over the runs and the final errors against the filter's σ."""
+    doc.heading("Attitude error envelopes")
+    doc.paragraph(markup(
+        "At each frame: the mean of the error over the runs with ± one run-to-run standard deviation, the "
+        "5-95 % percentile envelope, the RMS over runs, and the filter's ±3σ from the covariance averaged over "
+        "the runs. A consistent filter keeps the RMS curve near one third of the dashed bound."))
+    doc.figure(figures.error_envelopes(env), f"Attitude error envelopes over {m} runs per body axis, arcsec.")
+    if avg is not None:
+        doc.heading("Filter consistency over runs")
+        doc.paragraph(markup(
+            f"The average of M independent NEES values times M follows a chi-square law with M n degrees of "
+            f"freedom; with M = {avg.runs} and n = {avg.dof} the 95 % band of the average is "
+            f"[{number(avg.band[0])}, {number(avg.band[1])}]."))
+        doc.figure(figures.nees_band(avg), "NEES averaged over the runs with the 95 % chi-square band for M runs.")
+    doc.heading("Final errors")
+    final_rms = (env.final**2).mean(axis=0) ** 0.5
+    sigma = env.final_sigma_filter
+    rows = [(a, number(float(final_rms[i])), number(float(sigma[i])) if sigma is not None else "n/a",
+             number(float(final_rms[i] / sigma[i])) if sigma is not None else "n/a") for i, a in enumerate("xyz")]
+    doc.add(table(("Axis", "RMS of final error [arcsec]", "filter σ [arcsec]", "ratio"), rows))
+    doc.figure(figures.final_error_histogram(env),
+               "Histogram of the final attitude error over the runs with the normal law of the filter's σ.")
+
+
+def campaign_summary_section(doc, campaign, explanation):
+    """The campaign's own aggregate (``explanation`` says what it holds), the comparison, notes, failed runs."""
+    if campaign.summary:
+        rows = [(k, short(general(v))) for k, v in flatten(campaign.summary.to_json())]
+        if rows:
+            doc.heading("Aggregate summary")
+            doc.paragraph(markup(explanation))
+            doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
+        comparison_section(doc, campaign.summary)
+        _notes_section(doc, campaign.summary)
+    if campaign.failed:
+        doc.heading("Failed runs")
+        doc.add(table(("Run", "Error"), [(f.name, short(f.message, 160)) for f in campaign.failed], ("left", "left")))
 
 
 def short(text, limit=90):

@@ -18,14 +18,14 @@ from navsim.report import navigation_figures as nav_figures
 from navsim.report import statistics as stats
 from navsim.report.document import (
     Document,
-    comparison_section,
-    flatten,
+    campaign_headline,
+    campaign_summary_section,
+    campaign_tables,
     general,
     markup,
     number,
     scenario_name,
     scenario_section,
-    short,
     table,
 )
 from navsim.report.navigation_statistics import RUN_METRICS, horizontal_percentiles, position_envelopes
@@ -114,6 +114,12 @@ def _calibration_section(doc, calibration, fig):
     doc.figure(fig, "Gyro and accelerometer biases: truth (black) and the filter's estimate with ±3σ.")
 
 
+#: What a navigation campaign's summary.json holds, for its report.
+CAMPAIGN_AGGREGATE = ("The campaign's own aggregate (summary.json), as written by the campaign runner: CEP50/95 of the "
+                      "final horizontal error, the IMU error states pooled over the runs (normalised error RMS, "
+                      "expected 1, and the share within 3σ, expected 99.7 %).")
+
+
 def campaign_report(campaign) -> bytes:
     """The PDF (bytes) of a navigation campaign directory's report."""
     name = campaign.campaign.get("scenario") or scenario_name(campaign.runs[0].summary, campaign.scenario,
@@ -125,9 +131,8 @@ def campaign_report(campaign) -> bytes:
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim Monte Carlo report: {name}", f"navsim Monte Carlo · {name}")
         doc.title(f"Monte Carlo campaign report: {name}", str(campaign.directory))
-        doc.paragraph(markup(f"Campaign directory {campaign.directory}: {len(campaign.runs)} finished runs, "
-                             f"{len(campaign.failed)} failed; {env.t.size} frames per run over "
-                             f"{number(float(env.t[-1]) / 60.0, 1)} min."))
+        doc.paragraph(markup(campaign_headline(campaign, f"{env.t.size} frames per run over "
+                                                       f"{number(float(env.t[-1]) / 60.0, 1)} min")))
         doc.heading("Key results")
         sentences = [f"At the last logged frame the horizontal position error has CEP50 {number(final['cep50'])} m "
                      f"({number(final['cep50'] / units.NAUTICAL_MILE, 3)} nmi) and CEP95 {number(final['cep95'])} m "
@@ -138,7 +143,7 @@ def campaign_report(campaign) -> bytes:
                              f"lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] for {avg.runs} "
                              f"runs of {avg.dof} dof.")
         doc.paragraph(*(markup(x) for x in sentences))
-        _campaign_tables(doc, campaign, metrics)
+        campaign_tables(doc, campaign, metrics)
         doc.heading("Horizontal error over time")
         doc.paragraph(markup("At each frame the median (CEP50) and 95th percentile (CEP95) of the horizontal error over "
                              "the runs, their RMS and the filter's 3σ from the covariance averaged over the runs."))
@@ -151,31 +156,5 @@ def campaign_report(campaign) -> bytes:
         if avg is not None:
             doc.heading("Filter consistency over runs")
             doc.figure(figures.nees_band(avg), "NEES averaged over the runs with the 95 % chi-square band for M runs.")
-        _campaign_summary_section(doc, campaign)
+        campaign_summary_section(doc, campaign, CAMPAIGN_AGGREGATE)
         return doc.compile()
-
-
-def _campaign_tables(doc, campaign, metrics):
-    doc.heading("Campaign")
-    settings = {k: v for k, v in campaign.campaign.items() if not isinstance(v, dict)}
-    doc.add(table(("Setting", "Value"), [(k, short(general(v))) for k, v in flatten(settings)], ("left", "left")))
-    scenario_section(doc, campaign.scenario)
-    doc.heading("Statistics across runs")
-    doc.add(table(("Metric", "Unit", "Runs", "Mean", "σ", "Median", "95 %", "Max"),
-                  [(r.label, r.unit, str(r.runs), number(r.mean, 3), number(r.std, 3), number(r.median, 3),
-                    number(r.p95, 3), number(r.maximum, 3)) for r in metrics],
-                  ("left", "left", "right", "right", "right", "right", "right", "right")))
-
-
-def _campaign_summary_section(doc, campaign):
-    if campaign.summary:
-        rows = [(k, short(general(v))) for k, v in flatten(campaign.summary.to_json())]
-        doc.heading("Aggregate summary")
-        doc.paragraph(markup("The campaign's own aggregate (summary.json), as written by the campaign runner: CEP50/95 "
-                             "of the final horizontal error, the IMU error states pooled over the runs (normalised "
-                             "error RMS, expected 1, and the share within 3σ, expected 99.7 %)."))
-        doc.add(table(("Key", "Value"), rows[:200], ("left", "left")))
-        comparison_section(doc, campaign.summary)
-    if campaign.failed:
-        doc.heading("Failed runs")
-        doc.add(table(("Run", "Error"), [(f.name, short(f.message, 160)) for f in campaign.failed], ("left", "left")))

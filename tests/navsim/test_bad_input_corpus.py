@@ -14,7 +14,7 @@ import pytest
 from navsim import cli
 from navsim.scenario import SCHEMA, navigation, study_schema
 from navsim.scenario.schema import ListOfTables, Table, Tagged, Value
-from tests.cli_support import run_cli
+from tests.support import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"

@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pypdf
 import pytest
 
 from navsim import cli
@@ -18,6 +17,7 @@ from navsim.earth.wgs84 import radii
 from navsim.records import RunSummary
 from navsim.simulation import run_batch
 from startrack import units
+from tests.support import pdf_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = Path(__file__).resolve().parent / "data" / "base_navigation.toml"
@@ -84,11 +84,6 @@ def run_cli(argv, capsys):
     return status, capsys.readouterr()
 
 
-def pdf_text(path):
-    reader = pypdf.PdfReader(path)
-    return " ".join(" ".join(page.extract_text() for page in reader.pages).split())
-
-
 def test_the_same_seed_gives_the_same_files(tmp_path, capsys):
     for name in ("a", "b"):
         assert run_cli(["run", BASE, "--out", tmp_path / name, "--seed", "4"], capsys)[0] == 0
@@ -105,7 +100,7 @@ def test_run_and_report_of_a_navigation_scenario(tmp_path, capsys):
     assert "horizontal error" in out.out and "aiding: position, baro" in out.out
     summary = RunSummary.read(tmp_path / "run" / "summary.json")
     assert summary.kind == "navigation" and summary["nees"]["dof"] == 21
-    text = pdf_text(tmp_path / "run.pdf")
+    text, _ = pdf_text(tmp_path / "run.pdf")
     for heading in ("Navigation run report: corpus_navigation", "Key results", "Ground track", "Navigation errors",
                     "IMU error estimates", "Filter consistency"):
         assert heading in text
@@ -122,7 +117,7 @@ def test_campaign_and_its_report(tmp_path, capsys):
     assert summary["position_error_m"]["horizontal"]["cep50"] == pytest.approx(np.median(finals))
     assert summary["nees"]["dof"] == 21 and summary["divergent_runs"] == []
     assert run_cli(["report", out, "-o", tmp_path / "mc.pdf"], capsys)[0] == 0
-    text = pdf_text(tmp_path / "mc.pdf")
+    text, _ = pdf_text(tmp_path / "mc.pdf")
     for phrase in ("Monte Carlo campaign report: corpus_navigation", "CEP50", "Horizontal error over time",
                    "Position error envelopes", "Filter consistency over runs"):
         assert phrase in text

@@ -20,15 +20,10 @@ from navsim.report.inputs import RunData
 from startrack import address
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
+from tests.support import pdf_text
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity
 SHORT = {"duration_s": 20.0}  # 40 frames at 2 Hz
-
-
-def pdf_text(path):
-    """All text of the PDF with whitespace runs collapsed (line breaks do not split phrases)."""
-    reader = pypdf.PdfReader(path)
-    return " ".join(" ".join(page.extract_text() for page in reader.pages).split()), len(reader.pages)
 
 
 @pytest.fixture(scope="module")

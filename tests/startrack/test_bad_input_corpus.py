@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from startrack import cli
-from tests.cli_support import run_cli
+from tests.support import run_cli
 
 #: A valid call of each command ({tmp}: the test's directory) and its numeric options.
 COMMANDS = {
