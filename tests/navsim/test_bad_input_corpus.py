@@ -18,9 +18,12 @@ from tests.support import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
-BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid", "navigation")}
+BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid", "navigation",
+                                                              "sins_cns")}
 STUDY = ROOT / "scenarios" / "paper003_precision.toml"
-#: Which base scenario reaches the keys below each table (the first match wins; "constant" otherwise).
+#: Which base scenario reaches the keys below each table of the attitude and the navigation schema
+#: (the first match wins; the schema's default otherwise).
+NAV_BASE_OF = (("star_sensor", "sins_cns"), ("faults", "sins_cns"))
 BASE_OF = (("truth.sinusoidal_axis", "image"), ("truth.rate_segments", "segments"), ("truth.rigid_body", "rigid"),
            ("star_sensor.image", "image"), ("faults.attitude_jumps", "image"), ("faults.false_star_storms", "image"),
            ("faults.tracking_failure_probes", "image"))
@@ -76,20 +79,23 @@ def bad_values(spec):
     return out
 
 
-def scenario_cases(schema, prefix="", base=None):
+def scenario_cases(schema, base_of, default, prefix=""):
     """(case id, base, key path, --set override) for every leaf of ``schema`` and every table's unknown
-    key; ``base`` names the base scenario of every case (None: by :data:`BASE_OF`)."""
-    cases = [(f"{prefix or '<top>'}: an unknown key", base or _base_name(prefix),
-              f"{prefix + '.' if prefix else ''}bogus_key", "1")]
+    key; the base scenario of each is the first of ``base_of`` (table prefix, base) to match, else
+    ``default``."""
+    def base(path):
+        return next((name for table, name in base_of if path.startswith(table)), default)
+
+    cases = [(f"{prefix or '<top>'}: an unknown key", base(prefix), f"{prefix + '.' if prefix else ''}bogus_key", "1")]
     for key, spec in schema.entries.items():
         path = f"{prefix}.{key}" if prefix else key
         if isinstance(spec, Table):
-            cases += scenario_cases(spec, path, base)
+            cases += scenario_cases(spec, base_of, default, path)
         elif isinstance(spec, ListOfTables):
-            cases.append((f"{path}: not an array of tables", base or _base_name(path), path, "5"))
-            cases += list(_item_cases(spec.item, path, base or _base_name(path)))
+            cases.append((f"{path}: not an array of tables", base(path), path, "5"))
+            cases += list(_item_cases(spec.item, path, base(path)))
         else:
-            cases += [(f"{path}: {label}", base or _base_name(path), path, toml(value)) for label, value in bad_values(spec)]
+            cases += [(f"{path}: {label}", base(path), path, toml(value)) for label, value in bad_values(spec)]
     return cases
 
 
@@ -112,11 +118,7 @@ def _item_cases(item, path, base):
         yield f"{path}: an unknown {item.tag}", base, path, toml([{item.tag: "fly"}])
 
 
-def _base_name(path):
-    return next((base for table, base in BASE_OF if path.startswith(table)), "constant")
-
-
-SCENARIO_CASES = scenario_cases(SCHEMA) + scenario_cases(navigation.SCHEMA, base="navigation")
+SCENARIO_CASES = scenario_cases(SCHEMA, BASE_OF, "constant") + scenario_cases(navigation.SCHEMA, NAV_BASE_OF, "navigation")
 
 
 def assert_one_clear_line(status, err, culprit, out=None):
