@@ -139,16 +139,18 @@ def pyins_filter(truth, dtheta, dv, samples):
                                        measurements=[measurements.Position(positions, 3.0)], time_step=0.1)
 
 
-def campaign_minutes(runs):
-    """Wall minutes of ``runs`` runs of 1 h at 200 Hz through the campaign runner on two workers, with
-    the machine's 15-minute load average after them (a shared machine: other work slows the runs)."""
+def campaign_minutes(runs, scenario=SCENARIO, overrides=HOUR_AT_200_HZ):
+    """Wall minutes of ``runs`` runs of 1 h at 200 Hz (of ``scenario`` with ``overrides``) through the
+    campaign runner on two workers, with the machine's 15-minute load average after them (a shared
+    machine: other work slows the runs), and the campaign's NEES and divergent runs."""
     with tempfile.TemporaryDirectory(prefix="navsim-bench-") as tmp:
         start = time.perf_counter()
-        summary = run_campaign(SCENARIO, runs, Path(tmp) / "campaign", overrides=HOUR_AT_200_HZ, workers=2, progress=False)
+        summary = run_campaign(scenario, runs, Path(tmp) / "campaign", overrides=overrides, workers=2, progress=False)
         minutes = (time.perf_counter() - start) / 60.0
     return {"runs": runs, "wall_min_on_2_workers": minutes, "per_1000_runs_min": 1000.0 * minutes / runs,
             "load_average_15_min_after": os.getloadavg()[2],
-            "runs_finished": summary["runs_finished"], "nees_mean": summary["nees"]["mean"],
+            "runs_finished": summary["runs_finished"], "divergent_runs": len(summary["divergent_runs"]),
+            "nees_dof": summary["nees"]["dof"], "nees_mean": summary["nees"]["mean"],
             "nees_band_95": summary["nees"]["band_95"]}
 
 

@@ -27,6 +27,8 @@ from startrack.errors import InputError
 MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 7500.0, 1e5, 89.0, 2.6e6
 #: Samples of the flight on which the star sensor's boresight elevation is checked.
 ELEVATION_SAMPLES = 2000
+#: ... and of each segment, its ends included (a turn's bank, however short against the flight).
+SEGMENT_SAMPLES = 9
 #: What one run holds in memory: IMU samples (the truth trajectory and both sensors) and frames (each
 #: with the filter's covariance).
 MAX_IMU_SAMPLES, MAX_FRAMES = 1e7, 1e5
@@ -300,9 +302,14 @@ def _check_star_sensor(checked, source):
 
 def boresight_elevation(checked, samples=ELEVATION_SAMPLES):
     """The star sensor's boresight elevation above the local horizon [rad] at ``samples`` times of the
-    flight: asin(−b_D) of b_n = C_nb R_BS e_z (nominal mounting and misalignment)."""
+    flight and at SEGMENT_SAMPLES times of each segment (a short bank in a long flight is not missed):
+    asin(−b_D) of b_n = C_nb R_BS e_z (nominal mounting and misalignment)."""
     profile = segments.Profile.from_table(checked["trajectory"])
-    q_nb = trajectory.attitude(profile.channels(np.linspace(0.0, checked["duration_s"], samples)))
+    duration = checked["duration_s"]
+    ends = np.append(profile.starts[1:], profile.duration)
+    per_segment = np.linspace(profile.starts, ends, SEGMENT_SAMPLES).ravel()
+    times = np.union1d(np.linspace(0.0, duration, samples), per_segment[per_segment <= duration])
+    q_nb = trajectory.attitude(profile.channels(times))
     _, q_BS_true = mounting(checked["star_sensor"])
     boresight = rot.rotate(rot.multiply(q_nb, q_BS_true), np.array([0.0, 0.0, 1.0]))
     return np.arcsin(np.clip(-boresight[:, 2], -1.0, 1.0))
