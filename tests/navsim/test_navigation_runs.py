@@ -99,7 +99,7 @@ def test_run_and_report_of_a_navigation_scenario(tmp_path, capsys):
     assert status == 0
     assert "horizontal error" in out.out and "aiding: position, baro" in out.out
     summary = RunSummary.read(tmp_path / "run" / "summary.json")
-    assert summary.kind == "navigation" and summary["nees"]["dof"] == 21
+    assert summary.kind == "navigation" and summary["nees"]["dof"] == 24  # 15 + 6 scale factors + 3 gravity consider states
     text, _ = pdf_text(tmp_path / "run.pdf")
     for heading in ("Navigation run report: corpus_navigation", "Key results", "Ground track", "Navigation errors",
                     "IMU error estimates", "Filter consistency"):
@@ -115,7 +115,7 @@ def test_campaign_and_its_report(tmp_path, capsys):
     finals = [json.loads(p.read_text())["position_error_m"]["horizontal"]["final"]
               for p in sorted((out / "runs").glob("run_*/summary.json"))]
     assert summary["position_error_m"]["horizontal"]["cep50"] == pytest.approx(np.median(finals))
-    assert summary["nees"]["dof"] == 21 and summary["divergent_runs"] == []
+    assert summary["nees"]["dof"] == 24 and summary["divergent_runs"] == []
     assert run_cli(["report", out, "-o", tmp_path / "mc.pdf"], capsys)[0] == 0
     text, _ = pdf_text(tmp_path / "mc.pdf")
     for phrase in ("Monte Carlo campaign report: corpus_navigation", "CEP50", "Horizontal error over time",
