@@ -29,6 +29,8 @@ def chi2_band(dof, runs=1, probability=BAND_PROBABILITY):
 
 def nees(P, errors):
     """eᵢᵀ Pᵢ⁻¹ eᵢ at every frame for covariances P (F, m, m) and errors e (F, m) (Cholesky, compiled)."""
+    if np.shape(P)[1:] != (np.shape(errors)[1],) * 2:
+        raise ValueError(f"NEES: covariances {np.shape(P)} do not match errors {np.shape(errors)}")
     return quadratic_forms(np.ascontiguousarray(P), np.ascontiguousarray(errors))
 
 

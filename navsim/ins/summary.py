@@ -66,7 +66,7 @@ def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=Non
     series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))
     series["covariance_final"] = P[-1].copy()
     series["position_error_m"] = ned_metres(error[:, POSITION], series["lat_true"], series["h_true"])
-    series["nees"] = nees(P, error)
+    series["nees"] = nees(P, series["error_state"])
     return series
 
 
