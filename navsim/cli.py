@@ -4,6 +4,7 @@
     navsim report DIR -o FILE.pdf
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
     navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
+    navsim budget SCENARIO.toml --out DIR [--runs N] [--workers W]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -169,6 +170,18 @@ def _tune(args):
     return 0
 
 
+def _budget(args):
+    from navsim.campaign.budget import run_budget, text
+    from navsim.scenario import resolve_scenario
+
+    _check_seed(args.seed)
+    budget = run_budget(resolve_scenario(args.scenario, args.set or ()), args.out, runs=args.runs, workers=args.workers,
+                        base_seed=args.seed)
+    print("\n".join(text(budget)))
+    print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
+    return 0
+
+
 def build_parser():
     parser = ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -208,6 +221,17 @@ def build_parser():
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.add_argument("--json", action="store_true", help="print the iterations as JSON")
     p.set_defaults(func=_tune)
+
+    p = sub.add_parser("budget", help="the error budget of a star-aided navigation scenario: the horizontal error each "
+                                      "source leaves, from runs with one source at a time")
+    p.add_argument("scenario", help="scenario TOML file (a navigation scenario with a [star_sensor])")
+    p.add_argument("--out", required=True, help="budget directory (budget.json, budget.pdf, parts/; finished runs "
+                                                "there are kept)")
+    p.add_argument("--runs", type=int, default=5, help="runs per source (default 5)")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    p.add_argument("--seed", type=int, default=None, help="base seed (default: the scenario's)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.set_defaults(func=_budget)
     return parser
 
 

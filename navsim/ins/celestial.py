@@ -53,13 +53,14 @@ def summary(scenario, series, sky, orientation, q_BS_true):
             "observability": observability(series)}
 
 
-def floor_ned(series):
-    """(accelerometer-bias part, gravity part) (F, 2) [m] of eq. (1): the true bias resolved in the
-    navigation frame and the truth's gravity disturbance, north and east."""
+def floor_ned(series, bias=None):
+    """(accelerometer-bias part, gravity part) (F, 2) [m] of eq. (1): the true bias (or ``bias`` (F, 3)
+    [m/s²] in body axes, e.g. what the filter left of it) resolved in the navigation frame and the
+    truth's gravity disturbance, north and east."""
     lat, h = series["lat_true"], series["h_true"]
     r_m, r_n = radii(lat)
     scale = np.stack([r_m + h, r_n + h], axis=-1) / normal_gravity(lat, h)[:, None]
-    bias_n = rot.rotate(series["q_nb_true"], series["accel_bias_true"])
+    bias_n = rot.rotate(series["q_nb_true"], series["accel_bias_true"] if bias is None else bias)
     return scale * bias_n[:, :2], -scale * series["gravity_disturbance_true"][:, :2]
 
 

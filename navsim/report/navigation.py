@@ -34,6 +34,9 @@ from startrack import units
 CALIBRATION_LABELS = {"gyro_bias_deg_per_h": ("gyro bias", "deg/h", 4), "accel_bias_micro_g": ("accelerometer bias", "µg", 1),
                       "gyro_scale_factor_ppm": ("gyro scale factor", "ppm", 1),
                       "accel_scale_factor_ppm": ("accelerometer scale factor", "ppm", 1)}
+MOUNTING_LABELS = {"mounting_arcsec": ("mounting μ", "arcsec", 2)}
+#: Directions of the normalised covariance's spectrum listed as the least observed.
+LEAST_OBSERVED = 4
 
 
 def run_report(run) -> bytes:
@@ -62,6 +65,7 @@ def run_report(run) -> bytes:
         doc.figure(nav_figures.velocity_errors(run), "Velocity error north, east, down with ±3σ, m/s.")
         doc.figure(nav_figures.attitude_errors(run), "Tilt and heading errors with ±3σ, arcsec.")
         _calibration_section(doc, summary.get("imu_calibration"), nav_figures.imu_biases(run))
+        _star_sensor_section(doc, run)
         doc.heading("Filter consistency")
         doc.paragraph(markup(
             f"The NEES of the whole error state ({summary['nees']['dof']} dof) and the NIS of each update per degree of "
@@ -103,21 +107,118 @@ def _calibration_section(doc, calibration, fig):
     doc.heading("IMU error estimates")
     doc.paragraph(markup("The IMU error states at the end of the run: truth, estimate, the filter's σ and the normalised "
                          "error (estimate − truth)/σ, which a consistent filter keeps within ±3."))
+    _estimates_table(doc, calibration, CALIBRATION_LABELS)
+    doc.figure(fig, "Gyro and accelerometer biases: truth (black) and the filter's estimate with ±3σ.")
+
+
+def _estimates_table(doc, calibration, labels):
+    """Truth, estimate, 1σ and normalised error per axis of the ``calibration`` groups named in ``labels``
+    ({key: (label, unit, decimals)})."""
     rows = []
-    for key, (label, unit, digits) in CALIBRATION_LABELS.items():
+    for key, (label, unit, digits) in labels.items():
         if key in calibration:
             c = calibration[key]
             rows += [(f"{label} {axis}", unit, number(t, digits), number(e, digits), number(sig, digits), number(z, 2))
                      for axis, t, e, sig, z in zip("xyz", c["true"], c["estimate"], c["sigma"], c["normalised_error"])]
     doc.add(table(("State", "Unit", "Truth", "Estimate", "1σ", "Normalised error"), rows,
                   ("left", "left", "right", "right", "right", "right")))
-    doc.figure(fig, "Gyro and accelerometer biases: truth (black) and the filter's estimate with ±3σ.")
+
+
+def _star_sensor_section(doc, run):
+    """A star-aided run (SINS/CNS): the horizontal error against the analytic-horizon floor, the
+    aberration, the mounting estimate and the observability of each state."""
+    celestial = run.summary.get("celestial")
+    if not celestial:
+        return
+    doc.heading("Star sensor aiding")
+    floor, aberration = celestial["horizon_floor"], celestial["aberration"]
+    doc.paragraph(markup(
+        "The star sensor fixes the inertial attitude and the accelerometers the local vertical; together they fix "
+        "latitude and longitude (the analytic horizon). The horizontal error then oscillates at the Schuler period about "
+        "the floor of eq. (1), δN = (R_M + h)(∇_N − δg_N)/γ and δE = (R_N + h)(∇_E − δg_E)/γ, of the true accelerometer "
+        "bias ∇ and gravity disturbance δg; manoeuvres that make ∇ observable bring the error below it. "
+        f"Over {number(floor['schuler_periods'])} Schuler periods after the settling time the mean horizontal error is "
+        f"{number(floor['position_error_mean_m'])} m against a floor of {number(floor['floor_m'])} m."))
+    doc.figure(nav_figures.horizon_floor(run), "Horizontal position error north and east with the filter's ±3σ and "
+                                               "the analytic-horizon floor of eq. (1) of the true "
+                                               "accelerometer bias and of the bias the filter's estimate leaves, metres.")
+    corrected = "corrected" if aberration["corrected"] else "not corrected"
+    doc.paragraph(markup(
+        f"The aberration of the star directions is {corrected} by the processing; left uncorrected, its horizontal part "
+        f"would move the position by {number(aberration['uncorrected_position_m'])} m."))
+    doc.add(table(("Quantity", "Value", "Unit"), _horizon_rows(floor) + _aberration_rows(aberration),
+                  ("left", "right", "left")))
+    calibration = run.summary.get("imu_calibration") or {}
+    if "mounting_arcsec" in calibration:
+        doc.paragraph(markup("The star-sensor mounting error μ (sensor axes) at the end of the run: truth, estimate, "
+                             "the filter's σ and the normalised error."))
+        _estimates_table(doc, calibration, MOUNTING_LABELS)
+        doc.figure(nav_figures.mounting(run), "Star-sensor mounting error μ: truth (black) and the filter's estimate "
+                                              "with ±3σ, arcsec.")
+    _observability_section(doc, celestial["observability"])
+
+
+def _horizon_rows(floor):
+    def ne(values):
+        return ", ".join(number(v) for v in values)
+
+    return [("Schuler-mean position error (N, E)", ne(floor["position_error_mean_ne_m"]), "m"),
+            ("Schuler-mean horizontal error", number(floor["position_error_mean_m"]), "m"),
+            ("floor of eq. (1) (N, E)", ne(floor["floor_ne_m"]), "m"),
+            ("floor of eq. (1), horizontal", number(floor["floor_m"]), "m"),
+            ("floor: accelerometer-bias part", number(floor["accel_bias_m"]), "m"),
+            ("floor: gravity-disturbance part", number(floor["gravity_m"]), "m"),
+            ("Schuler periods averaged", number(floor["schuler_periods"]), "")]
+
+
+def _aberration_rows(aberration):
+    rows = [(f"{label} aberration (mean / max)", f"{number(aberration[key]['mean'])} / {number(aberration[key]['max'])}",
+             "arcsec") for label, key in (("annual", "annual_arcsec"), ("vehicle", "vehicle_arcsec"),
+                                          ("total", "total_arcsec"), ("horizontal part of the total", "horizontal_arcsec"))]
+    return rows + [("position error if uncorrected", number(aberration["uncorrected_position_m"]), "m"),
+                   ("aberration corrected", "yes" if aberration["corrected"] else "no", "")]
+
+
+def _observability_section(doc, observability):
+    names, ratios = observability["states"], observability["sigma_ratio_final"]
+    observed = [n for n, r in zip(names, ratios) if r < 0.1]
+    unobserved = [n for n, r in zip(names, ratios) if r > 0.5]
+    doc.paragraph(markup(
+        "Observability: per state the filter's σ at the end over its initial σ. "
+        f"Reduced below 10 %: {', '.join(observed) or 'none'}. Left above 50 % (unobserved, or grown): "
+        f"{', '.join(unobserved) or 'none'}."))
+    doc.figure(nav_figures.observability(names, ratios), "Observability: σ_end/σ_0 per error state (log scale).")
+    least = observability["spectrum"][::-1][:LEAST_OBSERVED]
+    doc.paragraph(markup(
+        "The least-observed directions: the largest eigenvalues of the final covariance normalised by the initial σ "
+        "(Ham & Brown 1983; an eigenvalue near 1 is a direction the measurements left as it was, near 0 one they "
+        "observed), each with its largest components."))
+    doc.add(table(("Eigenvalue", "σ ratio", "Main components"),
+                  [(f"{m['eigenvalue']:.3g}", f"{np.sqrt(max(m['eigenvalue'], 0.0)):.3g}",
+                    ", ".join(f"{name} {weight:+.2f}" for name, weight in m["components"])) for m in least],
+                  ("right", "right", "left")))
 
 
 #: What a navigation campaign's summary.json holds, for its report.
 CAMPAIGN_AGGREGATE = ("The campaign's own aggregate (summary.json), as written by the campaign runner: CEP50/95 of the "
                       "final horizontal error, the IMU error states pooled over the runs (normalised error RMS, "
                       "expected 1, and the share within 3σ, expected 99.7 %).")
+
+
+def _campaign_floor(doc, campaign):
+    """Star-aided runs: each run's Schuler-mean horizontal error against its analytic-horizon floor."""
+    floors = [(r.summary.get("celestial") or {}).get("horizon_floor") for r in campaign.runs]
+    if not all(floors):
+        return
+    floor = np.array([f["floor_m"] for f in floors])
+    error = np.array([f["position_error_mean_m"] for f in floors])
+    doc.heading("Analytic-horizon floor across runs")
+    doc.paragraph(markup(
+        f"Over the {floor.size} runs (each mean over {number(floors[0]['schuler_periods'])} Schuler periods) the "
+        f"Schuler-mean horizontal error has RMS {number(float(np.sqrt(np.mean(error**2))))} m "
+        f"against an RMS floor of eq. (1) of {number(float(np.sqrt(np.mean(floor**2))))} m (each run's own accelerometer "
+        "bias and gravity disturbance)."))
+    doc.figure(nav_figures.floor_scatter(floor, error), "Schuler-mean horizontal error against the floor of eq. (1), per run.")
 
 
 def campaign_report(campaign) -> bytes:
@@ -156,5 +257,6 @@ def campaign_report(campaign) -> bytes:
         if avg is not None:
             doc.heading("Filter consistency over runs")
             doc.figure(figures.nees_band(avg), "NEES averaged over the runs with the 95 % chi-square band for M runs.")
+        _campaign_floor(doc, campaign)
         campaign_summary_section(doc, campaign, CAMPAIGN_AGGREGATE)
         return doc.compile()

@@ -8,7 +8,8 @@ minutes. The error state and its σ are the filter's (:mod:`navsim.ins.summary`)
 
 import numpy as np
 
-from navsim.ins.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, ned_metres
+from navsim.ins.celestial import floor_ned
+from navsim.ins.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
 from navsim.report.figures import COLORS, new_figure
 from startrack import units
 
@@ -38,26 +39,43 @@ def ground_track(run):
     return fig
 
 
-def error_with_bounds(t, errors, sigmas, labels, unit, title=None):
-    """Three error components against time [min] with the filter's ±3σ."""
-    fig, axes = new_figure(4.2, 3, 1)
+def error_with_bounds(t, errors, sigmas, labels, unit, title=None, references=()):
+    """Error components (one per label) against time [min] with the filter's ±3σ and references drawn
+    over them, each (values (F, n), label, colour)."""
+    fig, axes = new_figure(1.4 * len(labels), len(labels), 1)
     for i, ax in enumerate(axes[:, 0]):
         ax.plot(_minutes(t), errors[:, i], color=COLORS[i], lw=0.8, label="error")
         ax.plot(_minutes(t), 3.0 * sigmas[:, i], "k--", lw=0.7, label="±3σ (filter)")
         ax.plot(_minutes(t), -3.0 * sigmas[:, i], "k--", lw=0.7)
+        for values, label, color in references:
+            ax.plot(_minutes(t), values[:, i], color=color, lw=0.9, label=label)
         ax.set_ylabel(f"{labels[i]} [{unit}]")
-        ax.legend(loc="upper right", ncols=2)
+        ax.legend(loc="upper right", ncols=3)
     if title:
         axes[0, 0].set_title(title)
     axes[-1, 0].set_xlabel("time [min]")
     return fig
 
 
+def _position_sigma(s):
+    return np.abs(ned_metres(s["error_sigma"][:, 6:9], s["lat_true"], s["h_true"]))
+
+
 def position_errors(run):
     """Position error north, east, down [m] with ±3σ."""
     s = run.series
-    sigma = np.abs(ned_metres(s["error_sigma"][:, 6:9], s["lat_true"], s["h_true"]))
-    return error_with_bounds(s["t"], s["position_error_m"], sigma, [f"δ{a}" for a in NED], "m")
+    return error_with_bounds(s["t"], s["position_error_m"], _position_sigma(s), [f"δ{a}" for a in NED], "m")
+
+
+def horizon_floor(run):
+    """Horizontal position error north and east [m] with ±3σ and the analytic-horizon floor of eq. (1)
+    (:func:`navsim.ins.celestial.floor_ned`) of the true accelerometer bias and of the bias the
+    filter's estimate leaves (its ∇ state), each with the gravity disturbance."""
+    s = run.series
+    floors = ((sum(floor_ned(s)), "floor of eq. (1), true ∇", "tab:red"),
+              (sum(floor_ned(s, s["error_state"][:, ACCEL_BIAS])), "floor, ∇ left by the filter", "tab:purple"))
+    return error_with_bounds(s["t"], s["position_error_m"][:, :2], _position_sigma(s)[:, :2], [f"δ{a}" for a in NED[:2]],
+                             "m", references=floors)
 
 
 def velocity_errors(run):
@@ -81,17 +99,33 @@ def imu_biases(run):
     s = run.series
     if "gyro_bias_true" not in s or "accel_bias_true" not in s:
         return None
-    fig, axes = new_figure(4.6, 3, 2)
-    columns = (("gyro_bias", GYRO_BIAS, units.DEG / units.HOUR, "deg/h"), ("accel_bias", ACCEL_BIAS, MICRO_G, "µg"))
-    for col, (name, span, unit, label) in enumerate(columns):
-        true, est = s[f"{name}_true"] / unit, s[name] / unit
+    return truth_and_estimate(s, (("gyro", "gyro_bias", GYRO_BIAS, units.DEG / units.HOUR, "deg/h"),
+                                  ("accel", "accel_bias", ACCEL_BIAS, MICRO_G, "µg")))
+
+
+def mounting(run):
+    """The star-sensor mounting error μ [arcsec] per sensor axis: truth and estimate with ±3σ; None
+    without the filter's mounting states."""
+    s = run.series
+    span = group(s, "mu_x")
+    if span is None or "mounting_true" not in s:
+        return None
+    return truth_and_estimate(s, (("μ", "mounting", span, units.ARCSEC, "arcsec"),), suffixes=("_true", "_estimate"))
+
+
+def truth_and_estimate(s, columns, suffixes=("_true", "")):
+    """One column per (label, series name, error-state slice, unit, unit label) of three axes: the truth
+    (``name + suffixes[0]``) and the estimate (``name + suffixes[1]``) with the estimate's ±3σ."""
+    fig, axes = new_figure(4.6, 3, len(columns))
+    for col, (label, name, span, unit, unit_label) in enumerate(columns):
+        true, est = s[name + suffixes[0]] / unit, s[name + suffixes[1]] / unit
         sigma3 = 3.0 * s["error_sigma"][:, span] / unit
         for i, ax in enumerate(axes[:, col]):
             ax.plot(_minutes(s["t"]), true[:, i], color="k", lw=1.0, label="truth")
             ax.plot(_minutes(s["t"]), est[:, i], color=COLORS[i], lw=0.8, label="estimate")
             ax.fill_between(_minutes(s["t"]), est[:, i] - sigma3[:, i], est[:, i] + sigma3[:, i], color=COLORS[i],
                             alpha=0.15, lw=0, label="±3σ")
-            ax.set_ylabel(f"{name.split('_')[0]} {'xyz'[i]} [{label}]")
+            ax.set_ylabel(f"{label} {'xyz'[i]} [{unit_label}]")
         axes[0, col].legend(loc="upper right", ncols=3)
         axes[-1, col].set_xlabel("time [min]")
     return fig
@@ -123,4 +157,48 @@ def final_scatter(final_ne, cep50, cep95):
     ax.set_aspect("equal", adjustable="datalim")
     ax.set(xlabel="final east error [m]", ylabel="final north error [m]")
     ax.legend(loc="upper right")
+    return fig
+
+
+def observability(names, ratios):
+    """σ_end/σ_0 of each error state (log scale): a bar well below 1 is a state the measurements and
+    manoeuvres observed; one near 1 or above was left unobserved (or grew)."""
+    fig, axes = new_figure(2.6)
+    ax = axes[0, 0]
+    ax.bar(range(len(names)), ratios, color="tab:blue")
+    ax.axhline(1.0, color="k", lw=0.7, ls="--", label="σ_0 (no reduction)")
+    ax.set_yscale("log")
+    ax.set_xticks(range(len(names)), names, rotation=90)
+    ax.set(ylabel="σ_end / σ_0")
+    ax.legend(loc="upper right")
+    return fig
+
+
+def floor_scatter(floor, error):
+    """Per run: the Schuler mean of the horizontal position error against the analytic-horizon floor
+    of eq. (1) [m], with the line where they are equal."""
+    fig, axes = new_figure(3.2)
+    ax = axes[0, 0]
+    ax.plot(floor, error, ".", color="tab:blue", ms=5, label="runs")
+    top = 1.05 * max(float(np.max(floor)), float(np.max(error)), 1e-9)
+    ax.plot([0.0, top], [0.0, top], "k--", lw=0.7, label="error = floor")
+    ax.set(xlabel="floor of eq. (1) [m]", ylabel="Schuler-mean horizontal error [m]", xlim=(0.0, top), ylim=(0.0, top))
+    ax.legend(loc="upper left")
+    return fig
+
+
+def budget_bars(labels, values, predictions):
+    """The error budget: per source the Schuler-mean, final and RMS horizontal error [m] (grouped bars,
+    ``values`` {metric label: list}) with the prediction of eq. (1) where there is one (None elsewhere)."""
+    fig, axes = new_figure(3.4)
+    ax = axes[0, 0]
+    x, width = np.arange(len(labels)), 0.8 / len(values)
+    for i, (name, heights) in enumerate(values.items()):
+        ax.bar(x + (i - (len(values) - 1) / 2) * width, heights, width, color=COLORS[i], label=name)
+    known = [(k, p) for k, p in enumerate(predictions) if p is not None]
+    if known:
+        ax.plot([k for k, _ in known], [p for _, p in known], "k_", ms=24, mew=1.5, label="eq. (1) / R·r_h prediction")
+    ax.set_xticks(x, labels, rotation=20, ha="right")
+    ax.set(ylabel="horizontal error [m]")
+    ax.legend(loc="upper left")
     return fig
