@@ -179,7 +179,7 @@ def _budget(args):
                         base_seed=args.seed)
     print("\n".join(text(budget)))
     print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
-    return 0
+    return 1 if any(row["status"] == "failed" for row in [*budget["parts"], budget["total"]]) else 0
 
 
 def build_parser():

@@ -188,6 +188,8 @@ def _part(directory, key, label, reason, prediction):
     if reason is not None:
         return row
     summaries = [RunSummary.read(p) for p in sorted((directory / "parts" / key / "runs").glob("run_*/summary.json"))]
+    if not summaries:
+        return {**row, "status": "failed", "note": f"failed: no run finished (parts/{key}/runs/*/error.json)"}
     horizontal = [s["position_error_m"]["horizontal"] for s in summaries]
     values = {"schuler_mean_m": [s.celestial["horizon_floor"]["position_error_mean_m"] for s in summaries],
               "final_m": [h["final"] for h in horizontal], "rms_m": [h["rms"] for h in horizontal]}

@@ -35,9 +35,9 @@ def budget_report(budget) -> bytes:
                if budget["aberration_corrected"] else " (as the scenario does).")))
         total = budget["total"]
         doc.paragraph(markup(
-            f"The total (all sources) has a Schuler-mean horizontal error of {number(total['schuler_mean_m'])} m and "
+            f"The total (all sources) has a Schuler-mean horizontal error of {number(total.get('schuler_mean_m'))} m and "
             f"the root-sum-square of the parts ({', '.join(rss['parts'])}) is {number(rss['schuler_mean_m'])} m; "
-            f"final {number(total['final_m'])} m against {number(rss['final_m'])} m. Each part's filter is built from its "
+            f"final {number(total.get('final_m'))} m against {number(rss['final_m'])} m. Each part's filter is built from its "
             "own datasheets (a source switched off is absent from its model too), so the total need not be the "
             "root-sum-square: the sources also act through what the filter must tell apart (in straight flight the "
             "tilt from the mounting error)."))
