@@ -2,7 +2,8 @@
 
 Layout of a campaign directory::
 
-    DIR/campaign.json            what was asked (scenario, overrides, base seed, runs) and the backend
+    DIR/campaign.json            what was asked (scenario, overrides, base seed, runs, truth sources
+                                 switched off) and the backend
     DIR/runs/run_00000/          one finished run: scenario.json, summary.json, timeseries.npz
     DIR/runs/run_00007/error.json   a run that raised: its error and traceback
     DIR/summary.json             the aggregate of all finished runs
@@ -12,7 +13,9 @@ do not depend on which backend ran it, on how many workers there were, or on whe
 was interrupted. Each run is written to a temporary directory and renamed into place when
 complete, so a killed campaign leaves only whole runs; rerunning the command runs only the missing
 ones. The aggregate is computed from the files, in run order, and is therefore identical whichever
-way the runs were produced.
+way the runs were produced. A navigation campaign may switch error sources off in the truth alone
+(``truth_off``, :data:`navsim.ins.simulation.TRUTH_SOURCES`: the filter stays the scenario's), as
+the parts of ``navsim budget`` do.
 """
 
 import contextlib
@@ -31,6 +34,7 @@ from tqdm import tqdm
 
 from navsim.campaign import navigation
 from navsim.campaign.pooling import averaged_nees, calibration, diverged, spread
+from navsim.ins import simulation as ins_simulation
 from navsim.output import read_npz, write_json, write_run
 from navsim.places import campaign_lock, check_output, mark
 from navsim.records import CampaignSummary, RunSummary
@@ -60,20 +64,24 @@ ENVIRONMENT_ERRORS = (OSError, MemoryError, TimeoutError)
 
 
 @functools.lru_cache(maxsize=1)
-def _prepared(scenario_json, source):
-    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`), computed once
+def _prepared(scenario_json, source, truth_off=()):
+    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`; with truth
+    sources switched off, a navigation scenario's :func:`navsim.ins.simulation.prepare`), computed once
     per process and kept for every chunk it runs (a navigation truth takes seconds per hour)."""
-    return prepare(Scenario(data=json.loads(scenario_json), source=source))
+    scenario = Scenario(data=json.loads(scenario_json), source=source)
+    if truth_off:
+        return ins_simulation.prepare(scenario, truth_off=frozenset(truth_off))
+    return prepare(scenario)
 
 
-def run_chunk(scenario_data, source, members):
+def run_chunk(scenario_data, source, members, truth_off=()):
     """Run campaign members [(seed, run_dir), ...] of one scenario on its seed-free part (prepared once
-    per process); each run is written atomically, and a run that raises is recorded in
-    ``run_dir/error.json`` (with its cause: the scenario, or the environment when a rerun may cure
-    it) without stopping the others. Returns the errors."""
+    per process), with the truth's sources ``truth_off`` switched off; each run is written atomically,
+    and a run that raises is recorded in ``run_dir/error.json`` (with its cause: the scenario, or the
+    environment when a rerun may cure it) without stopping the others. Returns the errors."""
     errors = []
     try:
-        prepared = _prepared(json.dumps(scenario_data, sort_keys=True), source)
+        prepared = _prepared(json.dumps(scenario_data, sort_keys=True), source, tuple(sorted(truth_off)))
     except Exception as error:  # the scenario itself fails: every member records it
         prepared, failure = None, error
     for seed, run_dir in members:
@@ -108,14 +116,18 @@ def _record_failure(run_dir, seed, error):
     return message
 
 
-def _prepare(directory, scenario, runs, base_seed, backend):
-    """Write campaign.json (checked against an earlier one for a resume); returns the request."""
+def _prepare(directory, scenario, runs, base_seed, backend, truth_off=()):
+    """Write campaign.json (checked against an earlier one for a resume); returns the request. The
+    truth sources switched off are recorded only when there are some (``truth_off``)."""
     request = {"scenario": scenario.name, "source": scenario.source, "base_seed": base_seed, "backend": backend,
                "runs": runs, "scenario_data": scenario.data}
+    if truth_off:
+        request["truth_off"] = sorted(truth_off)
     path = directory / "campaign.json"
+    same = ("scenario_data", "base_seed", "truth_off")
     if path.exists():
         previous = _read_request(path)
-        if {k: previous.get(k) for k in ("scenario_data", "base_seed")} != {k: request[k] for k in ("scenario_data", "base_seed")}:
+        if {k: previous.get(k) for k in same} != {k: request.get(k) for k in same}:
             raise InputError(f"{directory}: holds a different campaign (scenario, overrides or seed differ); "
                              "use a new --out directory")
         request["runs"] = max(runs, int(previous.get("runs", 0)))
@@ -157,20 +169,27 @@ def _failure_cause(path):
 
 
 def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None, scheduler=None,
-                 progress=True, chunk_size=25, retry_failed=False):
+                 progress=True, chunk_size=25, retry_failed=False, truth_off=()):
     """Run (or resume) a campaign; returns the aggregate summary (also written to out/summary.json).
 
     ``workers``: local processes (default: the machine's cores); ``scheduler``: the address of a
     Dask distributed scheduler ('tcp://host:8786'), or a ``distributed.Client``. Runs are sent in
     chunks of at most ``chunk_size`` that share the scenario's seed-free part. Runs that failed
     for a cause outside the scenario are run again; ``retry_failed`` runs every failed run again.
-    Interrupted (Ctrl-C), it cancels what is pending and keeps every finished run.
+    Interrupted (Ctrl-C), it cancels what is pending and keeps every finished run. ``truth_off``
+    (navigation only): error sources the truth leaves out, the filter not
+    (:data:`navsim.ins.simulation.TRUTH_SOURCES`).
     """
     if not 1 <= runs <= MAX_RUNS:
         raise InputError(f"--runs must be from 1 to {MAX_RUNS:,}, got {runs}; for more, run several campaigns "
                          "with different --seed")
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a Monte Carlo campaign")
+    truth_off = sorted(truth_off)
+    if truth_off:
+        if not scenario.is_navigation:
+            raise InputError(f"{scenario.source}: truth_off needs a navigation scenario")
+        ins_simulation.check_truth_off(scenario, truth_off)
     directory = check_output(out, "campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)
@@ -178,14 +197,14 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     try:
         mark(directory, "campaign")
         with campaign_lock(directory):
-            request = _prepare(directory, scenario, runs, base_seed, _backend(scheduler, n_workers))
+            request = _prepare(directory, scenario, runs, base_seed, _backend(scheduler, n_workers), truth_off)
             todo = pending_runs(directory, request, retry_failed)
             members = [(run_seed(base_seed, k), str(directory / "runs" / RUN_DIR.format(k))) for k in todo]
             size = max(1, min(chunk_size, -(-len(members) // (4 * n_workers)) if members else 1))
             chunks = [members[i : i + size] for i in range(0, len(members), size)]
             with tqdm(total=request["runs"], initial=request["runs"] - len(todo), desc=f"{scenario.name} runs",
                       unit="run", disable=not progress) as bar:
-                _execute(scenario, chunks, n_workers, client, bar)
+                _execute(scenario, chunks, n_workers, client, bar, tuple(truth_off))
             summary = aggregate(directory)
             write_json(directory / "summary.json", summary.to_json())
     finally:
@@ -194,18 +213,18 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     return summary
 
 
-def _execute(scenario, chunks, n_workers, client, bar):
+def _execute(scenario, chunks, n_workers, client, bar, truth_off=()):
     """Run the chunks serially, on local processes or on a Dask cluster (``client``)."""
     if not chunks:
         return
     if client is not None:
-        _run_dask(scenario, chunks, client, bar)
+        _run_dask(scenario, chunks, client, bar, truth_off)
     elif n_workers == 1:
         for chunk in chunks:
-            run_chunk(scenario.data, scenario.source, chunk)
+            run_chunk(scenario.data, scenario.source, chunk, truth_off)
             bar.update(len(chunk))
     else:
-        _run_pool(scenario, chunks, n_workers, bar)
+        _run_pool(scenario, chunks, n_workers, bar, truth_off)
 
 
 #: One BLAS thread per worker process, set before the worker imports numpy: workers whose BLAS
@@ -229,12 +248,12 @@ def _environment(values):
                 os.environ[key] = value
 
 
-def _run_pool(scenario, chunks, n_workers, bar):
+def _run_pool(scenario, chunks, n_workers, bar, truth_off=()):
     """Local processes (freshly spawned, single-threaded BLAS); on Ctrl-C the pending chunks are
     cancelled and the workers stopped at once."""
     with _environment(SINGLE_THREADED_BLAS):
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
-        futures = {pool.submit(run_chunk, scenario.data, scenario.source, c): len(c) for c in chunks}
+        futures = {pool.submit(run_chunk, scenario.data, scenario.source, c, truth_off): len(c) for c in chunks}
     try:
         for future in as_completed(futures):
             future.result()
@@ -259,10 +278,10 @@ def _backend(scheduler, n_workers):
 SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls|ws|wss|ucx|inproc)://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}$")
 
 
-def _run_dask(scenario, chunks, client, bar):
+def _run_dask(scenario, chunks, client, bar, truth_off=()):
     from distributed import as_completed as dask_completed
 
-    futures = [client.submit(run_chunk, scenario.data, scenario.source, chunk, pure=False) for chunk in chunks]
+    futures = [client.submit(run_chunk, scenario.data, scenario.source, chunk, truth_off, pure=False) for chunk in chunks]
     sizes = {future.key: len(chunk) for future, chunk in zip(futures, chunks)}
     for future in dask_completed(futures):
         future.result()

@@ -14,6 +14,12 @@ Random sub-streams (``SeedSequence(seed).spawn(7)``, in this fixed order): 0 gyr
 is then generated per run), 6 the star sensor (at vector fidelity its noise directly; at image
 fidelity it spawns three, all before the first frame: 0 attitude jumps, 1 false-star storms,
 2 rendering).
+
+A run may switch error sources off in the truth alone (``truth_off``, :data:`TRUTH_SOURCES`; the
+error budget of :mod:`navsim.campaign.budget`): the filter is still built from the unchanged scenario
+(the same P0, Q, R, consider states and mounting σ) and every draw still comes from its sub-stream
+(a source switched off has its terms zero, not its draws skipped), so runs with different sources
+off share the other sources' draws exactly.
 """
 
 import dataclasses
@@ -35,9 +41,11 @@ from navsim.sensors import faults
 from navsim.sensors.aiding import AidingRun, draw_record
 from navsim.sensors.celestial_aiding import CelestialAidingRun
 from navsim.sensors.star_sensor import MODES
+from navsim.sensors.star_vector import AttitudeFixSensor, VectorRun
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
+from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
 
@@ -60,17 +68,53 @@ class NavigationPrepared:
     orientation: EarthOrientation | None = None
     bias_steps: tuple = ()
     attitude_jumps: tuple = ()
+    truth_off: frozenset = frozenset()
 
 
-def prepare(scenario, star_catalog=None):
+#: The error sources a run can switch off in the truth alone (``truth_off``), what each zeroes:
+TRUTH_SOURCES = {
+    "accel_bias": "the accelerometer's turn-on bias, bias instability and bias random walk",
+    "inertial": "the gyro errors, the accelerometer's VRW, scale factors, misalignments and quantization, "
+                "the gyro bias steps",
+    "gravity": "the gravity disturbance (deflections of the vertical, anomaly)",
+    "star_noise": "the star sensor's measurement noise (vector fidelity)",
+    "mounting": "the star sensor's mounting error (its true mounting is the nominal one)",
+    "initial": "the filter's initial error x0 (the filter starts at the truth)",
+    "aiding": "the baro's noise, bias and lag and the position fixes' noise",
+}
+#: The model terms each of "accel_bias" and "inertial" zeroes in the truth's gyro and accelerometer.
+ACCEL_BIAS_TERMS = {"bias_turn_on_sigma": 0.0, "bias_instability_sigma": 0.0, "bias_rw": 0.0, "bias_turn_on": None}
+GYRO_TERMS = {"arw": 0.0, "rrw": 0.0, "bias_turn_on_sigma": 0.0, "bias_instability_sigma": 0.0, "bias_turn_on": None,
+              "scale_factor_sigma": 0.0, "misalignment_sigma": 0.0, "quantization": 0.0}
+ACCEL_OTHER_TERMS = {"vrw": 0.0, "scale_factor_sigma": 0.0, "misalignment_sigma": 0.0, "quantization": 0.0}
+
+
+def check_truth_off(scenario, truth_off):
+    """``truth_off`` as a frozenset of :data:`TRUTH_SOURCES`; InputError for an unknown name, for a
+    star sensor's source without one, or for the star noise at image fidelity (it comes from the pixels)."""
+    truth_off = frozenset(truth_off)
+    unknown = sorted(truth_off - set(TRUTH_SOURCES))
+    if unknown:
+        raise InputError(f"truth_off: unknown source(s) {', '.join(unknown)}; choose from {', '.join(TRUTH_SOURCES)}")
+    sensor = scenario.data.get("star_sensor")
+    if sensor is None and truth_off & {"star_noise", "mounting"}:
+        raise InputError("truth_off: star_noise and mounting need a star sensor")
+    if "star_noise" in truth_off and sensor["fidelity"] == "image":
+        raise InputError("truth_off: the star noise cannot be switched off at image fidelity (it comes from the pixels)")
+    return truth_off
+
+
+def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     """The :class:`NavigationPrepared` of a validated navigation scenario; ``star_catalog`` (a
-    startrack StarCatalog) is loaded at the scenario's epoch when a star sensor needs it."""
+    startrack StarCatalog) is loaded at the scenario's epoch when a star sensor needs it;
+    ``truth_off`` names error sources the truth leaves out (:data:`TRUTH_SOURCES`), not the filter."""
+    truth_off = check_truth_off(scenario, truth_off)
     imu_hz = scenario["imu"]["rate_hz"]
     frame_hz = frame_rate(scenario.data, scenario.source)
     ratio = int(round(imu_hz / frame_hz))
     n_frames = int(round(scenario["duration_s"] * imu_hz)) // ratio
     grid = FrameGrid(dt=1.0 / imu_hz, ratio=ratio, n_frames=n_frames)
-    disturbance = build.gravity_disturbance(scenario)
+    disturbance = None if "gravity" in truth_off else build.gravity_disturbance(scenario)
     random_field = disturbance is not None and disturbance.correlation_length > 0.0
     truth = None if random_field else _truth(scenario, disturbance, None)
     gyro, accel = build.imu(scenario)
@@ -79,13 +123,15 @@ def prepare(scenario, star_catalog=None):
     if "star_sensor" in scenario.data:
         star_catalog = star_catalog or load_star_catalog(epoch=scenario.catalog_epoch)
         star_sensor = build.star_sensor(scenario, star_catalog)
+        if "mounting" in truth_off:
+            star_sensor = dataclasses.replace(star_sensor, q_BS_true=mounting(scenario["star_sensor"])[0])
         orientation = EarthOrientation.compute(scenario["epoch_utc"], grid.frame_k * grid.dt)
     return NavigationPrepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
                               baro_every=0 if baro is None else int(round(frame_hz / baro.rate_hz)),
                               position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
                               star_sensor=star_sensor, orientation=orientation,
                               bias_steps=faults.bias_steps(scenario["faults"]),
-                              attitude_jumps=faults.attitude_jumps(scenario["faults"]))
+                              attitude_jumps=faults.attitude_jumps(scenario["faults"]), truth_off=truth_off)
 
 
 def _truth(scenario, disturbance, seed):
@@ -95,27 +141,31 @@ def _truth(scenario, disturbance, seed):
 
 def simulate(prepared, seed, compiled=True):
     """One seeded navigation run; returns a :class:`~navsim.records.RunResult`. ``compiled=False``
-    keeps the step-by-step loop where the filter's fast path would run."""
+    keeps the step-by-step loop where the filter's fast path would run. The filter is the scenario's
+    whatever ``prepared.truth_off`` switches off in the truth."""
     started = time.perf_counter()
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
     gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss, star_ss = np.random.SeedSequence(seed).spawn(7)
     truth = p.truth if p.truth is not None else _truth(scenario, p.disturbance, gravity_ss)
     n = grid.n_frames * grid.ratio
-    gyro = p.gyro.measure(truth.dtheta[:n] / grid.dt, gyro_ss)
-    omega, bias = faults.apply_bias_steps(gyro.omega, gyro.bias, truth.t[1:n + 1], p.bias_steps)
-    gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
-    accel = p.accel.measure(truth.dv[:n] / grid.dt, accel_ss)
+    gyro_truth, accel_truth = truth_imu(p)
+    gyro = gyro_truth.measure(truth.dtheta[:n] / grid.dt, gyro_ss)
+    if "inertial" not in p.truth_off:
+        omega, bias = faults.apply_bias_steps(gyro.omega, gyro.bias, truth.t[1:n + 1], p.bias_steps)
+        gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
+    accel = accel_truth.measure(truth.dv[:n] / grid.dt, accel_ss)
     gravity = build.gravity_uncertainty(scenario, truth.lat[0], truth.h[0])
     P0 = build.initial_covariance(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0])
-    filt = build.nav_filter(scenario, p.gyro, p.accel, _start(truth, P0, init_ss), P0, grid.dt, p.orientation, gravity)
-    record = draw_record(truth, grid.frame_k, p.position_sensor, p.baro, p.baro_every, position_ss, baro_ss)
+    start = _start(truth, P0, init_ss, zero="initial" in p.truth_off)
+    filt = build.nav_filter(scenario, p.gyro, p.accel, start, P0, grid.dt, p.orientation, gravity)
+    record = _aiding_record(p, truth, position_ss, baro_ss)
     sensor_run, loop_truth, jumps, sky = AidingRun(record), truth, None, None
     if p.star_sensor is not None:
         sky = SkyTruth.of(truth, p.orientation, grid.frame_k)
         star_run, jumps = _star_run(p, sky, star_ss)
         sensor_run, loop_truth = CelestialAidingRun(star_run, sensor_run), sky
     log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, compiled=compiled)
-    q_BS_true = mounting(scenario["star_sensor"])[1] if p.star_sensor is not None else None
+    q_BS_true = p.star_sensor.q_BS_true if p.star_sensor is not None else None
     series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true)
     series["error_sigma_initial"] = np.sqrt(np.diag(P0))
     if p.star_sensor is not None:
@@ -135,21 +185,54 @@ def simulate(prepared, seed, compiled=True):
                      timing_series=log.timing)
 
 
+def truth_imu(prepared):
+    """(gyro, accelerometer) models the truth's IMU record is drawn with: the scenario's, with the
+    terms of the sources in ``prepared.truth_off`` zero (the filter keeps ``prepared.gyro``, ``.accel``)."""
+    gyro, accel = prepared.gyro, prepared.accel
+    if "accel_bias" in prepared.truth_off:
+        accel = dataclasses.replace(accel, **ACCEL_BIAS_TERMS)
+    if "inertial" in prepared.truth_off:
+        gyro, accel = dataclasses.replace(gyro, **GYRO_TERMS), dataclasses.replace(accel, **ACCEL_OTHER_TERMS)
+    return gyro, accel
+
+
+def _aiding_record(prepared, truth, position_ss, baro_ss):
+    """The baro and position-fix record of a run; without their errors when ``truth_off`` has
+    "aiding" (the record keeps the sensors' σ, the filter's R)."""
+    p = prepared
+    record = draw_record(truth, p.grid.frame_k, p.position_sensor, p.baro, p.baro_every, position_ss, baro_ss)
+    if "aiding" not in p.truth_off:
+        return record
+    fixes = None if p.position_sensor is None else dataclasses.replace(p.position_sensor, sigma_ned=np.zeros(3))
+    baro = None if p.baro is None else dataclasses.replace(p.baro, noise_sigma=0.0, bias_sigma=0.0, bias_rw=0.0,
+                                                           lag_time_constant=0.0)
+    exact = draw_record(truth, p.grid.frame_k, fixes, baro, p.baro_every, position_ss, baro_ss)
+    return dataclasses.replace(exact, position_sigma=record.position_sigma, baro_sigma=record.baro_sigma)
+
+
 def _star_run(prepared, sky, seed):
     """(the star sensor's run, its attitude jumps or None) for the sky truth ``sky``: at vector fidelity
-    every frame drawn from ``seed``; at image fidelity the streams of jumps, storms and rendering."""
+    every frame drawn from ``seed`` (without noise when ``truth_off`` has "star_noise": the record keeps
+    the sensor's σ, the filter's R); at image fidelity the streams of jumps, storms and rendering."""
     sensor, grid = prepared.star_sensor, prepared.grid
     if prepared.scenario["star_sensor"]["fidelity"] != "image":
-        return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), None
+        if "star_noise" not in prepared.truth_off:
+            return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), None
+        if isinstance(sensor, AttitudeFixSensor):
+            quiet, kept = dataclasses.replace(sensor, sigma_cross=0.0, sigma_roll=0.0), {"R_S": sensor.R_S}
+        else:
+            quiet, kept = dataclasses.replace(sensor, sigma=0.0), {"sigma": sensor.sigma}
+        record = quiet.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I).record()
+        return VectorRun(dataclasses.replace(record, **kept)), None
     jump_ss, storm_ss, render_ss = seed.spawn(3)
     run = sensor.start(np.random.default_rng(storm_ss), np.random.default_rng(render_ss), grid.n_frames)
     jumps = faults.AttitudeJumps(prepared.attitude_jumps, np.random.default_rng(jump_ss)) if prepared.attitude_jumps else None
     return run, jumps
 
 
-def _start(truth, P0, seed):
+def _start(truth, P0, seed, zero=False):
     """(L, λ, h, v_n, q_nb) of the filter: the truth at t = 0 with an error x0 ~ N(0, P0) in attitude
-    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position."""
-    x0 = np.linalg.cholesky(P0[:9, :9]) @ np.random.default_rng(seed).standard_normal(9)
+    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position (``zero``: x0 = 0)."""
+    x0 = np.linalg.cholesky(P0[:9, :9]) @ np.random.default_rng(seed).standard_normal(9) * (0.0 if zero else 1.0)
     q0 = rot.multiply(rot.from_rotation_vector(-x0[0:3]), truth.q_nb[0])
     return truth.lat[0] + x0[6], truth.lon[0] + x0[7], truth.h[0] + x0[8], truth.v_n[0] + x0[3:6], q0
