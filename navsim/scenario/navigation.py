@@ -294,10 +294,23 @@ def _check_star_sensor(checked, source):
         if outage["end_s"] - outage["start_s"] > duration or length >= duration:
             raise InputError(f"{source}: faults.outages[{k}]: the outage ({outage['start_s']:g}-{outage['end_s']:g} s) is "
                              f"longer than the flight (duration_s = {duration:g} s): the star sensor would never see a star")
+    if faults["outages"] and _covered_until(faults["outages"]) >= duration:
+        raise InputError(f"{source}: faults.outages: together they cover the whole flight (0-{duration:g} s): the star "
+                         "sensor would never see a star")
     highest = boresight_elevation(checked).max()
     if highest < 0.0:
         raise InputError(f"{source}: star_sensor.mounting_rotvec_deg: the boresight points below the horizon for the whole "
                          f"flight (highest elevation {np.degrees(highest):.1f} deg): the star sensor would see the ground")
+
+
+def _covered_until(outages):
+    """The end [s] of the span from t = 0 the ``outages`` cover without a gap (0 if the first starts later)."""
+    end = 0.0
+    for outage in sorted(outages, key=lambda o: o["start_s"]):
+        if outage["start_s"] > end:
+            break
+        end = max(end, outage["end_s"])
+    return end
 
 
 def boresight_elevation(checked, samples=ELEVATION_SAMPLES):

@@ -32,6 +32,8 @@ BAD = [
     ("faults.outages=[{start_s = 0.0, end_s = 40.0}]", "faults.outages[0]", "longer than the flight"),
     ("faults.outages=[{start_s = 5.0, end_s = 100.0}]", "faults.outages[0]", "longer than the flight"),
     (f"faults.outages=[{{start_s = 0.0, end_s = {DURATION_S}}}]", "faults.outages[0]", "longer than the flight"),
+    ("faults.outages=[{start_s = 15.0, end_s = 40.0}, {start_s = 0.0, end_s = 15.0}]", "faults.outages",
+     "cover the whole flight"),
 ]
 
 
@@ -59,8 +61,10 @@ def test_the_base_flight_lasts_what_the_cases_assume():
 
 @pytest.mark.parametrize("name", ["run", "montecarlo"])
 @pytest.mark.parametrize("setting", ["faults.outages=[{start_s = 0.0, end_s = 30.0}]",
+                                     "faults.outages=[{start_s = 12.0, end_s = 40.0}, {start_s = 0.0, end_s = 10.0}]",
                                      f"star_sensor.mounting_rotvec_deg={LEFT_WING_LOW}"],
-                         ids=["outage of all but the last 3 s", "boresight above the horizon only in the bank"])
+                         ids=["outage of all but the last 3 s", "two outages with a gap",
+                              "boresight above the horizon only in the bank"])
 def test_the_edges_are_accepted_and_run(tmp_path, capsys, name, setting):
     out = tmp_path / "out"
     status, err = run_cli(cli.main, command(name, out, setting), capsys)
