@@ -52,7 +52,7 @@ from startrack.star_catalog import load_star_catalog
 @dataclass(frozen=True)
 class NavigationPrepared:
     """The seed-free part of a navigation scenario: the truth (None when a random gravity disturbance
-    makes it the run's own), the frame grid, the IMU, baro and position-fix models, the star sensor
+    makes it the run's own: then its seed-free ``kinematics``, which every run completes), the frame grid, the IMU, baro and position-fix models, the star sensor
     (None without one) with the Earth's orientation at the frames, and the faults."""
 
     scenario: object
@@ -69,6 +69,7 @@ class NavigationPrepared:
     bias_steps: tuple = ()
     attitude_jumps: tuple = ()
     truth_off: frozenset = frozenset()
+    kinematics: trajectory.Kinematics | None = None
 
 
 #: The error sources a run can switch off in the truth alone (``truth_off``), what each zeroes:
@@ -116,7 +117,8 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     grid = FrameGrid(dt=1.0 / imu_hz, ratio=ratio, n_frames=n_frames)
     disturbance = None if "gravity" in truth_off else build.gravity_disturbance(scenario)
     random_field = disturbance is not None and disturbance.correlation_length > 0.0
-    truth = None if random_field else _truth(scenario, disturbance, None)
+    kinematics = trajectory.kinematics(build.profile(scenario), imu_hz, duration=scenario["duration_s"])
+    truth = None if random_field else trajectory.with_gravity(kinematics, disturbance)
     gyro, accel = build.imu(scenario)
     baro = build.baro(scenario)
     star_sensor = orientation = None
@@ -131,12 +133,8 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
                               position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
                               star_sensor=star_sensor, orientation=orientation,
                               bias_steps=faults.bias_steps(scenario["faults"]),
-                              attitude_jumps=faults.attitude_jumps(scenario["faults"]), truth_off=truth_off)
-
-
-def _truth(scenario, disturbance, seed):
-    return trajectory.generate(build.profile(scenario), scenario["imu"]["rate_hz"], disturbance, seed,
-                               duration=scenario["duration_s"])
+                              attitude_jumps=faults.attitude_jumps(scenario["faults"]), truth_off=truth_off,
+                              kinematics=kinematics if random_field else None)
 
 
 def simulate(prepared, seed, compiled=True):
@@ -146,7 +144,7 @@ def simulate(prepared, seed, compiled=True):
     started = time.perf_counter()
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
     gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss, star_ss = np.random.SeedSequence(seed).spawn(7)
-    truth = p.truth if p.truth is not None else _truth(scenario, p.disturbance, gravity_ss)
+    truth = p.truth if p.truth is not None else trajectory.with_gravity(p.kinematics, p.disturbance, gravity_ss)
     n = grid.n_frames * grid.ratio
     gyro_truth, accel_truth = truth_imu(p)
     gyro = gyro_truth.measure(truth.dtheta[:n] / grid.dt, gyro_ss)

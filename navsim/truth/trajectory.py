@@ -79,10 +79,34 @@ class Trajectory:
         return State(lat=self.lat[k], lon=self.lon[k], h=self.h[k], v_n=self.v_n[k], q_nb=self.q_nb[k])
 
 
+@dataclass(frozen=True)
+class Kinematics:
+    """The seed-free part of a truth trajectory: the ``profile``, the N + 1 sample times ``t`` [s], the
+    segments' ``channels`` there, ``v_n`` (N+1, 3) [m/s], ``lat``, ``lon`` [rad], ``h`` [m] and ``q_nb``
+    (N+1, 4). A gravity disturbance changes only the specific force, so a random one drawn per run
+    reuses them (:func:`with_gravity`)."""
+
+    profile: object
+    t: np.ndarray
+    channels: object
+    v_n: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    h: np.ndarray
+    q_nb: np.ndarray
+    rate_hz: float
+
+
 def generate(profile, rate_hz, disturbance=None, seed=None, duration=None):
     """The truth :class:`Trajectory` of ``profile`` sampled at ``rate_hz`` [Hz] over its whole
     duration, or its first ``duration`` [s] (the last partial interval dropped). ``disturbance`` is an
     optional :class:`~navsim.earth.gravity.GravityDisturbance`; a random one draws from ``seed``."""
+    return with_gravity(kinematics(profile, rate_hz, duration), disturbance, seed)
+
+
+def kinematics(profile, rate_hz, duration=None):
+    """The :class:`Kinematics` of ``profile`` at ``rate_hz`` [Hz] over its duration or its first
+    ``duration`` [s]: velocity and attitude in closed form, position by quadrature (module docstring)."""
     if not (isinstance(rate_hz, (int, float)) and rate_hz > 0.0 and np.isfinite(rate_hz)):
         raise InputError(f"imu.rate_hz: must be > 0, got {rate_hz!r}")
     dt = 1.0 / rate_hz
@@ -95,16 +119,24 @@ def generate(profile, rate_hz, disturbance=None, seed=None, duration=None):
     v_samples = _velocity(at_samples)
     v_nodes = np.concatenate([_velocity(profile.channels(_node_times(t, lo, hi))) for lo, hi in _chunks(n)])
     lat, lon, h = _position(profile.start, dt, v_samples, v_nodes)
-    gamma_components = _disturbance_components(disturbance, seed, at_samples, dt)
+    return Kinematics(profile=profile, t=t, channels=at_samples, v_n=v_samples, lat=lat, lon=lon, h=h,
+                      q_nb=attitude(at_samples), rate_hz=float(rate_hz))
+
+
+def with_gravity(kin, disturbance=None, seed=None):
+    """The :class:`Trajectory` of :class:`Kinematics` ``kin`` under the truth gravity: normal gravity
+    plus the optional ``disturbance`` (a random one drawn from ``seed``), which sets the increments."""
+    n, dt = kin.t.size - 1, 1.0 / kin.rate_hz
+    gamma_components = _disturbance_components(disturbance, seed, kin.channels, dt)
     dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
     for lo, hi in _chunks(n):
-        dtheta[lo:hi], dv[lo:hi] = _increments(profile, t, lo, hi, (lat, lon, h), v_samples, gamma_components)
-    q_nb = attitude(at_samples)
+        dtheta[lo:hi], dv[lo:hi] = _increments(kin.profile, kin.t, lo, hi, (kin.lat, kin.lon, kin.h), kin.v_n,
+                                               gamma_components)
     delta_g = np.zeros((n + 1, 3))
     if gamma_components is not None:
-        delta_g = disturbance_n(gamma_components, normal_gravity(lat, h))
-    return Trajectory(t=t, lat=lat, lon=lon, h=h, v_n=v_samples, q_nb=q_nb, dtheta=dtheta, dv=dv,
-                      gravity_disturbance=delta_g, rate_hz=float(rate_hz))
+        delta_g = disturbance_n(gamma_components, normal_gravity(kin.lat, kin.h))
+    return Trajectory(t=kin.t, lat=kin.lat, lon=kin.lon, h=kin.h, v_n=kin.v_n, q_nb=kin.q_nb, dtheta=dtheta, dv=dv,
+                      gravity_disturbance=delta_g, rate_hz=kin.rate_hz)
 
 
 def _chunks(n):
