@@ -52,6 +52,24 @@ def quat_to_matrix(q):
 
 
 @njit
+def quat_from_matrix(R):
+    """Scalar-last unit quaternion, w >= 0, of the rotation matrix R (3, 3) (Shepperd's pivot, as
+    :func:`startrack.rotation.from_matrix`)."""
+    trace = R[0, 0] + R[1, 1] + R[2, 2]
+    q = np.empty(4)
+    if trace >= R[0, 0] and trace >= R[1, 1] and trace >= R[2, 2]:
+        q[0], q[1], q[2], q[3] = R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1], 1.0 + trace
+    elif R[0, 0] >= R[1, 1] and R[0, 0] >= R[2, 2]:
+        q[0], q[1], q[2], q[3] = 1.0 + R[0, 0] - R[1, 1] - R[2, 2], R[0, 1] + R[1, 0], R[0, 2] + R[2, 0], R[2, 1] - R[1, 2]
+    elif R[1, 1] >= R[2, 2]:
+        q[0], q[1], q[2], q[3] = R[0, 1] + R[1, 0], 1.0 - R[0, 0] + R[1, 1] - R[2, 2], R[1, 2] + R[2, 1], R[0, 2] - R[2, 0]
+    else:
+        q[0], q[1], q[2], q[3] = R[0, 2] + R[2, 0], R[1, 2] + R[2, 1], 1.0 - R[0, 0] - R[1, 1] + R[2, 2], R[1, 0] - R[0, 1]
+    norm = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return q / (-norm if q[3] < 0.0 else norm)
+
+
+@njit
 def rotation_vector(q):
     """Rotation vector of a unit quaternion (angle in [0, π]), shortest-path sign."""
     s = np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)

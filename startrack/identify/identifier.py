@@ -51,7 +51,7 @@ from startrack.identify.tracking import Tracking, propagate
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
 from startrack.identify.warmup import load_kernels
 from startrack.jit import njit
-from startrack.rotation import from_matrix
+from startrack.rotation_jit import quat_from_matrix
 
 #: Strategy names in the order they are tried.
 METHODS = ("tracking", "subcatalog", "lost_in_space")
@@ -255,7 +255,7 @@ class StarIdentifier:
         if strategy.name == "tracking":
             lost, entered = strategy.lost_and_entered(prior, verified.R_IS, matches[:, 1])
         return IdentificationResult(
-            status="ok", q_IS=from_matrix(verified.R_IS), matches=matches, obs_S=obs_S, ref_I=ref_I,
+            status="ok", q_IS=quat_from_matrix(verified.R_IS), matches=matches, obs_S=obs_S, ref_I=ref_I,
             sigma=self._sigma, false_match_probability=verified.false_match_probability, method=strategy.name,
             solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered)
 

@@ -59,6 +59,14 @@ def test_compiled_twin_equals_the_numpy_forms():
     np.testing.assert_allclose(rotation_jit.skew(w) @ p[:3], np.cross(w, p[:3]), atol=1e-15)
 
 
+def test_compiled_quaternion_of_a_matrix_takes_every_pivot():
+    """Near-identity (trace pivot) and ~180 deg about x, y, z (each diagonal pivot), plus random rotations."""
+    angles = np.array([[1e-3, -2e-3, 5e-4], [3.1, 0.05, -0.02], [0.03, 3.1, 0.04], [-0.02, 0.01, 3.1]])
+    q = np.vstack([rot.from_rotation_vector(angles), random_quats(50)])
+    for R in rot.to_matrix(q):
+        np.testing.assert_allclose(rotation_jit.quat_from_matrix(R), rot.from_matrix(R), atol=1e-15)
+
+
 def test_quaternion_matrix_conversions_match_scipy():
     rotations = Rotation.random(500, random_state=1)
     R = rotations.as_matrix()
