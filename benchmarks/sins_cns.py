@@ -12,8 +12,8 @@ Measured:
   filter (the closed loop, frame by frame) and the rest (series, summary). Two configurations: the
   issue's 18 states (the INS's 15 and the mounting; no gravity field, so the truth trajectory is
   built once by prepare) and the shipped scenario's 21 (a random gravity field along the track, three
-  consider states; the field is drawn per run, so every run completes the seed-free kinematics
-  prepare built with its own increments);
+  consider states; the field is drawn per run, so every run adds its term to the seed-free
+  increments prepare built);
 - image fidelity: the first --image-minutes (default 10) of flight, every frame rendered, detected
   and identified with the INS's prediction: the real-time factor (simulated s / wall s) and the
   wall milliseconds per frame of one run after a warm-up run of one minute;
