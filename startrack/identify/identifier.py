@@ -13,9 +13,11 @@ catalog's magnitude limit) and three strategies, each an object with ``identify(
 Each strategy is one compiled call per frame (:mod:`startrack.identify.pyramid`: feature search,
 hypotheses, verification and refit); the Python layer checks the input, orders the centroids and
 turns them into directions (one compiled call), and builds the result.  Profile of the full-sky call
-on the benchmark frames (16 deg, ~30 centroids, warm, median): ~13 us Python (input, result),
-~25 us compiled, of which ~8 us verification (two match/refit passes) and ~3 us features; before
-issue 17 the same call took ~180 us, ~60 us of it in Python orchestration of several kernels.
+on the benchmark frames (16 deg, ~30 centroids, each frame solved once in turn, median ~50 us):
+~10 us Python (input, result, kernel dispatch), 3 us directions, 2 us features, 4.5 us N_h (the
+hypothesis count of the false-match probability), ~17 us triangles and pyramids, ~11 us verification
+(match/refit passes); the same frame solved again takes ~38 us (its tables and branches are then in
+the caches).  Before issue 17 the call took ~180 us, ~60 us of it in Python orchestration.
 
 ``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
 vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
