@@ -88,12 +88,11 @@ class Trajectory:
 
 @dataclass(frozen=True)
 class Kinematics:
-    """The seed-free part of a truth trajectory: the ``profile``, the N + 1 sample times ``t`` [s], the
-    segments' ``channels`` there, ``v_n`` (N+1, 3) [m/s], ``lat``, ``lon`` [rad], ``h`` [m], ``q_nb``
+    """The seed-free part of a truth trajectory: the N + 1 sample times ``t`` [s], the segments'
+    ``channels`` there, ``v_n`` (N+1, 3) [m/s], ``lat``, ``lon`` [rad], ``h`` [m], ``q_nb``
     (N+1, 4), and the increments ``dtheta``, ``dv`` (N, 3) under normal gravity. A gravity disturbance
     changes only the specific force, so a random one drawn per run reuses them (:func:`with_gravity`)."""
 
-    profile: object
     t: np.ndarray
     channels: object
     v_n: np.ndarray
@@ -131,7 +130,7 @@ def kinematics(profile, rate_hz, duration=None):
     dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
     for lo, hi in _chunks(n):
         dtheta[lo:hi], dv[lo:hi] = _increments(profile, t, lo, hi, (lat, lon, h), v_samples)
-    return Kinematics(profile=profile, t=t, channels=at_samples, v_n=v_samples, lat=lat, lon=lon, h=h,
+    return Kinematics(t=t, channels=at_samples, v_n=v_samples, lat=lat, lon=lon, h=h,
                       q_nb=attitude(at_samples), dtheta=dtheta, dv=dv, rate_hz=float(rate_hz))
 
 
