@@ -171,6 +171,10 @@ def address_of_index(index, n_d: int):
 
 def sub_catalog_index(ra, dec, n_d: int):
     """Flat sub-catalog index serving boresights (ra, dec) [rad]: eq. 7-8 then :func:`base_index`."""
+    if isinstance(ra, float) and isinstance(dec, float):  # one boresight (the per-frame hot path)
+        n_d = _check_n_d(n_d)
+        l_d, l_ra = _address_scalar(ra, dec, n_d)
+        return _ring_lists(n_d)[1][l_d - 1] + l_ra - 1
     l_d, l_ra = address(ra, dec, n_d)
     return base_index(l_d, l_ra, n_d)
 

@@ -10,14 +10,15 @@ catalog's magnitude limit) and three strategies, each an object with ``identify(
 * :class:`~startrack.identify.lost_in_space.LostInSpace` -- needs nothing; searches the pairs of every
   field star (``dense_fallback``, the default) or of the guide catalog.
 
-Each strategy is one compiled call per frame (:mod:`startrack.identify.pyramid`: feature search,
-hypotheses, verification and refit); the Python layer checks the input, orders the centroids and
-turns them into directions (one compiled call), and builds the result.  Profile of the full-sky call
-on the benchmark frames (16 deg, ~30 centroids, each frame solved once in turn, median ~50 us):
-~10 us Python (input, result, kernel dispatch), 3 us directions, 2 us features, 4.5 us N_h (the
-hypothesis count of the false-match probability), ~17 us triangles and pyramids, ~11 us verification
-(match/refit passes); the same frame solved again takes ~38 us (its tables and branches are then in
-the caches).  Before issue 17 the call took ~180 us, ~60 us of it in Python orchestration.
+Each strategy is one compiled call per frame (lost-in-space: :mod:`startrack.identify.pattern_hash`'s
+look-ups, then :mod:`startrack.identify.pyramid`'s search; hypotheses, verification and refit); the
+Python layer checks the input, orders the centroids and turns them into directions (one compiled
+call), and builds the result.  Profile of the full-sky call on the benchmark frames (16 deg, ~30
+centroids, 0-3 false, each frame solved once in turn, median ~33 us): ~3.5 us directions, ~22 us the
+compiled search (12 us with warm caches: ~6.5 us verification, ~5 us look-ups; the rest is the tables
+a new frame reads from memory), ~6 us the result (matches, quaternion, record), ~2 us checks and
+dispatch.  Before issue 17 the call took ~180 us, ~60 us of it in Python orchestration; the pyramid
+search alone (no look-ups) ~50 us.
 
 ``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
 vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
@@ -54,6 +55,7 @@ from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
 from startrack.identify.warmup import load_kernels
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_matrix
+from startrack.sphere import radec_to_vector
 
 #: Strategy names in the order they are tried.
 METHODS = ("tracking", "subcatalog", "lost_in_space")
@@ -98,6 +100,14 @@ class Prior:
         if self.q_IS is None:
             return None
         return propagate(self.q_IS, _NO_RATE if self.rate_S is None else self.rate_S, float(self.dt))
+
+    def boresight_vector(self):
+        """Unit vector (3,) in I of the predicted boresight, or None."""
+        if self.q_IS is not None:
+            return np.ascontiguousarray(self.predicted_R_IS[:, 2])
+        if self.boresight is not None:
+            return radec_to_vector(*self.boresight)
+        return None
 
     def boresight_radec(self):
         """(ra, dec) [rad] of the predicted boresight, or None."""
@@ -164,7 +174,7 @@ class StarIdentifier:
         self.field = field_stars
         window_px = _positive("tracking_window_px", tracking_window_px, 1e4)
         context = SearchContext(catalog, self.field, self.pattern_stars, self.verify_gate, self.false_match_threshold,
-                                self.centroid_sigma_px / camera.focal_px, dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
+                                self.centroid_sigma_px / camera.focal_px, self.delta_px, dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
         available = {
             "tracking": lambda: Tracking(context, window_px),
             "subcatalog": lambda: SubCatalog(context, neighbours),

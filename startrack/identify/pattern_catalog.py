@@ -155,6 +155,20 @@ def pack_key(bins, base):  # pragma: no cover  (compiled)
 
 
 @njit(_nrt=False)
+def next_bins(bins, low, high):  # pragma: no cover  (compiled)
+    """Step the five bin numbers ``bins`` to the next combination within [low, high] (an odometer);
+    False when every combination has been visited."""
+    k = 0
+    while k < 5 and bins[k] == high[k]:
+        bins[k] = low[k]
+        k += 1
+    if k == 5:
+        return False
+    bins[k] += 1
+    return True
+
+
+@njit(_nrt=False)
 def hash_slot(key, mask):  # pragma: no cover  (compiled)
     """Start slot of ``key`` in a table of mask + 1 <= 2^32 slots (Knuth's multiplicative hashing, the
     64-bit golden-ratio constant)."""
@@ -285,10 +299,11 @@ class PatternLevel:
         return self.stars, self.keys, self.slots, float(self.width), int(self.base), float(self.tolerance)
 
 
-def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> PatternLevel:
-    """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag)."""
+def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams, min_width: float = 0.0) -> PatternLevel:
+    """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag); its bins
+    are at least ``min_width`` wide (ratio units)."""
     tolerance = model_tolerance(fov)
-    width = 2.0 * tolerance + NOISE_TOLERANCE
+    width = max(2.0 * tolerance + NOISE_TOLERANCE, float(min_width))
     base = int(math.ceil(1.0 / width)) + 1
     patterns = level_patterns(vectors, v_mag, fov, params)
     keys = _pattern_keys(vectors, patterns, width, base)

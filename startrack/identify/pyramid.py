@@ -212,17 +212,19 @@ def _attitude(obs, observed, stars, vectors):  # pragma: no cover  (compiled)
 
 
 @njit
-def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field, head, triangles):  # pragma: no cover
+def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field, head, triangles,
+           n_h_before):  # pragma: no cover  (compiled)
     """Pyramids of the brightest n centroids, each verified when found (module text).
 
     ``vectors`` (N, 3): the stars the table indexes; ``head`` (N,) int32 work array of -1;
     ``triangles`` (TRIANGLE_BUFFER, 6) int64 receives the unextended triangles (3 centroids, 3 catalog
-    stars).  Returns (verify_near's tuple, N_h, triangles kept).
+    stars); ``n_h_before``: hypotheses an earlier search of the frame could make (added to N_h).
+    Returns (verify_near's tuple, N_h, triangles kept).
     """
     lo = np.full((n, n), -1, np.int64)
     hi = np.full((n, n), -1, np.int64)
     counts = np.full((n, n), -1.0)
-    n_h = hypothesis_count(n, beta, gate, table, counts, lo, hi)
+    n_h = hypothesis_count(n, beta, gate, table, counts, lo, hi) + int(np.ceil(n_h_before))
     found = np.empty((TRIANGLE_BUFFER, 3), np.int64)
     tri = np.empty(3, np.int64)
     x_slots = np.empty(2, np.int64)

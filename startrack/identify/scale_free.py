@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from startrack.identify.pattern_catalog import edge_ratios, pack_key, run_start
+from startrack.identify.pattern_catalog import edge_ratios, next_bins, pack_key, run_start
 from startrack.identify.self_calibration import brightest_in_field, verify_calibrate
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
@@ -80,7 +80,7 @@ def _unit_vectors(uv, stars, focal, cx, cy):  # pragma: no cover  (compiled)
 
 
 @njit
-def _angle_matrix(vectors, stars):  # pragma: no cover  (compiled)
+def angle_matrix(vectors, stars):  # pragma: no cover  (compiled)
     """(4, 4) angular distances [rad] of the four unit vectors ``vectors[stars]``."""
     out = np.zeros((4, 4))
     for i in range(4):
@@ -92,7 +92,7 @@ def _angle_matrix(vectors, stars):  # pragma: no cover  (compiled)
 
 
 @njit
-def _correspondence(observed, catalog):  # pragma: no cover  (compiled)
+def correspondence(observed, catalog):  # pragma: no cover  (compiled)
     """(permutation p, cost): catalog star p[i] for observed star i minimising the sum of squared
     differences of the six normalised angles (``observed``, ``catalog``: (4, 4) angle matrices)."""
     scale_o, scale_c = observed.max(), catalog.max()
@@ -114,7 +114,7 @@ def _focal_length(uv, stars, cx, cy, focal, catalog_sum):  # pragma: no cover  (
     index = np.arange(4)
     for _ in range(4):
         vectors = _unit_vectors(uv, stars, focal, cx, cy)
-        focal *= _angle_matrix(vectors, index).sum() / (2.0 * catalog_sum)
+        focal *= angle_matrix(vectors, index).sum() / (2.0 * catalog_sum)
     return focal
 
 
@@ -122,9 +122,9 @@ def _focal_length(uv, stars, cx, cy, focal, catalog_sum):  # pragma: no cover  (
 def _hypothesis(uv, stars, cat, vectors, cx, cy, f_start, f_range, eps):  # pragma: no cover  (compiled)
     """(ok, R_IS, f) of the observed pattern ``stars`` (indices into uv) matched to the catalog pattern
     ``cat`` (indices into vectors): correspondence, focal length, attitude and the mirror check."""
-    catalog = _angle_matrix(vectors, cat)
-    observed = _angle_matrix(_unit_vectors(uv, stars, f_start, cx, cy), np.arange(4))
-    perm, cost = _correspondence(observed, catalog)
+    catalog = angle_matrix(vectors, cat)
+    observed = angle_matrix(_unit_vectors(uv, stars, f_start, cx, cy), np.arange(4))
+    perm, cost = correspondence(observed, catalog)
     if cost > 6.0 * eps * eps:
         return False, np.eye(3), 0.0
     focal = _focal_length(uv, stars, cx, cy, f_start, catalog.sum() / 2.0)
@@ -229,13 +229,8 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
                     mismatch[count], tolerance_of[count] = worst, eps
                     count += 1
                 e += 1
-            k = 0  # next bin combination (odometer over the five ranges)
-            while k < 5 and bins[k] == high[k]:
-                bins[k] = low[k]
-                k += 1
-            if k == 5:
+            if not next_bins(bins, low, high):
                 break
-            bins[k] += 1
     return count, mismatch[:count], tolerance_of[:count]
 
 

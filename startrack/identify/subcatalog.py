@@ -14,29 +14,29 @@ rho_sub east, west, north and south are searched in turn
 (:meth:`startrack.navigation_catalog.NavigationCatalog.redundant_neighbours`); 000 states that this
 tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000 §5).
 
-With the dense table (every field star's pairs, ``dense_fallback``) the search after the predicted
-sub-catalog is instead the one over every field star within 2 rho_sub of the predicted boresight: it
-holds every star of the four redundant sub-catalogs (their base points lie rho_sub from the boresight,
+With the dense table (every field star's pairs, ``dense_fallback``) the search is instead the one over
+every field star within 2 rho_sub of the predicted boresight: it holds every star of the predicted
+sub-catalog and of its four redundant neighbours (their base points lie rho_sub from the boresight,
 their stars within rho_sub of those) and also the stars the uniform guide selection of 000 §2.1 left
 out, so it identifies every frame they would and the frames whose brightest stars hold too few guide
-stars (about half of the rendered frames of 000 §5 with at most 7 stars); searching the neighbours
-first would only cost time.  Its candidate pairs come from the k-vector ranges of the observed gates,
-restricted to the region; the caller (:class:`startrack.identify.StarIdentifier`) falls back to the
-full sky when this fails too.
+stars (about half of the rendered frames of 000 §5 with at most 7 stars); searching the guide
+sub-catalogs first would only cost time (their pyramid walks ~70 observed triangles before one of guide
+stars on the benchmark frames, against ~2 in the dense table).  The search is the full sky's
+(:func:`~startrack.identify.lost_in_space.search_tables`: pattern look-ups, then pyramids) with every
+star of a hypothesis inside the region; the caller (:class:`startrack.identify.StarIdentifier`) falls
+back to the full sky when it fails.
 """
 
 from __future__ import annotations
 
-import math
-
 from startrack.identify.lost_in_space import search_tables
+from startrack.identify.pattern_hash import NO_PATTERNS
 from startrack.identify.zones import SKY, cap
-from startrack.sphere import radec_to_vector
 
 
 class SubCatalog:
-    """Pattern search restricted to the predicted sub-catalog, then the field stars of its region (with the
-    dense table) or (``neighbours``) its 4 redundant sub-catalogs."""
+    """Pattern search restricted to the field stars of the predicted boresight's region (with the dense
+    table), or to the predicted sub-catalog and then (``neighbours``) its 4 redundant sub-catalogs."""
 
     name = "subcatalog"
 
@@ -61,20 +61,18 @@ class SubCatalog:
                     yield int(b)
 
     def identify(self, frame, prior):
-        """Verified hypothesis or None; needs ``prior.boresight_radec()``."""
-        boresight = prior.boresight_radec() if prior is not None else None
-        if boresight is None or not all(math.isfinite(x) for x in boresight):
+        """Verified hypothesis or None; needs a predicted boresight (``prior.q_IS`` or ``prior.boresight``)."""
+        if prior is None or (prior.q_IS is None and prior.boresight is None):
             return None
         ctx = self.context
-        cells = self.cells(*boresight) if self._dense is None else [int(self.catalog.sub_catalog_index(*boresight))]
-        for b in cells:
-            result = search_tables(frame.arrays, ctx.widths, (ctx.sub_catalogs.arrays(b),),
-                                   (ctx.stars["guide"],), SKY, ctx.field_arrays)
-            if result[0]:
-                return ctx.verified(result)
         if self._dense is not None:
             tables, stars = self._dense
-            region = cap(radec_to_vector(*boresight), 2.0 * self.catalog.rho_sub)
+            region = cap(prior.boresight_vector(), 2.0 * self.catalog.rho_sub)
             return ctx.verified(search_tables(frame.arrays, ctx.widths, tables, stars, region,
-                                              ctx.field_arrays))
+                                              ctx.field_arrays, ctx.patterns))
+        for b in self.cells(*prior.boresight_radec()):
+            result = search_tables(frame.arrays, ctx.widths, (ctx.sub_catalogs.arrays(b),),
+                                   (ctx.stars["guide"],), SKY, ctx.field_arrays, NO_PATTERNS)
+            if result[0]:
+                return ctx.verified(result)
         return None

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from startrack.identify.verify import verify_near
+from startrack.identify.verify import predict, verify_near
 from startrack.jit import njit
 
 
@@ -55,8 +55,41 @@ class Tracking:
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""
-        tracked = np.zeros(0, np.int64) if prior.tracked_hip is None else np.asarray(prior.tracked_hip, np.int64)
-        in_field = self.field.hip[self.field.in_field(R_IS)[0]]
-        lost = np.setdiff1d(np.intersect1d(tracked, in_field), matched_hip)
-        entered = np.setdiff1d(matched_hip, tracked)
-        return lost, entered
+        tracked = _NO_STARS if prior.tracked_hip is None else np.asarray(prior.tracked_hip, np.int64)
+        field = self.field
+        return changes(field.vectors, field.hip, field.cell(R_IS[:, 2]), R_IS, field.camera_params, tracked,
+                       matched_hip)
+
+
+_NO_STARS = np.zeros(0, np.int64)
+
+
+@njit
+def changes(vectors, hip, cell, R_IS, camera_params, tracked, matched):  # pragma: no cover  (compiled)
+    """(lost, entered) sorted unique HIP arrays: the ``tracked`` HIP numbers of stars of ``cell`` (indices
+    into ``vectors``, ``hip``) imaged inside the field for R_IS and not in ``matched``; the ``matched``
+    HIP numbers not in ``tracked``."""
+    index, _ = predict(vectors[cell], R_IS, camera_params, 0.0)
+    in_field = np.sort(hip[cell[index]])
+    tracked = np.unique(tracked)
+    matched = np.unique(matched)
+    lost = np.empty(tracked.size, np.int64)
+    n_lost = 0
+    for h in tracked:
+        if _member(in_field, h) and not _member(matched, h):
+            lost[n_lost] = h
+            n_lost += 1
+    entered = np.empty(matched.size, np.int64)
+    n_entered = 0
+    for h in matched:
+        if not _member(tracked, h):
+            entered[n_entered] = h
+            n_entered += 1
+    return lost[:n_lost], entered[:n_entered]
+
+
+@njit(_nrt=False)
+def _member(sorted_values, value):  # pragma: no cover  (compiled)
+    """Whether ``value`` is in the ascending array ``sorted_values``."""
+    k = np.searchsorted(sorted_values, value)
+    return k < sorted_values.size and sorted_values[k] == value
