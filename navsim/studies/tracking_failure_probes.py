@@ -161,9 +161,10 @@ class Findings(common.Findings):
                 f"for the full sky (ratio {t['time_ratio']:.2f}; 000: {PAPER000_MS['subcatalog']} against "
                 f"{PAPER000_MS['lost_in_space']} ms, {PAPER000_RATIO})"
                 + (f"; medians {sub['ms_median']:.2f} and {lis['ms_median']:.2f} ms" if "ms_median" in sub else "")
-                + ". Both of our searches are compiled and stop at their first verified pyramid, so what is left "
-                "of each call is the verification and the Python layer they share (~20 µs), against which the pairs "
-                "the sub-catalog saves are worth little; and a rendered frame's brightest stars often hold fewer than "
+                + ". Both of our searches are compiled and stop at their first verified hypothesis (a four-star "
+                "pattern looked up, or a pyramid), so what is left of each call is the verification and the Python "
+                "layer they share (~20 µs), against which the pairs the sub-catalog saves are worth little; and a "
+                "rendered frame's brightest stars often hold fewer than "
                 "3 guide stars (Hipparcos flags many bright stars as double or variable, and the guide catalog leaves "
                 "them out), so the sub-catalog search goes on to every field star of its region, while our full-sky "
                 "search starts from every field star's pairs. The methods alternate which runs first on a frame."]

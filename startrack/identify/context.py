@@ -29,12 +29,12 @@ class SearchContext:
     catalog: the navigation catalog; field: :class:`~startrack.identify.verify.FieldStars`;
     pattern_stars: the brightest centroids searched first (then twice as many); verify_gate: match
     radius r [rad] (passes at 3 r then r); threshold: largest accepted false-match probability; sigma:
-    centroid noise [rad]; delta_px: centroid error bound [px]; dense: also build the field stars' pair table
-    and the pattern level of the look-ups (~0.3 s).
+    centroid noise [rad]; dense: also build the field stars' pair table and the pattern level of the
+    look-ups (~0.3 s).
     """
 
     def __init__(self, catalog, field, pattern_stars: int, verify_gate: float, threshold: float, sigma: float,
-                 delta_px: float, dense: bool):
+                 dense: bool):
         self.catalog = catalog
         self.field = field
         self.widths = np.array([pattern_stars, 2 * pattern_stars], np.int64)
@@ -47,7 +47,7 @@ class SearchContext:
         if dense:
             self.tables["dense"] = PairTable.of_stars(field.vectors, catalog.params.theta_min, catalog.params.theta_max)
             self.stars["dense"] = _stars(field.vectors)
-            self.patterns = pattern_arrays(field, delta_px)
+            self.patterns = pattern_arrays(field)
         pass_gates = np.array([3.0 * verify_gate, verify_gate])
         #: verify_near's ``field``: (vectors, zones, search radius [rad], camera parameters, pass gates [rad],
         #: f [px], field solid angle [sr], threshold, centroid noise [rad])

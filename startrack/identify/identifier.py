@@ -174,7 +174,7 @@ class StarIdentifier:
         self.field = field_stars
         window_px = _positive("tracking_window_px", tracking_window_px, 1e4)
         context = SearchContext(catalog, self.field, self.pattern_stars, self.verify_gate, self.false_match_threshold,
-                                self.centroid_sigma_px / camera.focal_px, self.delta_px, dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
+                                self.centroid_sigma_px / camera.focal_px, dense=bool(dense_fallback) and ("lost_in_space" in methods or "subcatalog" in methods))
         available = {
             "tracking": lambda: Tracking(context, window_px),
             "subcatalog": lambda: SubCatalog(context, neighbours),

@@ -299,11 +299,10 @@ class PatternLevel:
         return self.stars, self.keys, self.slots, float(self.width), int(self.base), float(self.tolerance)
 
 
-def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams, min_width: float = 0.0) -> PatternLevel:
-    """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag); its bins
-    are at least ``min_width`` wide (ratio units)."""
+def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> PatternLevel:
+    """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag)."""
     tolerance = model_tolerance(fov)
-    width = max(2.0 * tolerance + NOISE_TOLERANCE, float(min_width))
+    width = 2.0 * tolerance + NOISE_TOLERANCE
     base = int(math.ceil(1.0 / width)) + 1
     patterns = level_patterns(vectors, v_mag, fov, params)
     keys = _pattern_keys(vectors, patterns, width, base)

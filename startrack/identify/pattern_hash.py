@@ -59,31 +59,27 @@ from startrack.rotation_jit import wahba_svd
 
 #: Brightest thinned centroids whose four-star combinations are looked up (6: 15 combinations).
 HASH_STARS = 6
-#: Largest edge, per unit of the field of view, of the patterns the bin width is made for.
-MIN_SPAN = 0.25
 
 #: ``patterns`` of the search kernels when there is no pattern level (nothing is looked up).
 NO_PATTERNS = (np.zeros((0, 4), np.int32), np.zeros(0, np.int64), np.full(16, -1, np.int32), 1.0, 2, 0, 1.0, 0.0)
 
 
-def pattern_arrays(field, delta_px: float, hash_stars: int = HASH_STARS):
+def pattern_arrays(field, hash_stars: int = HASH_STARS):
     """The tuple the search kernels take for the field stars of an identifier
-    (:class:`~startrack.identify.verify.FieldStars`) and its centroid error bound ``delta_px`` [px]:
-    (pattern stars (P, 4) int32 into the field stars, keys, hash slots, bin width, bins per ratio,
-    combinations searched, cos of the thinning separation, N_h); :data:`NO_PATTERNS` when the camera's
-    field lies outside the pattern catalog's 0.5-90 deg.
+    (:class:`~startrack.identify.verify.FieldStars`): (pattern stars (P, 4) int32 into the field stars,
+    keys, hash slots, bin width, bins per ratio, combinations searched, cos of the thinning separation,
+    N_h); :data:`NO_PATTERNS` when the camera's field lies outside the pattern catalog's 0.5-90 deg.
 
-    The bins are at least twice the ratio tolerance eps = 2 e / beta_(6) of a pattern spanning
-    :data:`MIN_SPAN` of the field, e = 2 sqrt 2 delta / f the angle bound at the image centre, so that
-    such a pattern visits at most two bins per ratio (32 keys)."""
-    camera = field.camera
-    fov = float(camera.fov_x)
+    The bins are the pattern catalog's for that field (2 x its model tolerance + noise allowance,
+    0.013 at 16 deg): with wider bins the patterns per key grow as the fifth power of the width (measured
+    at 16 deg, V <= 6: 7x wider bins, 100x more candidates per look-up, 2 ms per frame), so frames whose
+    centroid errors are too large for them (eps > half a bin) are left to the pyramid search."""
+    fov = float(field.camera.fov_x)
     try:
         params = PatternCatalogParams(fov_min=fov, fov_max=fov)
     except InputError:
         return NO_PATTERNS
-    eps = 2.0 * (2.0 * math.sqrt(2.0) * delta_px / camera.focal_px) / (MIN_SPAN * fov)
-    level = build_level(field.vectors, field.v_mag, fov, params, min_width=2.0 * eps)
+    level = build_level(field.vectors, field.v_mag, fov, params)
     n_combinations = int(COMBINATIONS_BELOW[min(hash_stars, MAX_CANDIDATES)])
     n_h = n_combinations * expected_candidates(level)
     return (np.ascontiguousarray(level.stars, np.int32), np.ascontiguousarray(level.keys, np.int64),

@@ -34,14 +34,6 @@ def setup():
     return camera, stars, StarIdentifier(catalog, camera, centroid_sigma_px=SIGMA_PX)
 
 
-@pytest.fixture(scope="module")
-def noisy(setup):
-    """The same camera with 0.7 px centroid noise (000 §5's 1 px angular-distance error)."""
-    camera, stars, identifier = setup
-    return camera, stars, StarIdentifier(identifier.catalog, camera, centroid_sigma_px=0.7,
-                                         field_stars=identifier.field)
-
-
 def _look_up(identifier, frame, region=SKY):
     """hash_search alone on a frame: (ok, R_IS, centroid indices, HIP numbers)."""
     result = identifier.solve(frame.uv, frame.flux)  # the frame's directions, as the identifier orders them
@@ -64,34 +56,22 @@ def test_the_level_is_the_camera_field_and_n_h_counts_every_look_up(setup):
     assert 0.0 < n_h / n_combinations < 100.0
     narrow = Camera.from_fov(np.radians(0.3), 1024, 1024)  # below the pattern catalog's 0.5 deg: no look-ups
     assert pattern_arrays(type(identifier.field)(identifier.catalog, narrow, stars.vectors[:50], stars.hip[:50],
-                                                 stars.v_mag[:50]), 0.3) is NO_PATTERNS
+                                                 stars.v_mag[:50])) is NO_PATTERNS
     field = identifier.field
-    level = build_level(field.vectors, field.v_mag, camera.fov_x, PatternCatalogParams(camera.fov_x, camera.fov_x),
-                        min_width=width)
+    level = build_level(field.vectors, field.v_mag, camera.fov_x, PatternCatalogParams(camera.fov_x, camera.fov_x))
     assert level.width == width and n_h == pytest.approx(15 * expected_candidates(level))
 
 
-def test_bins_grow_with_the_centroid_error_bound(setup):
-    """A pattern spanning a quarter of the field visits at most two bins per ratio: width >= 2 eps."""
-    camera, _, identifier = setup
-    for delta_px in (0.3, 1.0, 3.0):
-        width = pattern_arrays(identifier.field, delta_px)[3]
-        eps = 2.0 * (2.0 * math.sqrt(2.0) * delta_px / camera.focal_px) / (0.25 * camera.fov_x)
-        assert width >= 2.0 * eps * (1 - 1e-12)
-    assert pattern_arrays(identifier.field, 3.0)[3] > 5.0 * pattern_arrays(identifier.field, 0.3)[3]
-
-
-@pytest.mark.parametrize("which, sigma_px", [("setup", SIGMA_PX), ("noisy", 0.7)])
-def test_look_ups_identify_clean_frames_at_the_pyramids_attitude(which, sigma_px, request):
+def test_look_ups_identify_clean_frames_at_the_pyramids_attitude(setup):
     """On 80 random frames without false stars the look-ups alone identify >= 95 % (measured: all but a
     few whose brightest stars form no catalog pattern), every HIP right, the stars and the attitude those
-    of the full identifier (the same verification refit) to 0.1"; also with 7 times the centroid noise."""
-    camera, stars, identifier = request.getfixturevalue(which)
+    of the full identifier (the same verification refit) to 0.1"."""
+    camera, stars, identifier = setup
     rng = np.random.default_rng(17)
     identified = 0
     for _ in range(80):
         q = random_attitude(rng)
-        frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, q, rng, sigma_px)
+        frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, q, rng, SIGMA_PX)
         ok, R_IS, centroid, hip, result = _look_up(identifier, frame)
         if not ok:
             continue
@@ -99,7 +79,7 @@ def test_look_ups_identify_clean_frames_at_the_pyramids_attitude(which, sigma_px
         np.testing.assert_array_equal(frame.hip[centroid], hip)
         np.testing.assert_array_equal(np.sort(hip), np.sort(result.matched_hip))
         error = (Rotation.from_matrix(R_IS).inv() * Rotation.from_quat(q)).magnitude()
-        assert error < 60.0 * ARCSEC * sigma_px / SIGMA_PX  # roll: ~6" per 0.1 px at 1 sigma
+        assert error < 60.0 * ARCSEC
         assert (Rotation.from_matrix(R_IS).inv() * Rotation.from_quat(result.q_IS)).magnitude() < 0.1 * ARCSEC
     assert identified >= 76
 
@@ -118,3 +98,20 @@ def test_mirror_images_random_points_and_a_wrong_region_give_nothing(setup):
                                                     frame.missing_hip))[0]
         opposite = -Rotation.from_quat(q).as_matrix()[:, 2]  # every catalog star of the frame outside the region
         assert not _look_up(identifier, frame, cap(opposite, np.radians(30.0)))[0]
+
+
+def test_centroid_errors_too_large_for_the_bins_are_left_to_the_pyramid(setup):
+    """With 0.7 px centroid noise (000 §5) eps exceeds half a bin for nearly every combination: the look-ups
+    give no answer (never a wrong one) and the identifier still identifies through the pyramid search."""
+    camera, stars, identifier = setup
+    noisy = StarIdentifier(identifier.catalog, camera, centroid_sigma_px=0.7, field_stars=identifier.field)
+    rng = np.random.default_rng(19)
+    answered = 0
+    for _ in range(30):
+        frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, 0.7)
+        ok, _, centroid, hip, result = _look_up(noisy, frame)
+        assert result.ok and np.all(frame.hip[result.matches[:, 0]] == result.matches[:, 1])
+        if ok:
+            answered += 1
+            np.testing.assert_array_equal(frame.hip[centroid], hip)
+    assert answered <= 10
