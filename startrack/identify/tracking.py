@@ -55,7 +55,9 @@ class Tracking:
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""
-        tracked = _NO_STARS if prior.tracked_hip is None else np.asarray(prior.tracked_hip, np.int64)
+        if prior.tracked_hip is None or len(prior.tracked_hip) == 0:  # nothing tracked: nothing lost
+            return _NO_STARS, np.unique(matched_hip)
+        tracked = np.asarray(prior.tracked_hip, np.int64)
         field = self.field
         return changes(field.vectors, field.hip, field.cell(R_IS[:, 2]), R_IS, field.camera_params, tracked,
                        matched_hip)

@@ -66,6 +66,9 @@ def test_a_removed_tracked_star_is_reported_lost(setup):
     assert second.method == "tracking"
     np.testing.assert_array_equal(second.lost_hip, [gone[1]])
     assert len(second.entered_hip) == 0
+    untracked = identifier.solve(frame.uv[keep], frame.flux[keep], Prior(q_IS=first.q_IS))  # nothing tracked before
+    assert untracked.method == "tracking" and len(untracked.lost_hip) == 0
+    np.testing.assert_array_equal(untracked.entered_hip, np.sort(untracked.matched_hip))
 
 
 def test_a_prior_beyond_the_window_hands_over_to_the_sub_catalog(setup):
