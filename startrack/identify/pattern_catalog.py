@@ -269,6 +269,8 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
         if len(members) >= 4:
             brightest = np.sort(np.asarray(members, dtype=np.int64))[:params.stars_per_field]  # rank = position
             groups.append(brightest[_COMBINATIONS[brightest.size]])
+    if not groups:  # no field holds four stars
+        return np.zeros((0, 4), np.int32)
     ranked = np.sort(np.concatenate(groups), axis=1).astype(np.uint64)
     if stars.size < 1 << 16:  # four 16-bit ranks in one integer: a 1-D unique, far faster than unique(axis=0)
         packed = np.sort(((ranked[:, 0] << 48) | (ranked[:, 1] << 32)) | ((ranked[:, 2] << 16) | ranked[:, 3]))

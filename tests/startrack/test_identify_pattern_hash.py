@@ -57,6 +57,8 @@ def test_the_level_is_the_camera_field_and_n_h_counts_every_look_up(setup):
     narrow = Camera.from_fov(np.radians(0.3), 1024, 1024)  # below the pattern catalog's 0.5 deg: no look-ups
     assert pattern_arrays(type(identifier.field)(identifier.catalog, narrow, stars.vectors[:50], stars.hip[:50],
                                                  stars.v_mag[:50])) is NO_PATTERNS
+    few = type(identifier.field)(identifier.catalog, camera, stars.vectors[:3], stars.hip[:3], stars.v_mag[:3])
+    assert pattern_arrays(few)[0].shape == (0, 4)  # no field of four stars: nothing to look up, no error
     field = identifier.field
     level = build_level(field.vectors, field.v_mag, camera.fov_x, PatternCatalogParams(camera.fov_x, camera.fov_x))
     assert level.width == width and n_h == pytest.approx(35 * expected_candidates(level))
