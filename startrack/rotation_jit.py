@@ -184,3 +184,16 @@ def wahba_svd(ref_I, obs_S):
         for c in range(3):
             R_IS[r, c] = v1[r] * u1[c] + v2[r] * u2[c] + v3[r] * u3[c]  # (U V^T)^T = V U^T
     return R_IS
+
+
+@njit
+def worst_cosine(ref_I, obs_S, R_IS):
+    """Smallest cosine between obs_S[i] and R_IS^T ref_I[i] over the pairs (n, 3): the largest residual of
+    an attitude fit as a cosine."""
+    worst = 1.0
+    for i in range(ref_I.shape[0]):
+        c = 0.0
+        for k in range(3):
+            c += (ref_I[i, 0] * R_IS[0, k] + ref_I[i, 1] * R_IS[1, k] + ref_I[i, 2] * R_IS[2, k]) * obs_S[i, k]
+        worst = min(worst, c)
+    return worst

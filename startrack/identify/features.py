@@ -151,22 +151,29 @@ def separated(obs, index, cos_merge, max_stars):  # pragma: no cover  (compiled)
     ``cos_merge``) to a brighter one kept: a repeated or split centroid counts once, so it can neither
     stand for several stars nor multiply the patterns searched. At most ``max_stars`` (< 0: all)."""
     n = obs.shape[0]
-    limit = n if max_stars < 0 else min(n, max_stars)
-    keep = np.empty(n, np.int64)
+    keep = np.empty(n if max_stars < 0 else min(n, max_stars), np.int64)
+    count = apart(obs, n, cos_merge, keep)
+    return obs[keep[:count]], index[keep[:count]]
+
+
+@njit(_nrt=False)
+def apart(obs, n, cos_limit, keep):  # pragma: no cover  (compiled)
+    """Write to ``keep`` (at most its size) the indices, brightest first, of the first n directions
+    ``obs`` whose cosine with every one kept before is at most ``cos_limit``; returns their number."""
     count = 0
     for m in range(n):
-        if count == limit:
+        if count == keep.size:
             break
         alone = True
         for k in range(count):
             j = keep[k]
-            if obs[m, 0] * obs[j, 0] + obs[m, 1] * obs[j, 1] + obs[m, 2] * obs[j, 2] > cos_merge:
+            if obs[m, 0] * obs[j, 0] + obs[m, 1] * obs[j, 1] + obs[m, 2] * obs[j, 2] > cos_limit:
                 alone = False
                 break
         if alone:
             keep[count] = m
             count += 1
-    return obs[keep[:count]], index[keep[:count]]
+    return count
 
 
 class FrameFeatures:

@@ -155,6 +155,15 @@ def pack_key(bins, base):  # pragma: no cover  (compiled)
 
 
 @njit(_nrt=False)
+def bin_ranges(values, scale, eps, width, base, low, high):  # pragma: no cover  (compiled)
+    """Bin numbers of the five ratios values[k] / scale +-eps, clipped to [0, base - 1], into ``low`` and
+    ``high`` (5,)."""
+    for k in range(5):
+        low[k] = min(max(int((values[k] / scale - eps) / width), 0), base - 1)
+        high[k] = min(max(int((values[k] / scale + eps) / width), 0), base - 1)
+
+
+@njit(_nrt=False)
 def next_bins(bins, low, high):  # pragma: no cover  (compiled)
     """Step the five bin numbers ``bins`` to the next combination within [low, high] (an odometer);
     False when every combination has been visited."""

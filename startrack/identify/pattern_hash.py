@@ -34,10 +34,11 @@ import math
 import numpy as np
 
 from startrack.errors import InputError
-from startrack.identify.features import fill_features
+from startrack.identify.features import apart, fill_features
 from startrack.identify.pattern_catalog import (
     SEPARATION_PER_FOV,
     PatternCatalogParams,
+    bin_ranges,
     build_level,
     edge_ratios,
     next_bins,
@@ -55,7 +56,7 @@ from startrack.identify.scale_free import (
 )
 from startrack.identify.verify import verify_near
 from startrack.jit import njit
-from startrack.rotation_jit import wahba_svd
+from startrack.rotation_jit import wahba_svd, worst_cosine
 
 #: Brightest thinned centroids whose four-star combinations are looked up (7: 35 combinations).  Median
 #: solve [us] on the benchmark frames (16 deg, 300 per set, solved in turn in one process) with 6 / 7 / 8:
@@ -88,24 +89,6 @@ def pattern_arrays(field, hash_stars: int = HASH_STARS):
     return (np.ascontiguousarray(level.stars, np.int32), np.ascontiguousarray(level.keys, np.int64),
             np.ascontiguousarray(level.slots, np.int32), float(level.width), int(level.base), n_combinations,
             math.cos(SEPARATION_PER_FOV * fov), float(n_h))
-
-
-@njit(_nrt=False)
-def _thinned(obs, n, cos_separation, out):  # pragma: no cover  (compiled)
-    """Write to ``out`` the first of the n brightest directions ``obs`` that lie farther than the
-    separation from every one kept before (brightest first); returns their number."""
-    count = 0
-    for i in range(n):
-        if count == out.size:
-            break
-        for k in range(count):
-            j = out[k]
-            if obs[i, 0] * obs[j, 0] + obs[i, 1] * obs[j, 1] + obs[i, 2] * obs[j, 2] > cos_separation:
-                break
-        else:
-            out[count] = i
-            count += 1
-    return count
 
 
 @njit(_nrt=False)
@@ -146,14 +129,7 @@ def _candidate(obs, stars, cat, vectors, angles, bound, region, first_gate):  # 
         ref[i] = vectors[cat[perm[i]]]
         seen[i] = obs[stars[i]]
     R_IS = wahba_svd(ref, seen)
-    cos_gate = math.cos(first_gate)
-    for i in range(4):
-        c = 0.0
-        for k in range(3):
-            c += (ref[i, 0] * R_IS[0, k] + ref[i, 1] * R_IS[1, k] + ref[i, 2] * R_IS[2, k]) * seen[i, k]
-        if c < cos_gate:
-            return False, R_IS
-    return True, R_IS
+    return worst_cosine(ref, seen, R_IS) >= math.cos(first_gate), R_IS
 
 
 @njit
@@ -168,7 +144,7 @@ def hash_search(obs, beta, gate, filled, focal_px, delta_px, patterns, region, f
         return no_result()
     vectors, first_gate = field[0], field[4][0]
     candidates = np.empty(MAX_CANDIDATES, np.int64)
-    n_candidates = _thinned(obs, beta.shape[0], cos_separation, candidates)
+    n_candidates = apart(obs, beta.shape[0], cos_separation, candidates)
     stop = min(n_combinations, COMBINATIONS_BELOW[n_candidates])
     if stop == 0:
         return no_result()
@@ -185,10 +161,8 @@ def hash_search(obs, beta, gate, filled, focal_px, delta_px, patterns, region, f
         eps = 2.0 * bound / angles[5]
         if eps > 0.5 * width:
             continue
-        for k in range(5):
-            low[k] = min(max(int((angles[k] / angles[5] - eps) / width), 0), base - 1)
-            high[k] = min(max(int((angles[k] / angles[5] + eps) / width), 0), base - 1)
-            bins[k] = low[k]
+        bin_ranges(angles, angles[5], eps, width, base, low, high)
+        bins[:] = low
         while True:
             key = pack_key(bins, base)
             e = run_start(key, keys, slots)

@@ -32,11 +32,11 @@ import math
 
 import numpy as np
 
-from startrack.identify.pattern_catalog import edge_ratios, next_bins, pack_key, run_start
+from startrack.identify.pattern_catalog import bin_ranges, edge_ratios, next_bins, pack_key, run_start
 from startrack.identify.self_calibration import brightest_in_field, verify_calibrate
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
-from startrack.rotation_jit import wahba_svd
+from startrack.rotation_jit import wahba_svd, worst_cosine
 
 #: Most detections whose combinations are searched.
 MAX_CANDIDATES = 24
@@ -135,12 +135,7 @@ def _hypothesis(uv, stars, cat, vectors, cx, cy, f_start, f_range, eps):  # prag
     for i in range(4):
         ref[i] = vectors[cat[perm[i]]]
     R_IS = wahba_svd(ref, seen)
-    worst = 0.0
-    for i in range(4):
-        c = 0.0
-        for k in range(3):
-            c += (ref[i, 0] * R_IS[0, k] + ref[i, 1] * R_IS[1, k] + ref[i, 2] * R_IS[2, k]) * seen[i, k]
-        worst = max(worst, math.acos(min(1.0, c)))
+    worst = math.acos(min(1.0, worst_cosine(ref, seen, R_IS)))
     return worst <= 3.0 * eps * catalog.max(), R_IS, focal
 
 
@@ -182,16 +177,6 @@ def _gates(eps, width, final):  # pragma: no cover  (compiled)
     return np.array([first, max(first / 4.0, 2.0 * final), final])
 
 
-@njit
-def _bin_ranges(ratios, eps, width, base):  # pragma: no cover  (compiled)
-    low = np.empty(5, np.int64)
-    high = np.empty(5, np.int64)
-    for k in range(5):
-        low[k] = min(max(int((ratios[k] - eps) / width), 0), base - 1)
-        high[k] = min(max(int((ratios[k] + eps) / width), 0), base - 1)
-    return low, high
-
-
 #: Catalog candidates gathered per observed pattern (over every level) before they are verified.
 CANDIDATE_BUFFER = 256
 
@@ -205,6 +190,8 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
     (count, mismatch, eps) (module text, steps 1-2)."""
     axis, cos_radius = region
     bins = np.empty(5, np.int64)
+    low = np.empty(5, np.int64)
+    high = np.empty(5, np.int64)
     mismatch = np.empty(found.shape[0])
     tolerance_of = np.empty(found.shape[0])
     count = 0
@@ -212,7 +199,7 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
         cat_stars, keys, slots, width, base, tolerance = levels[l]
         ratios, _, _ = edge_ratios(_unit_vectors(uv, stars, level_focal[l], cx, cy), np.arange(4))
         eps = tolerance + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
-        low, high = _bin_ranges(ratios, eps, width, base)
+        bin_ranges(ratios, 1.0, eps, width, base, low, high)
         bins[:] = low
         while True:
             key = pack_key(bins, base)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from startrack.identify.verify import predict, verify_near
+from startrack.identify.verify import verify_near
 from startrack.jit import njit
 
 
@@ -57,22 +57,18 @@ class Tracking:
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""
         if prior.tracked_hip is None or len(prior.tracked_hip) == 0:  # nothing tracked: nothing lost
             return _NO_STARS, np.unique(matched_hip)
-        tracked = np.asarray(prior.tracked_hip, np.int64)
-        field = self.field
-        return changes(field.vectors, field.hip, field.cell(R_IS[:, 2]), R_IS, field.camera_params, tracked,
-                       matched_hip)
+        in_field = self.field.hip[self.field.in_field(R_IS)[0]]
+        return changes(in_field, np.asarray(prior.tracked_hip, np.int64), matched_hip)
 
 
 _NO_STARS = np.zeros(0, np.int64)
 
 
 @njit
-def changes(vectors, hip, cell, R_IS, camera_params, tracked, matched):  # pragma: no cover  (compiled)
-    """(lost, entered) sorted unique HIP arrays: the ``tracked`` HIP numbers of stars of ``cell`` (indices
-    into ``vectors``, ``hip``) imaged inside the field for R_IS and not in ``matched``; the ``matched``
-    HIP numbers not in ``tracked``."""
-    index, _ = predict(vectors[cell], R_IS, camera_params, 0.0)
-    in_field = np.sort(hip[cell[index]])
+def changes(in_field, tracked, matched):  # pragma: no cover  (compiled)
+    """(lost, entered) sorted unique HIP arrays: the ``tracked`` HIP numbers that are ``in_field`` and not
+    ``matched``; the ``matched`` HIP numbers not ``tracked``."""
+    in_field = np.sort(in_field)
     tracked = np.unique(tracked)
     matched = np.unique(matched)
     lost = np.empty(tracked.size, np.int64)
