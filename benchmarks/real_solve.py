@@ -54,7 +54,6 @@ sys.path.insert(0, str(HERE))
 
 from startrack.attitude_angles import matrix_from_radec_roll  # noqa: E402
 from startrack.camera import Camera  # noqa: E402
-from startrack.camera_fit import CameraCalibration  # noqa: E402
 from startrack.commands.detect import detect_frame  # noqa: E402
 from startrack.image_io import Frame, read_frame  # noqa: E402
 from startrack.units import ARCSEC, DEG  # noqa: E402
@@ -80,7 +79,7 @@ def _record(frame_id, set_name, found, truth):
 
 def _centre_truth(camera, q_IS):
     """R_IC (image-centre frame, the frame plate solvers report) and the field of view of a true camera."""
-    ra_dec_roll = CameraCalibration(camera, np.zeros((8, 8)), 0.0, 0.0, 0, 0, 0.0).center_radec_roll(q_IS)
+    ra_dec_roll = camera.center_radec_roll(q_IS)
     return {"R_IC": matrix_from_radec_roll(*ra_dec_roll).tolist(), "fov_deg": math.degrees(camera.angular_width)}
 
 
@@ -160,7 +159,7 @@ def run_startrack(frames):
         ms = (time.perf_counter_ns() - begin) / 1e6
         record = {"id": frame["id"], "status": result.status, "solve_ms": ms}
         if result.ok:
-            R = matrix_from_radec_roll(*result.calibration.center_radec_roll(result.q_IS))
+            R = matrix_from_radec_roll(*result.calibration.camera.center_radec_roll(result.q_IS))
             record.update(R_IC=R.tolist(), fov_deg=math.degrees(result.calibration.camera.angular_width),
                           matches=result.matches.tolist())
         results.append(record)

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from startrack.attitude_angles import radec_roll_from_matrix
 from startrack.errors import InputError
 from startrack.rotation import from_rotation_vector, to_matrix
 
@@ -230,6 +231,15 @@ class Camera:
         xy_n = self.undistort((uv - np.array([self.cx, self.cy])) / self.focal_px)
         v = np.concatenate([xy_n, np.ones((len(uv), 1))], axis=1)
         return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    def center_radec_roll(self, q_IS):
+        """(ra, dec, roll) [rad] of the image centre: the frame whose +z is the direction of the centre pixel
+        ((W-1)/2, (H-1)/2) and whose axes follow S by the smallest rotation (what plate solvers report)."""
+        c = self.unproject([[(self.width - 1) / 2.0, (self.height - 1) / 2.0]])[0]
+        axis = np.cross([0.0, 0.0, 1.0], c)
+        angle = math.atan2(np.linalg.norm(axis), c[2])
+        turn = to_matrix(from_rotation_vector(axis / max(np.linalg.norm(axis), 1e-300) * angle))
+        return radec_roll_from_matrix(to_matrix(q_IS) @ turn)
 
     def stars_in_field(self, q_IS, vectors_I, margin_px=0.0):
         """Indices of the directions inside the field grown by ``margin_px`` pixels."""

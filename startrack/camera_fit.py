@@ -29,10 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.attitude_angles import radec_roll_from_matrix
 from startrack.camera import fold_radius_squared
 from startrack.jit import njit
-from startrack.rotation import from_rotation_vector, to_matrix
 from startrack.rotation_jit import quat_from_rotation_vector, quat_to_matrix
 
 #: Positions of the intrinsics (f, cx, cy, k1, k2) in a camera-parameter array (f, cx, cy, W, H, k1, k2,
@@ -228,20 +226,8 @@ class CameraCalibration:
         out["fov_deg"] = math.degrees(math.sqrt(max(gradient @ covariance @ gradient, 0.0)))
         return out
 
-    def center_radec_roll(self, q_IS):
-        """(ra, dec, roll) [rad] of the image centre: the frame whose +z is the direction of the centre pixel
-        ((W-1)/2, (H-1)/2) and whose axes follow S by the smallest rotation (what plate solvers report)."""
-        cam = self.camera
-        c = cam.unproject([[(cam.width - 1) / 2.0, (cam.height - 1) / 2.0]])[0]
-        axis = np.cross([0.0, 0.0, 1.0], c)
-        angle = math.atan2(np.linalg.norm(axis), c[2])
-        turn = to_matrix(from_rotation_vector(axis / max(np.linalg.norm(axis), 1e-300) * angle))
-        return radec_roll_from_matrix(to_matrix(q_IS) @ turn)
-
     def to_dict(self) -> dict:
-        """JSON-ready camera with 1-sigma (the ``camera`` entry of ``startrack solve --json``)."""
-        cam, sigma = self.camera, self.sigma
-        return {"width": cam.width, "height": cam.height, "fov_deg": math.degrees(cam.angular_width),
-                "focal_px": cam.focal_px, "cx": cam.cx, "cy": cam.cy, "k1": cam.k1, "k2": cam.k2,
-                "sigma": sigma, "rms_px": self.rms_px, "reduced_chi2": self.reduced_chi2,
+        """JSON-ready 1-sigma and fit statistics (with the camera's geometry, the ``camera`` entry of
+        ``startrack solve --json``)."""
+        return {"sigma": self.sigma, "rms_px": self.rms_px, "reduced_chi2": self.reduced_chi2,
                 "matched": self.matched, "predicted": self.predicted, "mag_limit": self.mag_limit}

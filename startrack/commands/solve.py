@@ -1,5 +1,4 @@
-"""``startrack solve``: identify the stars of frames from an unknown camera and print their attitude and
-the camera they calibrate (docs/design.md contract).
+"""``startrack solve``: identify the stars of frames and print their attitude (docs/design.md contract).
 
 INPUT is one or more images (.png/.tif/.tiff/.jpg/.jpeg/.npy: detected first, size from the file) or
 centroid CSV files (``u,v[,flux]`` per line [px], header optional; ``--width``/``--height`` give the
@@ -7,26 +6,34 @@ image size); ``--batch PATH`` takes a JSON Lines file (``{"id": ..., "centroids"
 per line), a folder of images or a list of image paths (:mod:`startrack.commands.solve_input`).  One
 process solves them all: the start-up (catalogs, compiled kernels) is paid once.
 
-No field of view is needed: the frame is identified by its four-star patterns
-(:class:`startrack.identify.plate_solver.PlateSolver`), which also fit the focal length, principal
-point and radial distortion.  ``--fov-deg`` is a hint (the nearest pattern levels are searched first),
-``--fov-range-deg LO,HI`` narrows the search, ``--camera FILE`` starts from a camera file (its focal
-length within 1 % or 3 sigma, its principal point and distortion as priors), ``--boresight-deg RA,DEC``
-keeps the hypotheses within ``--boresight-error-deg`` of a prior boresight.  ``--write-camera FILE``
-writes the calibrated camera (of the solved frame with the most matched stars) for a later solve or a
-navsim scenario (``star_sensor.image.camera_file``).
+Two uses (:mod:`startrack.commands.solve_modes`):
 
-With ``--json`` one JSON object per frame and line: ``id``, ``status`` ("ok", "no_match", "too_few",
-"error"), ``reason`` when not ok, ``q_IS`` [x, y, z, w] of the sensor frame (+z through the principal
-point), ``ra_deg``, ``dec_deg``, ``roll_deg`` of it, ``center`` (the pointing of the image centre, as
-plate solvers report it), ``camera`` (the calibrated camera with its sigma), ``matches`` [[centroid
-index, hip], ...], residuals, sigmas, ``false_match_probability``, ``method``, ``solve_ms`` and, for
-images, ``detection``.  Exit status: 0 when every frame is identified, 1 when some is not, 2 for bad
-options or an unreadable INPUT.
+* a **star tracker with its calibrated camera**: ``--camera FILE`` (a camera file) or ``--fov-deg F`` (an
+  ideal pinhole of the frame's size: principal point at the centre of the pixel grid, no distortion).
+  The frame is identified with that camera and the attitude ``q_IS`` is that camera's frame, with its
+  sigma at the Cramér-Rao bound.  ``--refit focal,centre,k1,k2`` (or ``all``) refits the named
+  intrinsics per frame from the given camera, the others held.
+* an **image from an unknown camera** (no geometry): the frame is identified by its four-star patterns
+  (:class:`startrack.identify.plate_solver.PlateSolver`), which also fit the focal length, principal
+  point and radial distortion.  ``--fov-hint-deg`` is a hint (the nearest pattern levels are searched
+  first), ``--fov-range-deg LO,HI`` narrows the search.  ``--write-camera FILE`` writes the calibrated
+  camera (of the solved frame with the most matched stars) for a later ``--camera`` or a navsim
+  scenario (``star_sensor.image.camera_file``).
+
+``--boresight-deg RA,DEC`` searches near a prior boresight first (the plate solver within
+``--boresight-error-deg``).  With ``--json`` one JSON object per frame and line: ``id``, ``status``
+("ok", "no_match", "too_few", "error"), ``reason`` when not ok, ``q_IS`` [x, y, z, w] of the sensor
+frame (+z through the principal point), ``ra_deg``, ``dec_deg``, ``roll_deg`` of it, ``sigma_arcsec``,
+``center`` (the pointing of the image centre, as plate solvers report it), ``camera`` (the camera the
+attitude refers to: ``source`` given, fitted or refined, and for a fitted or refined camera its sigma),
+``matches`` [[centroid index, hip], ...], residuals, ``false_match_probability``, ``method``,
+``solve_ms`` and, for images, ``detection``.  Exit status: 0 when every frame is identified, 1 when some
+is not, 2 for bad options or an unreadable INPUT.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 
@@ -34,6 +41,7 @@ import numpy as np
 
 from startrack.commands.detect import add_detection_options, detection_options
 from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame
+from startrack.commands.solve_modes import FrameSolver, centroid_sigma, parse_refit
 from startrack.errors import InputError, check_range
 from startrack.units import DEG
 
@@ -41,24 +49,39 @@ from startrack.units import DEG
 def register(subparsers):
     parser = subparsers.add_parser(
         "solve",
-        help="identify stars and calibrate the camera of images (no field of view needed) and print the attitude",
-        description="Star identification of images or centroid lists from an unknown camera.",
+        help="identify the stars of images or centroid lists and print the attitude (a given camera, or none)",
+        description="Star identification of images or centroid lists: with a calibrated camera (--camera, or "
+                    "--fov-deg for an ideal pinhole) as a star tracker, or from an unknown camera, whose focal "
+                    "length, principal point and distortion are then fitted.",
     )
     parser.add_argument("input", nargs="*", help="images (.png/.tif/.tiff/.jpg/.jpeg/.npy) or centroid CSV files")
     parser.add_argument("--batch", metavar="PATH", help="frames: a .jsonl file, a folder of images or a list of images")
-    parser.add_argument("--fov-deg", type=float, help="field of view across the width [deg]: a hint, not required")
-    parser.add_argument("--fov-range-deg", metavar="LO,HI", help="search only fields of view in [LO, HI] deg (5,40)")
-    parser.add_argument("--camera", metavar="FILE", help="start from this camera file (startrack solve --write-camera)")
-    parser.add_argument("--write-camera", metavar="FILE", help="write the calibrated camera (TOML) to FILE")
-    parser.add_argument("--width", type=int, help="image width [px] (centroid input; checked for images)")
-    parser.add_argument("--height", type=int, help="image height [px] (centroid input; checked for images)")
+    parser.add_argument("--camera", metavar="FILE",
+                        help="the calibrated camera (a camera file, e.g. from --write-camera): identify with it")
+    parser.add_argument("--fov-deg", type=float,
+                        help="field of view across the width [deg] of an ideal pinhole camera of the frame's size "
+                             "(principal point at the centre of the pixel grid, no distortion): identify with it")
+    parser.add_argument("--refit", metavar="LIST",
+                        help="refit these intrinsics of the given camera per frame: focal,centre,k1,k2 or all")
+    parser.add_argument("--fov-hint-deg", type=float,
+                        help="unknown camera: field of view across the width [deg] searched first (a hint)")
+    parser.add_argument("--fov-range-deg", metavar="LO,HI",
+                        help="unknown camera: search only fields of view in [LO, HI] deg (5,40)")
+    parser.add_argument("--write-camera", metavar="FILE", help="write the fitted camera (TOML) to FILE")
+    parser.add_argument("--width", type=int,
+                        help="image width [px] (centroid input, default the camera file's; checked for images)")
+    parser.add_argument("--height", type=int,
+                        help="image height [px] (centroid input, default the camera file's; checked for images)")
     parser.add_argument("--boresight-deg", metavar="RA,DEC", help="prior boresight right ascension, declination [deg]")
     parser.add_argument("--boresight-error-deg", type=float, default=10.0,
-                        help="largest error of the prior boresight [deg] (10)")
-    parser.add_argument("--mag", type=float, default=None, help="faintest catalog star of the verification [V mag] (8)")
+                        help="largest error of the prior boresight [deg] for the plate solver (10)")
+    parser.add_argument("--mag", type=float, default=None,
+                        help="faintest catalog star [V mag]: of a given camera's catalog (default from the field's "
+                             "size: V 6 at 16 deg) or of the plate solver's verification (8)")
     parser.add_argument("--epoch", type=float, default=2000.0, help="epoch of the star positions [Julian year] (2000)")
-    parser.add_argument("--centroid-sigma-px", type=float, default=0.3,
-                        help="centroid sigma of centroid lists [px] (0.3; images use their detections')")
+    parser.add_argument("--centroid-sigma-px", type=float, default=None,
+                        help="centroid sigma [px] of centroid lists and of a given camera's gates (the camera "
+                             "file's fit RMS, else 0.3; images weight stars by their detections')")
     parser.add_argument("--time-budget-s", type=float, default=1.0, help="search time per frame before no_match [s] (1)")
     parser.add_argument("--max-false-match", type=float, default=1e-6,
                         help="largest accepted false-match probability (1e-6)")
@@ -75,21 +98,18 @@ def _pair(option, text):
     return first, second
 
 
-def parse_boresight(text, error_deg):
-    """(axis (3,), radius [rad]) of ``--boresight-deg RA,DEC`` and its error [deg]."""
+def _parse_boresight(text, error_deg):
+    """(axis (3,), radius [rad]) of ``--boresight-deg RA,DEC`` and its error [deg] (checked before)."""
     from startrack.sphere import radec_to_vector
 
     ra_deg, dec_deg = _pair("--boresight-deg", text)
     check_range("--boresight-deg RA", ra_deg, -360.0, 720.0)
     check_range("--boresight-deg DEC", dec_deg, -90.0, 90.0)
-    check_range("--boresight-error-deg", error_deg, 0.0, 180.0)
     return radec_to_vector(ra_deg * DEG, dec_deg * DEG), error_deg * DEG
 
 
 def _fov_range(args):
     """(low, high) [rad] of the field of view searched, or None for the default range."""
-    if args.fov_deg is not None:
-        check_range("--fov-deg", args.fov_deg, 0.5, 90.0)
     if args.fov_range_deg is None:
         return None
     low, high = _pair("--fov-range-deg", args.fov_range_deg)
@@ -98,8 +118,50 @@ def _fov_range(args):
     return low * DEG, high * DEG
 
 
-def _frames(args, options):
-    """The SolveFrame records of the inputs (a single INPUT's read error is raised, a batch's reported)."""
+def _checked_geometry(args):
+    """Refuse options that contradict each other: a given camera and the unknown camera's search."""
+    for option, value in (("--fov-deg", args.fov_deg), ("--fov-hint-deg", args.fov_hint_deg)):
+        if value is not None:
+            check_range(option, value, 0.5, 90.0)
+    given = [o for o, v in (("--camera", args.camera), ("--fov-deg", args.fov_deg)) if v is not None]
+    search = [o for o, v in (("--fov-hint-deg", args.fov_hint_deg), ("--fov-range-deg", args.fov_range_deg)) if v is not None]
+    if len(given) == 2:
+        raise InputError("give the camera as --camera FILE or as --fov-deg F, not both.")
+    if given and search:
+        raise InputError(f"{given[0]} gives the camera; {search[0]} is the search of an unknown camera's field of view.")
+    if args.refit is not None and not given:
+        raise InputError("--refit refits a given camera: give --camera FILE or --fov-deg F.")
+    if args.write_camera is not None and given and args.refit is None:
+        raise InputError("--write-camera writes a fitted camera: give no camera, or --refit with it.")
+
+
+def _frame_solver(args):
+    """The :class:`startrack.commands.solve_modes.FrameSolver` of the options (checked)."""
+    from startrack.camera_file import read_camera_file
+
+    _checked_geometry(args)
+    fov_range = _fov_range(args)
+    if args.centroid_sigma_px is not None:
+        check_range("--centroid-sigma-px", args.centroid_sigma_px, 1e-3, 100.0)
+    check_range("--epoch", args.epoch, 1000.0, 3000.0)
+    check_range("--time-budget-s", args.time_budget_s, 1e-3, 3600.0)
+    check_range("--boresight-error-deg", args.boresight_error_deg, 0.0, 180.0)
+    check_range("--max-false-match", args.max_false_match, 1e-300, 1.0)
+    if args.mag is not None:
+        check_range("--mag", args.mag, -2.0, 8.0)
+    refit = None if args.refit is None else parse_refit(args.refit)
+    camera_file = None if args.camera is None else read_camera_file(args.camera)
+    plate = {"fov_range": fov_range, "epoch": args.epoch, "threshold": args.max_false_match,
+             "time_budget_s": args.time_budget_s, "mag_limit": args.mag, "progress": True}
+    return FrameSolver(camera_file, None if args.fov_deg is None else args.fov_deg * DEG, refit,
+                       centroid_sigma(args.centroid_sigma_px, camera_file), plate,
+                       None if args.fov_hint_deg is None else args.fov_hint_deg * DEG, args.mag, args.epoch,
+                       args.max_false_match)
+
+
+def _frames(args, options, camera_file):
+    """The SolveFrame records of the inputs (a single INPUT's read error is raised, a batch's reported);
+    centroid input has the size of --width/--height, else of the camera file."""
     if args.batch is not None and args.input:
         raise InputError("give either INPUT files or --batch PATH, not both.")
     if args.batch is None and not args.input:
@@ -107,20 +169,23 @@ def _frames(args, options):
     for option, value in (("--width", args.width), ("--height", args.height)):
         if value is not None and not 16 <= value <= 100_000:
             raise InputError(f"option {option} = {value} is not a number of pixels in [16, 100000].")
+    width, height = args.width, args.height
+    if camera_file is not None and width is None and height is None:
+        width, height = camera_file.camera.width, camera_file.camera.height
     if args.batch is not None:
-        yield from batch_frames(args.batch, options, args.width, args.height)
+        yield from batch_frames(args.batch, options, width, height)
         return
     single = len(args.input) == 1
     for path in args.input:
         try:
-            yield input_frame(path, options, args.width, args.height)
+            yield input_frame(path, options, width, height)
         except InputError as error:
             if single:
                 raise
             yield SolveFrame(str(path), reason=str(error))
 
 
-def _solve(solver, frame, args, camera, boresight):
+def _solve(solver, frame, boresight):
     from startrack.identify.result import IdentificationResult
 
     if frame.reason is not None:
@@ -129,10 +194,10 @@ def _solve(solver, frame, args, camera, boresight):
         return IdentificationResult(status="error", reason="centroid input needs --width and --height.", solve_ms=0.0)
     if len(frame.uv) == 0 and frame.detection is not None:
         return IdentificationResult(status="too_few", reason=_nothing_detected(frame.detection), solve_ms=0.0)
-    sigma = frame.sigma if frame.sigma is not None else np.full(len(frame.uv), args.centroid_sigma_px)
-    return solver.solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
-                        fov_hint=None if args.fov_deg is None else args.fov_deg * DEG, camera=camera,
-                        boresight=boresight)
+    try:
+        return solver.solve(frame, boresight)
+    except InputError as error:  # a frame that does not fit the camera file
+        return IdentificationResult(status="error", reason=str(error), solve_ms=0.0)
 
 
 def _nothing_detected(detection):
@@ -156,7 +221,7 @@ def _line(frame_id, result):
             f"{result.solve_ms:.2f} ms")
     if result.calibration is not None:
         cam, spread = result.calibration.camera, result.calibration.sigma
-        text += (f"\n  camera: FOV {math.degrees(cam.angular_width):.4f} +- {spread['fov_deg']:.4f} deg  "
+        text += (f"\n  camera ({result.camera_source}): FOV {math.degrees(cam.angular_width):.4f} +- {spread['fov_deg']:.4f} deg  "
                  f"f {cam.focal_px:.2f} +- {spread['focal_px']:.2f} px  c ({cam.cx:.1f}, {cam.cy:.1f}) +- "
                  f"({spread['cx']:.1f}, {spread['cy']:.1f}) px  k1 {cam.k1:+.4f} +- {spread['k1']:.4f}  "
                  f"rms {result.calibration.rms_px:.2f} px")
@@ -164,34 +229,18 @@ def _line(frame_id, result):
 
 
 def run(args):
-    from startrack.camera_file import read_camera_file, write_camera_file
-    from startrack.identify.plate_solver import PlateSolver
+    from startrack.camera_file import write_camera_file
 
     options = detection_options(args)
-    fov_range = _fov_range(args)
-    check_range("--epoch", args.epoch, 1000.0, 3000.0)
-    check_range("--boresight-error-deg", args.boresight_error_deg, 0.0, 180.0)
-    check_range("--centroid-sigma-px", args.centroid_sigma_px, 1e-3, 100.0)
-    check_range("--time-budget-s", args.time_budget_s, 1e-3, 3600.0)
-    check_range("--max-false-match", args.max_false_match, 1e-300, 1.0)
-    if args.mag is not None:
-        check_range("--mag", args.mag, -2.0, 8.0)
-    camera = None if args.camera is None else read_camera_file(args.camera)
-    boresight = None if args.boresight_deg is None else parse_boresight(args.boresight_deg, args.boresight_error_deg)
-    frames = _frames(args, options)
+    solver = _frame_solver(args)
+    boresight = None if args.boresight_deg is None else _parse_boresight(args.boresight_deg, args.boresight_error_deg)
+    frames = _frames(args, options, solver.camera_file)
     first = next(frames, None)  # a single INPUT's read error surfaces before the catalogs are loaded
-    solver = PlateSolver(fov_range=fov_range, epoch=args.epoch, threshold=args.max_false_match,
-                         time_budget_s=args.time_budget_s, mag_limit=args.mag, progress=True)
     best, all_ok = None, True
-    for frame in ([first] if first is not None else []) + list(frames):
-        try:
-            result = _solve(solver, frame, args, camera, boresight)
-        except InputError as error:  # a frame that does not fit the camera file
-            from startrack.identify.result import IdentificationResult
-
-            result = IdentificationResult(status="error", reason=str(error), solve_ms=0.0)
+    for frame in itertools.chain([] if first is None else [first], frames):
+        result = _solve(solver, frame, boresight)
         all_ok &= result.ok
-        if result.ok and (best is None or len(result.matches) > len(best[1].matches)):
+        if result.calibration is not None and (best is None or len(result.matches) > len(best[1].matches)):
             best = (frame.frame_id, result)
         record = result.to_dict(frame.frame_id)
         if frame.detection is not None:

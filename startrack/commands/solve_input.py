@@ -117,14 +117,15 @@ def batch_jsonl(path, width, height):
 
 
 def image_frame(path, options, width=None, height=None):
-    """The SolveFrame of an image file: read, size checked against --width/--height, detected."""
+    """The SolveFrame of an image file: read, size checked against the given one, detected."""
     from startrack.commands.detect import detect_frame
     from startrack.image_io import read_frame
 
     frame = read_frame(path)
     rows, cols = frame.image.shape
     if (width is not None and width != cols) or (height is not None and height != rows):
-        raise InputError(f"image {path} is {cols} x {rows} px, not --width {width} x --height {height}.")
+        wanted = f"{cols if width is None else width} x {rows if height is None else height}"
+        raise InputError(f"image {path} is {cols} x {rows} px, not the {wanted} px of --width/--height or the camera file.")
     found = detect_frame(frame, options)
     summary = {"detections": len(found), "background_dn": found.background, "sigma_n_dn": found.sigma_n,
                "threshold_dn": found.threshold, "full_scale_dn": frame.full_scale}

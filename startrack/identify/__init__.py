@@ -8,8 +8,10 @@ sub-catalogs' pairs), :mod:`~startrack.identify.pyramid` (the compiled triangle/
 :mod:`~startrack.identify.lost_in_space` (full sky), :mod:`~startrack.identify.subcatalog` (000 §4),
 :mod:`~startrack.identify.tracking`, :mod:`~startrack.identify.context` (what the strategies share),
 :mod:`~startrack.identify.warmup` (kernels loaded at construction), :mod:`~startrack.identify.result`
-(the result record) and :mod:`~startrack.identify.identifier` (:class:`StarIdentifier`, the one call
-per frame; each strategy is one compiled call).
+(the result record), :mod:`~startrack.identify.identifier` (:class:`StarIdentifier`, the one call
+per frame; each strategy is one compiled call) and :mod:`~startrack.identify.calibrated`
+(:class:`CalibratedSolver`: catalog and identifier built for a camera, frames taken as the plate solver
+takes them).
 
 Without a calibrated camera (issue 18): :mod:`~startrack.identify.pattern_catalog` (four-star patterns
 keyed by edge ratios, by scale level), :mod:`~startrack.identify.scale_free` (the compiled pattern
@@ -22,6 +24,7 @@ on first use (PEP 562), so a plate solve loads none of the calibrated identifier
 from startrack.lazy import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "startrack.identify.calibrated": ("CalibratedSolver",),
     "startrack.identify.identifier": ("METHODS", "Prior", "StarIdentifier"),
     "startrack.identify.plate_solver": ("PlateSolver",),
     "startrack.identify.result": ("IdentificationResult",),

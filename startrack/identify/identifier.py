@@ -269,7 +269,8 @@ class StarIdentifier:
         return IdentificationResult(
             status="ok", q_IS=quat_from_matrix(verified.R_IS), matches=matches, obs_S=obs_S, ref_I=ref_I,
             sigma=self._sigma, false_match_probability=verified.false_match_probability, method=strategy.name,
-            solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered)
+            solve_ms=1e3 * (time.perf_counter() - start), lost_hip=lost, entered_hip=entered, camera=self.camera,
+            camera_source="given")
 
 
 @njit

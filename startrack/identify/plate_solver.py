@@ -44,6 +44,12 @@ FIRST_STARS = 40
 #: reports leaves out the PSF's asymmetries, the pixel response and compression, so without a floor the
 #: brightest stars would take nearly all the weight of the fit.
 SIGMA_FLOOR_PX = 0.1
+#: The intrinsics a known camera can have refitted: focal length, principal point, k1, k2; and those
+#: refitted unless told otherwise (k2 is rarely determined by one frame).
+REFIT = ("focal", "centre", "k1", "k2")
+DEFAULT_REFIT = ("focal", "centre", "k1")
+#: Prior sigma of a held focal length, as a fraction of it: the fit's first step puts it at the camera's.
+HELD_FOCAL = 1e-9
 
 
 def _density_grid(uv, width, height):
@@ -112,17 +118,19 @@ class PlateSolver:
         self.load_ms = 1e3 * (time.perf_counter() - start)
 
     # ------------------------------------------------------------------ public
-    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None,
+    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None, refit=DEFAULT_REFIT,
               boresight=None) -> IdentificationResult:
         """Identify the detections ``uv`` (n, 2) [px] of a ``width`` x ``height`` frame; ``flux`` orders them
         (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3, with
         :data:`SIGMA_FLOOR_PX` added in quadrature);
         ``fov_hint`` [rad] searches the levels nearest it first; ``camera`` a
-        :class:`startrack.camera_file.CameraFile` known before (its focal length within 1 % or 3 sigma,
-        its principal point and distortion as the priors' means, within 3 times its sigma; InputError if
-        its size differs); ``boresight`` = (axis (3,) unit vector, radius [rad]): the hypotheses whose
-        pattern starts inside that cap are searched first, then the whole sky.  Never raises for the
-        frame's content."""
+        :class:`startrack.camera_file.CameraFile` known before, refined: the intrinsics named in ``refit``
+        (a subset of :data:`REFIT`) are fitted -- the focal length within 1 % or 3 sigma, the principal
+        point and distortion with priors about the camera's, 3 times its sigma where the file gives one
+        (else the solver's own prior; k2 that of k1 when the solver holds it) -- the others held at the
+        camera's (InputError if its size differs); ``boresight`` = (axis (3,) unit vector, radius [rad]):
+        the hypotheses whose pattern starts inside that cap are searched first, then the whole sky.  Never
+        raises for the frame's content."""
         start = time.perf_counter()
         checked = self._checked(uv, width, height, flux, sigma_px)
         if isinstance(checked, str):
@@ -131,7 +139,7 @@ class PlateSolver:
         candidates = pattern_candidates(uv, max(width, height) / 20.0)
         if candidates.size < 4:
             return _failed("too_few", f"{candidates.size} separated detections; at least 4 are needed", start)
-        params, prior, f_range = self._start(width, height, camera)
+        params, prior, f_range = self._start(width, height, camera, refit)
         settings = (self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0,
                     prior, _density_grid(uv, width, height), self.threshold)
         regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
@@ -144,7 +152,8 @@ class PlateSolver:
             result, count, done = self._search(frame, region, start)
             tried += count
             if result[0]:
-                return self._result(result, uv, sigma, index, width, height, start)
+                return self._result(result, uv, sigma, index, width, height, start,
+                                    "fitted" if camera is None else "refined")
             if done < n_combinations:
                 return _failed("no_match", f"time budget of {self.time_budget_s:g} s spent after {done} of "
                                f"{n_combinations} patterns ({tried} hypotheses verified)", start)
@@ -166,24 +175,32 @@ class PlateSolver:
         return result, tried, done
 
     # ------------------------------------------------------------------ internals
-    def _start(self, width, height, known):
+    def _start(self, width, height, known, refit):
         """(camera parameters the hypotheses start from, prior (mean (5,), sigma (5,): inf free without a
         prior, 0 held) of (f, cx, cy, k1, k2), focal-length range (2,) [px]) for a frame, with or without a
-        known camera (a :class:`startrack.camera_file.CameraFile`)."""
+        known camera (a :class:`startrack.camera_file.CameraFile`) and the intrinsics of it ``refit``."""
         params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0])
         sigma = self.prior_sigma.copy()
         sigma[1:3] *= max(width, height)
         f_range = np.array([width / 2.0 / math.tan(self.fov_range[1] / 2.0), width / 2.0 / math.tan(self.fov_range[0] / 2.0)])
-        if known is not None:
-            cam = known.camera
-            if (cam.width, cam.height) != (width, height):
-                raise InputError(f"the camera is {cam.width} x {cam.height} px, the frame {width} x {height} px.")
-            params[[1, 2, 5, 6]] = cam.cx, cam.cy, cam.k1, cam.k2
-            for k, name in enumerate(("cx", "cy", "k1", "k2")):
-                if name in known.sigma:
-                    sigma[k + 1] = 3.0 * known.sigma[name]
-            spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
-            f_range = np.array([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)])
+        if known is None:
+            return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
+        unknown = set(refit) - set(REFIT)
+        if unknown:
+            raise InputError(f"cannot refit {', '.join(sorted(unknown))}: the intrinsics are {', '.join(REFIT)}.")
+        cam = known.camera
+        if (cam.width, cam.height) != (width, height):
+            raise InputError(f"the camera is {cam.width} x {cam.height} px, the frame {width} x {height} px.")
+        params[[0, 1, 2, 5, 6]] = cam.focal_px, cam.cx, cam.cy, cam.k1, cam.k2
+        sigma[4] = sigma[4] or sigma[3]  # k2 named for a refit is fitted, with k1's prior unless the solver has one
+        for k, name in enumerate(("cx", "cy", "k1", "k2")):
+            given = known.sigma.get(name, 0.0)
+            refitted = ("centre" if k < 2 else name) in refit
+            sigma[k + 1] = (3.0 * given if given > 0.0 else sigma[k + 1]) if refitted else 0.0
+        spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
+        f_range = np.array([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)])
+        if "focal" not in refit:  # the pattern's focal length starts the fit, which a tight prior pulls to the camera's
+            sigma[0] = HELD_FOCAL * cam.focal_px
         return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
 
     def _level_order(self, fov_hint):
@@ -215,7 +232,7 @@ class PlateSolver:
         index = index[inside]
         return np.ascontiguousarray(uv[index]), np.ascontiguousarray(np.hypot(sigma[index], SIGMA_FLOOR_PX)), index
 
-    def _result(self, result, uv, sigma, index, width, height, start):
+    def _result(self, result, uv, sigma, index, width, height, start, source):
         _, R_IS, params, covariance, obs_index, star_index, probability, n_predicted, _, reduced = result
         camera = Camera(width, height, params[0], cx=params[1], cy=params[2], k1=params[5], k2=params[6])
         order = np.argsort(index[obs_index], kind="stable")
@@ -229,8 +246,8 @@ class PlateSolver:
         return IdentificationResult(
             status="ok", q_IS=from_matrix(R_IS), matches=np.column_stack([index[obs_index], self.hip[star_index]]),
             obs_S=camera.unproject(uv[obs_index]), ref_I=self.vectors[star_index], sigma=rms / camera.focal_px,
-            false_match_probability=float(probability), method="pattern", calibration=calibration,
-            solve_ms=1e3 * (time.perf_counter() - start))
+            false_match_probability=float(probability), method="pattern", calibration=calibration, camera=camera,
+            camera_source=source, solve_ms=1e3 * (time.perf_counter() - start))
 
     def _warm_up(self):
         """Load (or compile) the kernels: an identifiable frame of catalog stars and an unidentifiable one."""

@@ -20,7 +20,9 @@ from startrack.units import ARCSEC
 #: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
 #: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
 STATUSES = ("ok", "no_match", "too_few", "error")
-
+#: Where the camera of an answer came from: given (a calibrated camera: a camera file, or a field of view
+#: and the frame size), fitted from the stars alone, or refined from a given camera (``--refit``).
+CAMERA_SOURCES = ("given", "fitted", "refined")
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,7 +34,7 @@ class IdentificationResult:
         :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
     matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number), by centroid index.
     obs_S, ref_I: (M, 3) the matched centroid directions in S and their catalog directions in I (the
-        measurements a filter uses); sigma: their per-axis angular noise [rad].
+        measurements a filter uses); sigma: their per-axis angular noise [rad], scalar or (M,).
         :attr:`residuals` and :attr:`covariance` are derived from them when asked.
     false_match_probability: chance that a wrong attitude hypothesis explains as many centroids
         (:func:`startrack.identify.verify.false_match_probability`); NaN when nothing was verified.
@@ -42,8 +44,10 @@ class IdentificationResult:
     lost_hip / entered_hip: tracking only -- previously tracked stars predicted inside the field but not
         found, and stars identified now that were not tracked before (HIP numbers).
     calibration: the camera the frame calibrated (:class:`startrack.camera_fit.CameraCalibration`), when
-        the camera was not known (:class:`startrack.identify.plate_solver.PlateSolver`); then
+        the camera was fitted or refined (:class:`startrack.identify.plate_solver.PlateSolver`); then
         :attr:`covariance` is the fit's, which includes the intrinsics' uncertainty.
+    camera: the :class:`startrack.camera.Camera` whose frame S ``q_IS`` is the attitude of (None when not
+        ok); camera_source: where it came from, one of :data:`CAMERA_SOURCES` ("" when not ok).
     """
 
     status: str
@@ -59,10 +63,14 @@ class IdentificationResult:
     lost_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     entered_hip: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     calibration: object = None
+    camera: object = None
+    camera_source: str = ""
 
     def __post_init__(self):
         if self.status not in STATUSES:
             raise ValueError(f"identification status {self.status!r} is not one of {STATUSES}")
+        if self.camera_source not in CAMERA_SOURCES + ("",):
+            raise ValueError(f"camera source {self.camera_source!r} is not one of {CAMERA_SOURCES}")
 
     @property
     def ok(self) -> bool:
@@ -131,10 +139,11 @@ class IdentificationResult:
                 sigma_arcsec=[float(s) for s in sigma],
                 false_match_probability=float(self.false_match_probability),
             )
-            if self.calibration is not None:
-                ra, dec, roll = (math.degrees(float(x)) for x in self.calibration.center_radec_roll(self.q_IS))
+            if self.camera is not None:
+                ra, dec, roll = (math.degrees(float(x)) for x in self.camera.center_radec_roll(self.q_IS))
                 out["center"] = {"ra_deg": ra, "dec_deg": dec, "roll_deg": roll}
-                out["camera"] = self.calibration.to_dict()
+                out["camera"] = {"source": self.camera_source, **_camera_dict(self.camera),
+                                 **({} if self.calibration is None else self.calibration.to_dict())}
             if self.method == "tracking":
                 out["lost_hip"] = [int(h) for h in self.lost_hip]
                 out["entered_hip"] = [int(h) for h in self.entered_hip]
@@ -142,3 +151,8 @@ class IdentificationResult:
         out["solve_ms"] = round(float(self.solve_ms), 4)
         return out
 
+
+def _camera_dict(camera) -> dict:
+    """The geometry of ``camera`` as the ``camera`` entry of ``startrack solve --json`` gives it."""
+    return {"width": camera.width, "height": camera.height, "fov_deg": math.degrees(camera.angular_width),
+            "focal_px": camera.focal_px, "cx": camera.cx, "cy": camera.cy, "k1": camera.k1, "k2": camera.k2}

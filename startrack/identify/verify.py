@@ -250,7 +250,7 @@ def _field_radius(camera) -> float:
     return float(np.arccos(np.min(camera.unproject(corners)[:, 2])))
 
 
-def _field_solid_angle(camera, blocks: int = 128) -> float:
+def field_solid_angle(camera, blocks: int = 128) -> float:
     """Solid angle [sr] of the sensor's field: sum of f^-2 z^3 dA over a grid of image blocks."""
     u = (np.arange(blocks) + 0.5) * camera.width / blocks - 0.5
     v = (np.arange(blocks) + 0.5) * camera.height / blocks - 0.5
@@ -281,7 +281,7 @@ class FieldStars:
         self.field_radius = _field_radius(camera)
         self.search_radius = self.field_radius + _FIELD_MARGIN  # the stars verify_near projects
         self.zones = zone_index(self.vectors)
-        self.solid_angle = _field_solid_angle(camera)
+        self.solid_angle = field_solid_angle(camera)
         radius = self.field_radius + catalog.s_max
         pairs = cKDTree(catalog.base_vectors).sparse_distance_matrix(
             cKDTree(self.vectors), float(chord(radius)), output_type="ndarray")

@@ -93,6 +93,6 @@ def test_calibration_record_sigma_and_centre():
     assert sigma["focal_px"] == pytest.approx(2.0) and sigma["k1"] == pytest.approx(0.01) and sigma["k2"] == 0.0
     assert sigma["fov_deg"] > 0.0
     q_IS = random_attitude(np.random.default_rng(5))
-    ra, dec, _ = calibration.center_radec_roll(q_IS)
+    ra, dec, _ = calibration.camera.center_radec_roll(q_IS)
     centre = TRUE.unproject([[511.5, 383.5]])[0] @ to_matrix(q_IS).T
     assert np.allclose(centre, [np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], atol=1e-12)

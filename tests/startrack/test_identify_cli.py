@@ -1,23 +1,27 @@
 """``startrack solve``: centroid CSV (with and without header/flux), image, JSON Lines batch, bad input.
 
-The field of view is a hint (``--fov-deg``) and the camera is calibrated from the stars, so the
+With ``--fov-deg`` and the frame size the camera is given (an ideal pinhole) and the frame is identified
+as a star tracker does (``tests/startrack/test_solve_given_camera.py`` checks its accuracy).  With
+``--fov-hint-deg`` the field of view is a hint and the camera is calibrated from the stars, so the
 attitude checked against the truth is the pointing of the image centre (``center``), which the stars
 fix; the sensor frame's +z runs through the fitted principal point, known only to its sigma.
 """
 
 import json
+import re
 
 import numpy as np
 import pytest
 
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
-from startrack.camera_fit import CameraCalibration
 from startrack.cli import main
 from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.star_catalog import load_star_catalog
 
-GEOMETRY = ["--fov-deg", "16", "--width", "1024", "--height", "1024"]
+SIZE = ["--width", "1024", "--height", "1024"]
+GEOMETRY = ["--fov-deg", "16", *SIZE]
+HINT = ["--fov-hint-deg", "16", *SIZE]
 
 
 @pytest.fixture(scope="module")
@@ -37,15 +41,16 @@ def _run(capsys, argv):
 
 def _center_error(record, camera, q_IS):
     """Angle [rad] between the reported image-centre attitude and the true one."""
-    truth = CameraCalibration(camera, np.zeros((8, 8)), 0.0, 0.0, 0, 0, 0.0).center_radec_roll(q_IS)
+    truth = camera.center_radec_roll(q_IS)
     center = record["center"]
     found = np.radians([center["ra_deg"], center["dec_deg"], center["roll_deg"]])
     R = matrix_from_radec_roll(*truth).T @ matrix_from_radec_roll(*found)
     return float(np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)))
 
 
-def _check_identified(record, camera, frame):
-    assert record["status"] == "ok" and record["method"] == "pattern"
+def _check_identified(record, camera, frame, source):
+    assert record["status"] == "ok" and record["camera"]["source"] == source
+    assert record["method"] == ("lost_in_space" if source == "given" else "pattern")
     for pair in record["matches"]:
         assert frame.hip[pair[0]] == pair[1]
     assert _center_error(record, camera, frame.q_IS) < 1e-4
@@ -54,15 +59,16 @@ def _check_identified(record, camera, frame):
         assert key in record
 
 
-def test_csv_with_header_and_flux(tmp_path, capsys, frame):
+@pytest.mark.parametrize("geometry, source", [(GEOMETRY, "given"), (HINT, "fitted")])
+def test_csv_with_header_and_flux(tmp_path, capsys, frame, geometry, source):
     camera, f = frame
     path = tmp_path / "frame.csv"
     np.savetxt(path, np.column_stack([f.uv, f.flux]), delimiter=",", header="u,v,flux", comments="")
-    status, out, _ = _run(capsys, ["solve", str(path), *GEOMETRY, "--centroid-sigma-px", "0.1", "--json"])
+    status, out, _ = _run(capsys, ["solve", str(path), *geometry, "--centroid-sigma-px", "0.1", "--json"])
     assert status == 0
     record = json.loads(out)
     assert record["id"] == str(path)
-    _check_identified(record, camera, f)
+    _check_identified(record, camera, f, source)
 
 
 def test_csv_without_header_or_flux_in_brightness_order(tmp_path, capsys, frame):
@@ -93,7 +99,8 @@ def test_image_is_detected_then_identified(tmp_path, capsys, frame):
     assert record["detection"]["detections"] >= len(record["matches"])
 
 
-def test_batch_reports_every_frame_and_bad_lines(tmp_path, capsys, frame):
+@pytest.mark.parametrize("geometry, source", [(GEOMETRY, "given"), (HINT, "fitted")])
+def test_batch_reports_every_frame_and_bad_lines(tmp_path, capsys, frame, geometry, source):
     camera, f = frame
     lines = [json.dumps({"id": "good", "centroids": np.column_stack([f.uv, f.flux]).tolist()}),
              json.dumps({"id": "nan", "centroids": [[1, 2, 1], [3, float("nan"), 1], [5, 6, 1]]}),
@@ -104,16 +111,47 @@ def test_batch_reports_every_frame_and_bad_lines(tmp_path, capsys, frame):
              "{broken", ""]
     path = tmp_path / "frames.jsonl"
     path.write_text("\n".join(lines) + "\n")
-    status, out, err = _run(capsys, ["solve", "--batch", str(path), *GEOMETRY, "--centroid-sigma-px", "0.1",
+    status, out, err = _run(capsys, ["solve", "--batch", str(path), *geometry, "--centroid-sigma-px", "0.1",
                                      "--json"])
     records = [json.loads(line) for line in out.splitlines()]
     assert status == 1 and err == ""
     assert [r["status"] for r in records] == ["ok", "error", "too_few", "error", "error", "error", "error"]
     assert [r["id"] for r in records] == ["good", "nan", "two", "off", "text", "extra", 7]
-    _check_identified(records[0], camera, f)
+    _check_identified(records[0], camera, f, source)
     for record in records[1:]:
         assert record["reason"]
     assert "unknown key(s) fov" in records[5]["reason"]
+
+
+def test_refit_refines_the_given_camera_and_holds_the_rest(tmp_path, capsys, frame):
+    camera, f = frame
+    path = tmp_path / "frame.csv"
+    np.savetxt(path, np.column_stack([f.uv, f.flux]), delimiter=",")
+    for refit in ("centre,k1", "all"):
+        status, out, _ = _run(capsys, ["solve", str(path), *GEOMETRY, "--refit", refit, "--centroid-sigma-px", "0.1",
+                                       "--json"])
+        record = json.loads(out)
+        assert status == 0 and record["camera"]["source"] == "refined" and record["method"] == "pattern"
+        assert _center_error(record, camera, f.q_IS) < 1e-4
+        fitted = record["camera"]
+        if refit == "all":  # fitted: within its sigma of the truth, not at the given value
+            assert fitted["focal_px"] != camera.focal_px and fitted["k2"] != 0.0
+            assert abs(fitted["focal_px"] - camera.focal_px) < 5.0 * fitted["sigma"]["focal_px"]
+        else:  # held by a prior of 1e-9 of it; k2 held exactly
+            assert abs(fitted["focal_px"] / camera.focal_px - 1.0) < 1e-8 and fitted["k2"] == 0.0
+            assert fitted["sigma"]["cx"] > 0.0 and fitted["sigma"]["k2"] == 0.0
+
+
+def test_a_frame_the_given_camera_cannot_identify_says_what_camera_it_shows(tmp_path, capsys, frame):
+    _, f = frame
+    path = tmp_path / "frame.csv"
+    np.savetxt(path, np.column_stack([f.uv, f.flux]), delimiter=",")
+    status, out, _ = _run(capsys, ["solve", str(path), "--fov-deg", "16.8", *SIZE, "--centroid-sigma-px", "0.1", "--json"])
+    record = json.loads(out)
+    assert status == 1 and record["status"] == "no_match" and "q_IS" not in record
+    assert "with the given camera. Solved as an unknown camera, the frame shows" in record["reason"]
+    shown = re.search(r"FOV (\d+\.\d+) deg \(given 16.8000\)", record["reason"])
+    assert shown and abs(float(shown.group(1)) - 16.0) < 0.01
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -128,6 +166,13 @@ def test_batch_reports_every_frame_and_bad_lines(tmp_path, capsys, frame):
     (["solve", "FILE", "--camera", "no-such-camera.toml"], "does not exist"),
     (["solve", "FILE", "--time-budget-s", "-1"], "--time-budget-s"),
     (["solve", "FILE", "--mesh-px", "3"], "--mesh-px"),
+    (["solve", "FILE", "--fov-hint-deg", "inf", *SIZE], "--fov-hint-deg"),
+    (["solve", "FILE", *GEOMETRY, "--camera", "cam.toml"], "not both"),
+    (["solve", "FILE", *GEOMETRY, "--fov-hint-deg", "16"], "--fov-hint-deg"),
+    (["solve", "FILE", *GEOMETRY, "--fov-range-deg", "10,20"], "--fov-range-deg"),
+    (["solve", "FILE", *HINT, "--refit", "focal"], "--refit refits a given camera"),
+    (["solve", "FILE", *GEOMETRY, "--refit", "focal,zoom"], "--refit"),
+    (["solve", "FILE", *GEOMETRY, "--write-camera", "out.toml"], "--write-camera"),
 ])
 def test_bad_options_end_with_one_line(tmp_path, capsys, argv, message):
     path = tmp_path / "frame.csv"

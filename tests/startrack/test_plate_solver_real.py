@@ -72,7 +72,7 @@ def test_frame_solved_without_field_of_view(solver, solved, name):
     assert result.ok, result.reason
     calibration = result.calibration
     assert abs(math.degrees(calibration.camera.angular_width) / reference["fov_deg"] - 1.0) < 1e-3
-    centre = calibration.center_radec_roll(result.q_IS)
+    centre = calibration.camera.center_radec_roll(result.q_IS)
     truth = np.radians([reference["ra_deg"], reference["dec_deg"], reference["roll_deg"]])
     error = matrix_from_radec_roll(*truth).T @ matrix_from_radec_roll(*centre)
     cross = math.hypot(error[0, 2], error[1, 2])  # boresight offset [rad] (small angles)

@@ -20,7 +20,6 @@ import pytest
 
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
-from startrack.camera_fit import CameraCalibration
 from startrack.detection import detect
 from startrack.identify.plate_solver import PlateSolver
 from startrack.identify.simulate import as_jpeg, noise_crowd, random_attitude, rendered_sky
@@ -51,8 +50,8 @@ def _solve(solver, image, full_scale):
 
 def _centre_error(result, camera, q_IS):
     """Angle [rad] between the solved and the true attitude of the image centre."""
-    truth = CameraCalibration(camera, np.zeros((8, 8)), 0.0, 0.0, 0, 0, 0.0).center_radec_roll(q_IS)
-    solved = result.calibration.center_radec_roll(result.q_IS)
+    truth = camera.center_radec_roll(q_IS)
+    solved = result.calibration.camera.center_radec_roll(result.q_IS)
     R = matrix_from_radec_roll(*truth).T @ matrix_from_radec_roll(*solved)
     return math.acos(min(1.0, (np.trace(R) - 1.0) / 2.0))
 

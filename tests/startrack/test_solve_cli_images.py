@@ -47,7 +47,7 @@ def test_batch_list_of_images_and_several_inputs(tmp_path, capsys):
     listing = tmp_path / "frames.txt"
     listing.write_text("# two frames\n" + "\n".join(str(f) for f in FRAMES[:2]) + "\n")
     status, out, _ = _run(capsys, ["solve", "--batch", str(listing)])
-    assert status == 0 and out.count(": ok  RA") == 2 and out.count("camera: FOV") == 2
+    assert status == 0 and out.count(": ok  RA") == 2 and out.count("camera (fitted): FOV") == 2
     status, out, _ = _run(capsys, ["solve", str(FRAMES[0]), str(tmp_path / "missing.tiff"), "--json"])
     records = [json.loads(line) for line in out.splitlines()]
     assert status == 1 and [r["status"] for r in records] == ["ok", "error"]
@@ -80,7 +80,7 @@ def test_all_dark_and_empty_frames_say_why(tmp_path, capsys):
     ("missing", [], "does not exist"),
     ("good", ["--fov-range-deg", "5"], "--fov-range-deg"),
     ("good", ["--mag", "9.5"], "--mag"),
-    ("good", ["--width", "1000"], "not --width 1000"),
+    ("good", ["--width", "1000"], "not the 1000 x"),
     ("good", ["--batch", "x"], "not both"),
 ])
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, setup, argv_tail, message):

@@ -1,0 +1,134 @@
+"""How ``startrack solve`` identifies a frame: with the camera it is given, or with the camera it fits.
+
+* **given camera** (``--camera FILE``, or ``--fov-deg F`` with the frame's size: an ideal pinhole, principal
+  point at the centre of the pixel grid, no distortion): a star tracker's identification
+  (:class:`startrack.identify.calibrated.CalibratedSolver`, one per camera); the attitude is that camera's.
+  A frame it cannot identify is solved once more as from an unknown camera, and its reason gives the
+  camera the stars show beside the given one (it stays ``no_match``: refitting is asked for with
+  ``--refit``);
+* **refined camera** (a given camera and ``--refit focal,centre,k1,k2``): the plate solver from the given
+  camera, the intrinsics named refitted per frame, the others held;
+* **fitted camera** (no geometry): the plate solver (:class:`startrack.identify.plate_solver.PlateSolver`),
+  with ``--fov-hint-deg`` / ``--fov-range-deg``.
+
+Every solver is built on first use, so a single bad INPUT fails before the catalogs are loaded.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from startrack.errors import InputError
+
+#: Centroid sigma [px] of centroid lists and of a given camera's gates when neither the option nor the
+#: camera file's fit gives one.
+DEFAULT_CENTROID_SIGMA_PX = 0.3
+
+
+def parse_refit(text):
+    """The intrinsics of ``--refit`` (comma-separated names of :data:`REFIT`, or ``all``)."""
+    from startrack.identify.plate_solver import REFIT
+
+    names = tuple(REFIT) if text.strip() == "all" else tuple(n.strip() for n in text.split(","))
+    unknown = [n for n in names if n not in REFIT]
+    if unknown or not names:
+        raise InputError(f"option --refit = {text!r}: give some of {','.join(REFIT)} (comma-separated) or all.")
+    return names
+
+
+def centroid_sigma(option, camera_file):
+    """The centroid sigma [px]: the option's, else the camera file's fit RMS, else the default."""
+    if option is not None:
+        return option
+    rms = {} if camera_file is None else camera_file.fit.get("rms_px")
+    if isinstance(rms, (int, float)) and not isinstance(rms, bool) and 0.0 < rms <= 100.0:
+        return float(rms)
+    return DEFAULT_CENTROID_SIGMA_PX
+
+
+class FrameSolver:
+    """The solve of every frame of one ``startrack solve`` run.
+
+    camera_file: a :class:`startrack.camera_file.CameraFile` or None; fov: the field of view [rad] of an
+    ideal pinhole of the frame's size, or None; refit: intrinsics refitted (None: the camera is used as
+    given); sigma_px: centroid sigma of centroid lists and of the given camera's gates [px]; plate:
+    keyword arguments of the plate solver; fov_hint [rad] or None; mag_limit, epoch, threshold as the
+    solvers take them.
+    """
+
+    def __init__(self, camera_file, fov, refit, sigma_px, plate, fov_hint, mag_limit, epoch, threshold):
+        self.camera_file, self.fov, self.refit, self.sigma_px = camera_file, fov, refit, sigma_px
+        self.plate_options, self.fov_hint = plate, fov_hint
+        self.mag_limit, self.epoch, self.threshold = mag_limit, epoch, threshold
+        self._plate, self._calibrated = None, {}
+
+    @property
+    def given(self):
+        """True when the frames come with their camera."""
+        return self.camera_file is not None or self.fov is not None
+
+    def solve(self, frame, boresight):
+        """The :class:`startrack.identify.result.IdentificationResult` of a readable ``SolveFrame``."""
+        sigma = frame.sigma if frame.sigma is not None else np.full(len(frame.uv), self.sigma_px)
+        if not self.given:
+            return self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma, fov_hint=self.fov_hint,
+                                    boresight=boresight)
+        known = self._camera_file(frame.width, frame.height)
+        if self.refit is not None:
+            return self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma, camera=known,
+                                    refit=self.refit, boresight=boresight)
+        weights = None  # centroid lists: the stated sigma of the identifier's gates
+        if frame.sigma is not None:  # a detection's sigma leaves out the PSF's and pixels' own errors
+            from startrack.identify.plate_solver import SIGMA_FLOOR_PX
+
+            weights = np.hypot(frame.sigma, SIGMA_FLOOR_PX)
+        result = self._calibrated_solver(known.camera).solve(frame.uv, frame.width, frame.height, frame.flux, weights,
+                                                              boresight=boresight)
+        return self._diagnosed(result, frame, known, sigma, boresight) if result.status == "no_match" else result
+
+    # ------------------------------------------------------------------ internals
+    @property
+    def plate(self):
+        if self._plate is None:
+            from startrack.identify.plate_solver import PlateSolver
+
+            self._plate = PlateSolver(**self.plate_options)
+        return self._plate
+
+    def _camera_file(self, width, height):
+        if self.camera_file is not None:
+            return self.camera_file
+        from startrack.camera import Camera
+        from startrack.camera_file import CameraFile
+
+        return CameraFile(Camera.from_fov(self.fov, width, height))
+
+    def _calibrated_solver(self, camera):
+        key = (camera.width, camera.height)
+        if key not in self._calibrated:
+            from startrack.identify.calibrated import CalibratedSolver
+
+            self._calibrated[key] = CalibratedSolver(camera, self.mag_limit, self.epoch, self.sigma_px, self.threshold,
+                                                     progress=True)
+        return self._calibrated[key]
+
+    def _diagnosed(self, result, frame, known, sigma, boresight):
+        """``result`` (no_match with the given camera) with what a solve as an unknown camera finds."""
+        unknown = self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
+                                   fov_hint=known.camera.angular_width, boresight=boresight)
+        if not unknown.ok:
+            return result
+        reason = (f"{result.reason.rstrip('.')} with the given camera. Solved as an unknown camera, the frame shows "
+                  f"{_camera_change(known.camera, unknown.camera)}: the given camera does not fit it (--refit refines "
+                  f"it per frame, no geometry fits one from the stars).")
+        return dataclasses.replace(result, reason=reason)
+
+
+def _camera_change(given, fitted):
+    """The fitted camera beside the given one, in words."""
+    return (f"focal {fitted.focal_px:.2f} px (given {given.focal_px:.2f}), FOV {math.degrees(fitted.angular_width):.4f} deg "
+            f"(given {math.degrees(given.angular_width):.4f}), centre ({fitted.cx:.1f}, {fitted.cy:.1f}) px (given "
+            f"({given.cx:.1f}, {given.cy:.1f})), k1 {fitted.k1:+.4f} (given {given.k1:+.4f})")
