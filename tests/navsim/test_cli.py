@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import navsim
+from tests.support import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity: fast
@@ -16,7 +17,7 @@ DEMO = ROOT / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity: fas
 
 def navsim_cli(*args):
     return subprocess.run([sys.executable, "-m", "navsim.cli", *map(str, args)], capture_output=True,
-                          text=True, cwd=ROOT, timeout=300)
+                          text=True, cwd=ROOT, timeout=HANG_S)
 
 
 def test_run_writes_summary_and_timeseries(tmp_path):

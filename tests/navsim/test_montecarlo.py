@@ -5,7 +5,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +13,7 @@ import pytest
 import navsim.campaign.montecarlo as mc
 from navsim.simulation import run, run_batch
 from startrack.errors import InputError
+from tests.support import HANG_S, finished_runs, wait_for
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -56,15 +56,10 @@ def test_killed_campaign_resumes_to_the_same_summary(tmp_path, base_scenario):
                "--workers", "1"]
     process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                start_new_session=True)
-    deadline = time.time() + 120
-    while time.time() < deadline:
-        finished = list((out / "runs").glob("run_*/summary.json")) if (out / "runs").exists() else []
-        if len(finished) >= 3:
-            break
-        time.sleep(0.002)
+    wait_for(lambda: len(finished_runs(out)) >= 3, "3 finished runs")
     os.killpg(process.pid, signal.SIGKILL)
     process.wait()
-    finished_before = len(list((out / "runs").glob("run_*/summary.json")))
+    finished_before = len(finished_runs(out))
     assert 3 <= finished_before < runs
     assert not (out / "summary.json").exists()
     resumed = mc.run_campaign(scenario, runs, out, workers=1, progress=False)
@@ -165,14 +160,12 @@ def test_ctrl_c_cancels_the_pending_runs_and_keeps_the_finished(tmp_path, base_s
                "--workers", "2"]
     process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                start_new_session=True)
-    deadline = time.time() + 600  # a loaded machine may take minutes to start the pool and finish 3 runs
-    while time.time() < deadline and len(list(out.glob("runs/run_*/summary.json"))) < 3:
-        time.sleep(0.01)
+    wait_for(lambda: len(finished_runs(out)) >= 3, "3 finished runs")  # runs in place, not a .partial
     os.killpg(process.pid, signal.SIGINT)
-    _, err = process.communicate(timeout=60)
+    _, err = process.communicate(timeout=HANG_S)
     assert process.returncode == 130
     assert err.strip().splitlines()[-1] == "navsim: interrupted" and "Traceback" not in err
-    assert 3 <= len(list(out.glob("runs/run_*/summary.json"))) < runs
+    assert 3 <= len(finished_runs(out)) < runs
     assert not (out / "campaign.lock").exists()
     resumed = mc.run_campaign(scenario, runs, out, workers=1, progress=False)
     assert resumed["runs_finished"] == runs and not list(out.glob("runs/*.partial"))

@@ -17,7 +17,7 @@ from navsim.earth.wgs84 import radii
 from navsim.records import RunSummary
 from navsim.simulation import run_batch
 from startrack import units
-from tests.support import pdf_text
+from tests.support import HANG_S, pdf_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = Path(__file__).resolve().parent / "data" / "base_navigation.toml"
@@ -137,7 +137,7 @@ def test_position_aided_campaign_of_the_shipped_scenario(tmp_path):
     out = tmp_path / "aided"
     done = subprocess.run([sys.executable, "-m", "navsim.cli", "montecarlo", "scenarios/position_aided_aircraft.toml",
                            "--runs", "50", "--workers", "2", "--out", str(out)], cwd=ROOT, capture_output=True, text=True,
-                          timeout=1800)
+                          timeout=HANG_S)
     assert done.returncode == 0, done.stderr
     summary = json.loads((out / "summary.json").read_text())
     nees = summary["nees"]

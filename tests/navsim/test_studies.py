@@ -15,6 +15,7 @@ import navsim
 from navsim.report import write_report
 from navsim.scenario import load_scenario, scenario_from_dict
 from startrack.errors import InputError
+from tests.support import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 PRECISION = ROOT / "scenarios" / "paper003_precision.toml"
@@ -30,7 +31,7 @@ SMALL_CONTEST = {"study.contest_starmap.maps": 120, "study.contest_starmap.casad
 
 def navsim_cli(*args):
     return subprocess.run([sys.executable, "-m", "navsim.cli", *map(str, args)], capture_output=True,
-                          text=True, cwd=ROOT, timeout=600)
+                          text=True, cwd=ROOT, timeout=HANG_S)
 
 
 @pytest.fixture(scope="module")

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from navsim.campaign.tuning import tune
+from tests.support import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -32,7 +33,7 @@ def test_tune_recovers_the_arw_ratio_and_restores_consistency(base_scenario):
 def test_tune_command_prints_the_settings_to_use():
     done = subprocess.run([sys.executable, "-m", "navsim.cli", "tune", "scenarios/paper000_high_dynamic.toml", "--runs", "2",
                            "--evaluations", "3", "--set", "duration_s=5"], cwd=ROOT, capture_output=True, text=True,
-                          timeout=300)
+                          timeout=HANG_S)
     assert done.returncode == 0, done.stderr
     assert "use: --set filter.process_noise_scale=" in done.stdout
     assert "before: NEES/dof" in done.stdout

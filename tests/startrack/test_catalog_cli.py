@@ -8,6 +8,7 @@ import sys
 import pytest
 
 from startrack.cli import main
+from tests.support import HANG_S
 
 CATALOG_KEYS = {
     "candidates", "excluded", "guide_stars", "base_points", "s_max_deg", "rho_sub_deg", "pairs",
@@ -100,6 +101,6 @@ def test_unparsable_numbers_exit_2_without_traceback():
     for argv in (["address", "--ra-deg", "abc", "--dec-deg", "1"], ["address", "--ra-deg", "1", "--dec-deg", "91"],
                  ["catalog", "--nd", "x"]):  # fmt: skip
         result = subprocess.run([sys.executable, "-m", "startrack.cli", *argv], capture_output=True, text=True,
-                                timeout=60)  # fmt: skip
+                                timeout=HANG_S)  # fmt: skip
         assert result.returncode == 2
         assert "Traceback" not in result.stderr and "error" in result.stderr

@@ -14,6 +14,7 @@ unless right.  The default suite runs a few frames of each kind; the slow one 60
 """
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -21,15 +22,26 @@ import pytest
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
 from startrack.detection import detect
+from startrack.identify import plate_solver
 from startrack.identify.plate_solver import PlateSolver
 from startrack.identify.simulate import as_jpeg, noise_crowd, random_attitude, rendered_sky
 from startrack.star_catalog import load_star_catalog
 from startrack.units import ARCSEC, DEG
+from tests.support import SteppedClock
 
 WIDTH, HEIGHT = 1024, 768
 BLEND_PX = 1.5
 JPEG_BLEND_PX = 3.0
 WRONG_ANGLE = 60.0 * ARCSEC
+
+
+@pytest.fixture(scope="module", autouse=True)
+def stepped_clock():
+    """The plate solver's clock advances 1 ms per look (about one chunk of combinations), so its 1 s budget
+    ends after the same search on any machine, loaded or not."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(plate_solver, "time", SimpleNamespace(perf_counter=SteppedClock(1e-3)))
+        yield
 
 
 @pytest.fixture(scope="module")
@@ -140,8 +152,9 @@ def _crowd_case(solver, stars, seed, with_stars):
     return result
 
 
-def test_crowds_of_false_detections_never_give_an_answer():
+def test_crowds_of_false_detections_never_give_an_answer(monkeypatch):
     quick = PlateSolver(time_budget_s=0.2)
+    monkeypatch.setattr(plate_solver, "time", SimpleNamespace(perf_counter=SteppedClock(0.05)))  # 4 looks
     for seed in (5, 6):
         result = _crowd_case(quick, None, seed, with_stars=False)
         assert result.status == "no_match" and "time budget" in result.reason

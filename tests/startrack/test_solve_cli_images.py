@@ -4,13 +4,16 @@ bad input (missing, corrupt, empty, all-dark, NaN frames; wrong options) answere
 import json
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from PIL import Image
 
 from startrack.cli import main
+from startrack.identify import plate_solver
 from startrack.image_io import read_image
+from tests.support import SteppedClock
 
 FRAMES = sorted((Path(__file__).resolve().parents[1] / "data" / "realsky").glob("*.tiff"))
 
@@ -97,7 +100,9 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, setup, argv_tail, me
     assert status == 2 and out == "" and err.count("\n") == 1 and message in err and "Traceback" not in err
 
 
-def test_time_budget_ends_a_frame_of_noise_with_its_reason(tmp_path, capsys):
+def test_time_budget_ends_a_frame_of_noise_with_its_reason(tmp_path, capsys, monkeypatch):
+    # the solver's clock advances 10 ms per look: the 0.05 s budget ends after 5 chunks on any machine
+    monkeypatch.setattr(plate_solver, "time", SimpleNamespace(perf_counter=SteppedClock(0.01)))
     rng = np.random.default_rng(41)
     path = tmp_path / "noise.csv"
     np.savetxt(path, np.column_stack([rng.uniform(0, 1023, (400, 2)), rng.uniform(1, 2, 400)]), delimiter=",",
