@@ -39,8 +39,9 @@ def source_key(roots) -> str:
 
 
 def kernel_cache_dir() -> Path:
-    """The cache folder of this installation's kernels (created, marked as used; stale siblings pruned)."""
-    base = Path(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR") else cache_dir() / "numba"
+    """The cache folder of this installation's kernels (created, marked as used; stale siblings pruned).
+    Its root goes to ``$NUMBA_CACHE_DIR`` for child processes, which so share the folder."""
+    base = Path(os.environ.setdefault("NUMBA_CACHE_DIR", str(cache_dir() / "numba")))
     here = Path(__file__).resolve().parent.parent
     folder = base / source_key([here / name for name in PACKAGES if (here / name).is_dir()])
     folder.mkdir(parents=True, exist_ok=True)

@@ -54,7 +54,7 @@ from startrack.identify.scale_free import (
     correspondence,
     expected_candidates,
 )
-from startrack.identify.verify import verify_near
+from startrack.identify.verify import PATTERN_SEEDS, verify_near
 from startrack.jit import njit
 from startrack.rotation_jit import wahba_svd, worst_cosine
 
@@ -169,7 +169,7 @@ def hash_search(obs, beta, gate, filled, focal_px, delta_px, patterns, region, f
             while 0 <= e < keys.size and keys[e] == key:
                 ok, R_IS = _candidate(obs, stars, cat_stars[e], vectors, angles, bound, region, first_gate)
                 if ok:
-                    result = verify_near(obs, R_IS, field, n_h, 4)
+                    result = verify_near(obs, R_IS, field, n_h, PATTERN_SEEDS)
                     if result[0]:
                         return result
                 e += 1

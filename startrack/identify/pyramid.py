@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from startrack.identify.pairs import pair_count, pair_range
-from startrack.identify.verify import verify_near
+from startrack.identify.verify import TRIANGLE_SEEDS, verify_near
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
 from startrack.rotation_jit import wahba_svd
@@ -251,7 +251,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
                                                  y_slots, vectors, head, partner, chain, found)):
                     R_IS = _attitude(obs, tri, found[t], vectors)
                     if fourth_star(R_IS, obs, tri, n, field, near, direction) >= 0:
-                        result = verify_near(obs, R_IS, field, n_h, 2)
+                        result = verify_near(obs, R_IS, field, float(n_h), TRIANGLE_SEEDS)
                         if result[0]:
                             return result, n_h, kept
                     elif kept < triangles.shape[0]:
@@ -265,7 +265,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
 def verify_triangles(obs, triangles, kept, vectors, field, n_h):  # pragma: no cover  (compiled)
     """The first of the ``kept`` triangles (rows of ``triangles``) whose SVD attitude verifies."""
     for t in range(kept):
-        result = verify_near(obs, _attitude(obs, triangles[t, :3], triangles[t, 3:], vectors), field, n_h, 2)
+        result = verify_near(obs, _attitude(obs, triangles[t, :3], triangles[t, 3:], vectors), field, float(n_h), TRIANGLE_SEEDS)
         if result[0]:
             return result
     return no_result()

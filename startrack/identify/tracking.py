@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from startrack.identify.verify import verify_near
+from startrack.identify.verify import NO_SEEDS, verify_near
 from startrack.jit import njit
 
 
@@ -51,7 +51,7 @@ class Tracking:
         """Verified solution or None; needs ``prior.q_IS``."""
         if prior is None or prior.q_IS is None:
             return None
-        return self.context.verified(verify_near(frame.obs_S, prior.predicted_R_IS, self._field, 1, 0))
+        return self.context.verified(verify_near(frame.obs_S, prior.predicted_R_IS, self._field, 1.0, NO_SEEDS))
 
     def lost_and_entered(self, prior, R_IS, matched_hip):
         """(lost, entered) HIP arrays: tracked stars predicted in the field but unmatched; new matches."""

@@ -85,6 +85,12 @@ def false_match_probability(n_other, n_matched_other, gate, density, n_hypothese
     return min(1.0, max(n_hypotheses, 1) * binomial_tail(n_other, n_matched_other, p))
 
 
+#: Stars that seed a hypothesis of each strategy: tracking, the pyramid's triangle, a four-star pattern.
+#: Numpy integers, so that every caller passes verify_near the same types (one compiled version, not one
+#: per literal).
+NO_SEEDS, TRIANGLE_SEEDS, PATTERN_SEEDS = np.int64(0), np.int64(2), np.int64(4)
+
+
 @njit
 def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  (compiled)
     """Verification (module text) of the attitude hypothesis R_IS for the centroid directions ``obs_S``
