@@ -56,6 +56,7 @@ def test_level_accelerometer_at_rest_reads_minus_g():
     """Error-free, fed by the truth at rest on a level table: f = [0, 0, −γ] in NED body axes."""
     truth = trajectory.generate(Profile(Start(30.0, 0.0), (Hold(1.0),)), 100.0)
     force = AccelerometerModel(rate_hz=100.0).measure(truth.dv / truth.dt, 0).force
+    # rounding level (of 10 m/s²): level and at rest, the horizontal force is exactly zero
     assert np.allclose(force[:, :2], 0.0, atol=1e-12) and np.all(force[:, 2] < -9.79)
 
 
@@ -70,7 +71,7 @@ def test_constant_errors_quantisation_and_saturation():
     model = AccelerometerModel(rate_hz=100.0, bias_turn_on_sigma=1e-3, scale_factor_sigma=1e-3, misalignment_sigma=1e-3)
     force = np.tile([0.3, -2.0, -9.8], (500, 1))
     record = model.measure(force, 9)
-    np.testing.assert_allclose(record.force, force @ record.matrix.T + record.bias, atol=1e-13)
+    np.testing.assert_allclose(record.force, force @ record.matrix.T + record.bias, atol=1e-13)  # rounding level
     lsb = 1e-4
     quantised = AccelerometerModel(rate_hz=100.0, vrw=1e-3, quantization=lsb).measure(force, 4).force
     exact = AccelerometerModel(rate_hz=100.0, vrw=1e-3).measure(force, 4).force
@@ -106,6 +107,7 @@ def test_baro_noise_bias_and_lag():
     assert np.all(flat.bias == flat.bias[0]) and flat.bias[0] != 0.0
     step = np.concatenate([np.zeros(10), np.full(200, 10.0)])
     lagged = BaroModel(rate_hz=10.0, lag_time_constant=2.0).measure(step, 1).h
+    # rounding level: the lag is discretised exactly (e^(−Δt/τ) a step)
     assert lagged[9] == 0.0 and lagged[9 + 20] == pytest.approx(10.0 * (1.0 - np.exp(-1.0)), rel=1e-12)
 
 

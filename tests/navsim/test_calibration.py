@@ -121,9 +121,11 @@ def test_extended_filter_reaches_the_riccati_solution_without_calibration_errors
     F, Q = kernels.transition(omega, dt, 6, six), kernels.process_noise(six, dt, 6)
     H = np.hstack([np.eye(3), np.zeros((3, 3))])
     P_dare = solve_discrete_are(F.T, H.T, Q, np.eye(3) * sigma_n**2)
+    # 30000 fixes leave the recursion ρ^60000 = 6e-8 of its start's offset from the fixed point (ρ = 0.99972,
+    # the closed-loop spectral radius; 1.1e-7 seen): 1e-6 of the variances, far below what matters
     np.testing.assert_allclose(np.diag(P_pre), np.diag(P_dare), rtol=1e-6)
     scale = 1.0 / np.sqrt(np.outer(np.diag(P_dare), np.diag(P_dare)))
-    np.testing.assert_allclose(P_pre * scale, P_dare * scale, atol=1e-6)
+    np.testing.assert_allclose(P_pre * scale, P_dare * scale, atol=1e-6)  # the correlations, likewise
 
 
 def test_renamed_filter_keys_say_what_replaced_them(base_scenario):

@@ -15,7 +15,8 @@ PUBLISHED_GAMMA_P = 9.8321849378
 
 
 def test_normal_gravity_matches_the_published_wgs84_values():
-    """γ_e and γ_p derived here from (a, f, GM, ω) alone match TR8350.2 Table 3.4 to 1e-6 m/s²."""
+    """γ_e and γ_p derived here from (a, f, GM, ω) alone match TR8350.2 Table 3.4 to 1e-6 m/s² (0.1 µg, far
+    below the best accelerometer bias; a GM or ω wrong in its 7th digit moves γ by more; 6e-11 seen)."""
     assert gravity.normal_gravity(0.0, 0.0) == pytest.approx(PUBLISHED_GAMMA_E, abs=1e-6)
     assert gravity.normal_gravity(np.pi / 2, 0.0) == pytest.approx(PUBLISHED_GAMMA_P, abs=1e-6)
     assert gravity.normal_gravity(-np.pi / 2, 0.0) == pytest.approx(PUBLISHED_GAMMA_P, abs=1e-6)
@@ -24,13 +25,17 @@ def test_normal_gravity_matches_the_published_wgs84_values():
 def test_free_air_gradient_and_height_term():
     """∂γ/∂h ≈ −0.3086 mGal/m (the standard free-air gradient) and equals the finite difference."""
     lat = 45.0 * units.DEG
+    # two units of the standard value's last digit (1e-9 s⁻²)
     assert gravity.normal_gravity_height_gradient(lat, 0.0) == pytest.approx(-3.086e-6, abs=2e-9)
     h = 3000.0
     numeric = (gravity.normal_gravity(lat, h + 1.0) - gravity.normal_gravity(lat, h - 1.0)) / 2.0
+    # the difference's rounding, eps γ / (2 m) = 1e-15 s⁻² of 3e-6 (4e-10 relative; 6e-11 seen); its truncation
+    # is (Δh / a)² ~ 1e-14 (γ is quadratic in h: none at all)
     assert gravity.normal_gravity_height_gradient(lat, h) == pytest.approx(numeric, rel=1e-9)
 
 
 def test_radii_at_the_equator_and_pole():
+    """Rounding level: closed forms of the same radii."""
     r_m, r_n = wgs84.radii(0.0)
     assert r_m == pytest.approx(wgs84.A * (1.0 - wgs84.E2), rel=1e-15)
     assert r_n == pytest.approx(wgs84.A, rel=1e-15)
@@ -45,10 +50,13 @@ def test_geodetic_ecef_round_trip():
     lon = rng.uniform(-np.pi, np.pi, lat.size)
     h = rng.uniform(-1000.0, 100e3, lat.size)
     back = wgs84.ecef_to_geodetic(*wgs84.geodetic_to_ecef(lat, lon, h))
+    # Bowring's five passes converge to rounding (2e-16 rad, 2e-9 m seen); 1e-12 rad (6 µm on the ground) and
+    # 1 µm in h are far below any navigation error and well above the rounding of 6e6 m coordinates (1e-9 m)
     np.testing.assert_allclose(back[0], lat, atol=1e-12)
     np.testing.assert_allclose(back[2], h, atol=1e-6)
     away_from_poles = np.abs(lat) < np.pi / 2 - 1e-6
     np.testing.assert_allclose(back[1][away_from_poles], lon[away_from_poles], atol=1e-12)
+    # rounding level (ulp of 6e6 m is 1e-9 m): closed forms
     np.testing.assert_allclose(wgs84.geodetic_to_ecef(0.0, 0.0, 0.0), [wgs84.A, 0.0, 0.0], atol=1e-9)
     np.testing.assert_allclose(wgs84.geodetic_to_ecef(np.pi / 2, 0.3, 0.0), [0.0, 0.0, wgs84.B], atol=1e-9)
 
@@ -57,7 +65,7 @@ def test_c_en_columns_are_the_position_derivatives():
     """∂r_e/∂L = (R_M + h) north and ∂r_e/∂λ = (R_N + h) cos L east: checks C_en and the radii together."""
     lat, lon, h = 0.7, -1.9, 1234.0
     C = frames.c_en(lat, lon)
-    np.testing.assert_allclose(C @ C.T, np.eye(3), atol=1e-15)
+    np.testing.assert_allclose(C @ C.T, np.eye(3), atol=1e-15)  # rounding level: a closed-form rotation
     assert np.linalg.det(C) == pytest.approx(1.0)
     r_m, r_n = wgs84.radii(lat)
     eps = 1e-7
@@ -67,6 +75,8 @@ def test_c_en_columns_are_the_position_derivatives():
     d_lat = (ecef(lat + eps, lon, h) - ecef(lat - eps, lon, h)) / (2 * eps)
     d_lon = (ecef(lat, lon + eps, h) - ecef(lat, lon - eps, h)) / (2 * eps)
     d_h = ecef(lat, lon, h + 1.0) - ecef(lat, lon, h)
+    # central differences: rounding of the 6e6 m coordinates (a few ulp, 3e-9 m, over 2e-7 rad: 4e-9 relative),
+    # truncation eps² ~ 1e-14; r_e is linear in h, so d_h has the rounding alone (1e-9 m over 1 m)
     np.testing.assert_allclose(d_lat, (r_m + h) * C[:, 0], rtol=1e-7)
     np.testing.assert_allclose(d_lon, (r_n + h) * np.cos(lat) * C[:, 1], rtol=1e-7)
     np.testing.assert_allclose(d_h, -C[:, 2], atol=1e-7)
@@ -76,6 +86,7 @@ def test_earth_and_transport_rates():
     """ω_ie^n is the Earth's axis in n; ω_en^n of a velocity equals the rate of C_en along the track."""
     lat, lon, h = 0.6, 0.2, 500.0
     C = frames.c_en(lat, lon)
+    # rounding level (ω_ie's ulp is 1.4e-20 rad/s): closed forms
     np.testing.assert_allclose(C @ np.array(frames.earth_rate_n(lat)), [0.0, 0.0, wgs84.OMEGA_IE], atol=1e-18)
     v = np.array([120.0, -80.0, 0.0])
     r_m, r_n = wgs84.radii(lat)
@@ -135,7 +146,7 @@ def test_random_gravity_disturbance_statistics_and_seed():
     rho = np.mean(a[:-lag] * a[lag:], axis=0) / a.var(axis=0)
     np.testing.assert_allclose(rho, np.exp(-1.0), atol=0.08)
     g = gravity.disturbance_n(np.array([[1e-5, -2e-5, 3e-4]]), np.array([9.8]))
-    np.testing.assert_allclose(g, [[-9.8e-5, 19.6e-5, 3e-4]])
+    np.testing.assert_allclose(g, [[-9.8e-5, 19.6e-5, 3e-4]])  # rounding level: products of the inputs
 
 
 SITES = [(0.0, 30.0, 0.0), (45.0, -70.0, 3000.0), (-33.9, 151.2, 11000.0)]
@@ -166,6 +177,7 @@ def test_observer_velocity_against_skyfield(skyfield_sky, site):
     assert np.linalg.norm(ours - theirs, axis=-1).max() < 0.01
     rotation = ours - aberration.earth_barycentric_velocity(*frames.tt_epoch("2026-03-01T12:00:00", offsets))
     radius = np.hypot(*r_e[:2])
+    # rounding level: |C_ie (ω × r_e)| = ω_ie hypot(x, y) exactly, less the same Earth velocity
     np.testing.assert_allclose(np.linalg.norm(rotation, axis=-1), wgs84.OMEGA_IE * radius, rtol=1e-12)
 
 
@@ -177,7 +189,7 @@ def test_observer_velocity_adds_the_vehicle_velocity():
     still = site_velocity("2026-03-01T12:00:00", t, site, np.zeros(3))
     c_ie = np.swapaxes(frames.c_ei("2026-03-01T12:00:00", t), -1, -2)
     v_e = frames.c_en(site[0] * units.DEG, site[1] * units.DEG) @ v_n
-    np.testing.assert_allclose(moving - still, c_ie @ v_e, atol=1e-9)
+    np.testing.assert_allclose(moving - still, c_ie @ v_e, atol=1e-9)  # rounding level: linear in v_n (3e4 m/s terms)
 
 
 @pytest.mark.parametrize("site", SITES)

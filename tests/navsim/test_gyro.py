@@ -73,7 +73,7 @@ def test_constant_errors_scale_factor_misalignment_and_bias():
     omega = np.tile([0.3, -0.2, 0.5], (1000, 1))
     record = model.measure(omega, 9)
     expected = omega @ record.matrix.T + record.bias
-    np.testing.assert_allclose(record.omega, expected, atol=1e-15)
+    np.testing.assert_allclose(record.omega, expected, atol=1e-15)  # rounding level: the same products
     assert np.all(np.abs(np.diag(record.matrix) - 1.0) < 5e-3)
     assert np.any(np.abs(record.matrix - np.diag(np.diag(record.matrix))) > 0)
 
@@ -85,7 +85,7 @@ def test_quantisation_keeps_the_accumulated_angle_within_one_lsb():
     quantised = model.measure(omega, 4).omega
     exact = GyroModel(rate_hz=100.0, arw=units.arw_to_si(0.01)).measure(omega, 4).omega
     counts = quantised / 100.0 / lsb
-    np.testing.assert_allclose(counts, np.round(counts), atol=1e-6)
+    np.testing.assert_allclose(counts, np.round(counts), atol=1e-6)  # rounding level: whole LSBs, once divided
     drift = np.abs(np.cumsum(quantised - exact, axis=0) / 100.0)
     assert drift.max() <= 0.5 * lsb + 1e-15
 

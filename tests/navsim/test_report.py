@@ -165,7 +165,7 @@ def test_averaged_nees_band_holds_95_percent_for_a_consistent_filter():
     rng = np.random.default_rng(5)
     m, frames = 25, 4000
     avg = statistics.averaged_nees(fake_campaign(rng.chisquare(6, size=(m, frames))))
-    assert avg.band == pytest.approx(tuple(chi2.ppf([0.025, 0.975], 6 * m) / m))
+    assert avg.band == pytest.approx(tuple(chi2.ppf([0.025, 0.975], 6 * m) / m))  # rounding level: the same ppf
     assert avg.fraction_in_band == pytest.approx(0.95, abs=0.015)  # binomial σ over 4000 frames: 0.0034
     inflated = statistics.averaged_nees(fake_campaign(1.5 * rng.chisquare(6, size=(m, frames))))
     assert inflated.fraction_in_band < 0.5
@@ -173,7 +173,7 @@ def test_averaged_nees_band_holds_95_percent_for_a_consistent_filter():
 
 def test_filter_sigma_envelope_averages_the_covariance_not_the_sigma():
     P = np.stack([np.full((5, 6), 1.0), np.full((5, 6), 9.0)]) * (np.pi / 180 / 3600) ** 2  # (1")², (3")²
-    env = statistics.envelopes(fake_campaign(np.ones((2, 5)), P))
+    env = statistics.envelopes(fake_campaign(np.ones((2, 5)), P))  # rounding level below: closed forms
     assert env.final_sigma_filter == pytest.approx(np.full(3, np.sqrt(5.0)))
     assert env.sigma3_filter[0] == pytest.approx(np.full(3, 3 * np.sqrt(5.0)))
 

@@ -89,6 +89,7 @@ def test_a_ten_times_better_accelerometer_lowers_the_floor_ten_times(tmp_path, c
     velocity error's Schuler swing and the star noise still add a few)."""
     summary, series = level_run(tmp_path, capsys, "a10", "imu.accelerometer.bias_turn_on_micro_g = 10.0")
     floor = bias_floor(series)
+    # rounding level: the same seed's bias draws, scaled by ten
     assert np.linalg.norm(floor) == pytest.approx(np.linalg.norm(bias_floor(level[1])) / 10.0, rel=1e-9)
     assert np.linalg.norm(schuler_mean(summary)) == pytest.approx(np.linalg.norm(floor), rel=0.15)
 

@@ -62,7 +62,7 @@ def test_003_inscribed_radius_drops_corner_stars(sky):
     assert np.any(in_square & ~kept)
 
 
-def test_window_closed_forms():
+def test_window_closed_forms():  # default tolerances: rounding level of the same closed forms
     dec_min, dec_max, half = radec_window(1.0, 0.0, 0.1)
     assert (dec_min, dec_max) == pytest.approx((-0.1, 0.1)) and half == pytest.approx(0.1)
     _, _, half = radec_window(1.0, np.radians(60), np.radians(8))        # eq. 3

@@ -23,6 +23,7 @@ def test_pixel_round_trip_to_1e9_px(k1, k2):
     uv = _random_pixels(camera, 2000, rng)
     uv_back, visible = camera.project_body(camera.unproject(uv))
     assert np.all(visible)
+    # 1e-9 px, far below any centroid error; the distortion inverse's Newton stops at 1e-16 of r (rounding, 1e-13 px)
     assert np.max(np.abs(uv_back - uv)) < 1e-9
 
 
@@ -35,7 +36,7 @@ def test_inertial_round_trip_through_attitude(k1, k2):
     v_I = Rotation.from_quat(q_IS).apply(camera.unproject(uv))
     uv_back, visible = camera.project(q_IS, v_I)
     assert np.all(visible)
-    assert np.max(np.abs(uv_back - uv)) < 1e-9
+    assert np.max(np.abs(uv_back - uv)) < 1e-9  # as above
 
 
 def test_distortion_inverse_against_root_finding():
@@ -43,16 +44,17 @@ def test_distortion_inverse_against_root_finding():
     rng = np.random.default_rng(4)
     xy_d = rng.uniform(-0.27, 0.27, (50, 2))
     xy_n = camera.undistort(xy_d)
-    assert np.max(np.abs(camera.distort(xy_n) - xy_d)) < 1e-15
+    assert np.max(np.abs(camera.distort(xy_n) - xy_d)) < 1e-15  # rounding level: Newton stops at 1e-16 of r
     for (xd, yd), (xn, yn) in zip(xy_d, xy_n):
         rd = np.hypot(xd, yd)
         r = brentq(lambda r: r * (1 + camera.k1 * r**2 + camera.k2 * r**4) - rd, 0.0, 1.0, xtol=1e-15)
+        # brentq stops within xtol 1e-15 + rtol 9e-16 r of the root (Newton at rounding): 1e-14 is ~8 times that
         assert np.hypot(xn, yn) == pytest.approx(r, abs=1e-14)
-        assert np.arctan2(yn, xn) == pytest.approx(np.arctan2(yd, xd), abs=1e-13)
+        assert np.arctan2(yn, xn) == pytest.approx(np.arctan2(yd, xd), abs=1e-13)  # rounding level: radial scaling
 
 
 def test_pinhole_closed_form_and_fov():
-    camera = Camera.from_fov(20 * DEG, 1024, 512)
+    camera = Camera.from_fov(20 * DEG, 1024, 512)  # rounding level throughout: closed forms
     assert camera.focal_px == pytest.approx(512 / np.tan(10 * DEG), rel=1e-15)
     assert camera.fov_x == pytest.approx(20 * DEG, rel=1e-14)
     assert camera.fov_y == pytest.approx(2 * np.arctan(256 / camera.focal_px), rel=1e-14)
@@ -78,9 +80,9 @@ def test_attitude_convention_east_right_north_down():
 
     uv, visible = camera.project(q_IS, [vec(ra, dec), vec(ra + 1 * DEG, dec), vec(ra, dec + 1 * DEG)])
     assert np.all(visible)
-    np.testing.assert_allclose(uv[0], [camera.cx, camera.cy], atol=1e-9)
+    np.testing.assert_allclose(uv[0], [camera.cx, camera.cy], atol=1e-9)  # rounding level: closed forms
     assert uv[1, 0] > camera.cx + 40 and abs(uv[1, 1] - camera.cy) < 2
-    assert uv[2, 1] > camera.cy + 40 and abs(uv[2, 0] - camera.cx) < 1e-6
+    assert uv[2, 1] > camera.cy + 40 and abs(uv[2, 0] - camera.cx) < 1e-6  # on the central meridian: rounding
 
 
 def test_circular_and_rectangular_fields():
@@ -115,7 +117,7 @@ def test_roll_track_rotates_about_principal_point():
     x, y = uv0[0] - [camera.cx, camera.cy]
     a = omega[2] * times
     expected = np.column_stack([camera.cx + x * np.cos(a) + y * np.sin(a), camera.cy - x * np.sin(a) + y * np.cos(a)])
-    np.testing.assert_allclose(track, expected, atol=1e-9)
+    np.testing.assert_allclose(track, expected, atol=1e-9)  # rounding level: closed forms of a roll
 
 
 def test_bad_camera_input_is_refused():

@@ -18,6 +18,7 @@ def test_written_camera_is_read_back_with_its_sigma(tmp_path):
                              'frame "a".tiff')
     content = read_camera_file(path)
     assert content.camera == camera and Camera.from_file(path) == camera
+    # rounding level: square roots of the diagonal written above
     assert content.sigma == pytest.approx({"focal_px": 0.4, "cx": 2.0, "cy": 2.5, "k1": 0.01, "k2": 0.0})
     assert content.fit["source"] == 'frame "a".tiff' and content.fit["matched"] == 150
     assert f"fov_deg = {math.degrees(camera.angular_width)!r}" in path.read_text()

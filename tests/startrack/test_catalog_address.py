@@ -18,7 +18,7 @@ def test_exactly_3100_base_points_for_53_divisions():
     # Eq. 1-2 recomputed ring by ring with plain floats.
     sizes = [math.floor(0.5 + math.sqrt(3) * 53 * math.cos(math.pi * j / 53 - math.pi / 2)) for j in range(1, 53)]
     assert addr.ring_sizes(53).tolist() == sizes
-    ra, dec = addr.base_points_radec(53)
+    ra, dec = addr.base_points_radec(53)  # default tolerances below: rounding level of the closed forms
     assert ra.size == 3100
     assert np.allclose(np.unique(np.round(dec, 12)), np.round(addr.ring_declinations(53), 12))
     assert ra[0] == 0.0 and dec[0] == pytest.approx(math.pi / 53 - math.pi / 2)
@@ -89,7 +89,7 @@ def test_redundant_neighbours_across_ra_0():
 
 def test_redundant_neighbours_over_the_pole():
     ra, dec = 30.0 * DEG, 85.0 * DEG
-    moved_ra, moved_dec = addr.offset_directions(ra, dec, RHO_SUB)
+    moved_ra, moved_dec = addr.offset_directions(ra, dec, RHO_SUB)  # default tolerances: rounding level, closed forms
     assert np.allclose(angular_distance(radec_to_vector(ra, dec), radec_to_vector(moved_ra, moved_dec)), RHO_SUB)
     # North crosses the pole: comes down at RA + 180 deg, Dec = 180 - 85 - 12 deg.
     assert np.degrees(moved_ra[2]) == pytest.approx(210.0)

@@ -42,6 +42,7 @@ def test_parse_matches_whitespace_split_of_the_records(table):
         assert table["hip"][row] == int(tokens[0])
         assert table["solution_type"][row] == int(tokens[1])
         assert table["n_components"][row] == int(tokens[3])
+        # rounding level below: the same decimal text, parsed twice
         assert table["ra"][row] == pytest.approx(float(tokens[4]), abs=1e-12)
         assert table["dec"][row] == pytest.approx(float(tokens[5]), abs=1e-12)
         assert table["pm_ra_cosdec"][row] == pytest.approx(float(tokens[7]) * MAS, abs=1e-15)
@@ -65,7 +66,7 @@ def test_parse_small_file_with_crlf_and_missing_file(tmp_path):
 def test_positions_at_catalog_epoch_are_the_catalog_positions(table):
     stars = load_star_catalog(HIPPARCOS_EPOCH)
     expected = radec_to_vector(table["ra"], table["dec"])
-    assert np.max(angular_distance(stars.vectors, expected)) < 1e-12
+    assert np.max(angular_distance(stars.vectors, expected)) < 1e-12  # rounding level: no motion applied
     assert np.allclose(np.linalg.norm(stars.vectors, axis=1), 1.0, atol=1e-14)
 
 
@@ -86,6 +87,7 @@ def test_propagation_is_linear_in_time_for_small_steps():
     mu_a, mu_d = np.array([1e-6, -3e-7]), np.array([2e-7, 5e-7])
     one = propagate_proper_motion(ra, dec, mu_a, mu_d, 1.0)
     start = radec_to_vector(ra, dec)
+    # the rounding of a 1e-6 rad distance, eps / 1e-6 = 2e-10 of it; the second-order term is (μ Δt)² ~ 1e-12
     assert angular_distance(start, one) == pytest.approx(np.hypot(mu_a, mu_d), rel=1e-9)
 
 

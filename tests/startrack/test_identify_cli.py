@@ -137,7 +137,7 @@ def test_refit_refines_the_given_camera_and_holds_the_rest(tmp_path, capsys, fra
         if refit == "all":  # fitted: within its sigma of the truth, not at the given value
             assert fitted["focal_px"] != camera.focal_px and fitted["k2"] != 0.0
             assert abs(fitted["focal_px"] - camera.focal_px) < 5.0 * fitted["sigma"]["focal_px"]
-        else:  # held by a prior of 1e-9 of it; k2 held exactly
+        else:  # held by a prior of 1e-9 of it (1e-8: ten prior sigmas); k2 held exactly
             assert abs(fitted["focal_px"] / camera.focal_px - 1.0) < 1e-8 and fitted["k2"] == 0.0
             assert fitted["sigma"]["cx"] > 0.0 and fitted["sigma"]["k2"] == 0.0
 

@@ -52,7 +52,7 @@ def test_the_level_is_the_camera_field_and_n_h_counts_every_look_up(setup):
     assert cat_stars.shape[1] == 4 and cat_stars.min() >= 0 and cat_stars.max() < len(identifier.field)
     assert np.all(np.diff(keys) >= 0) and 50_000 < keys.size < 200_000
     assert n_combinations == COMBINATIONS_BELOW[HASH_STARS] == 35
-    assert math.isclose(math.acos(cos_separation), camera.fov_x / 20.0)
+    assert math.isclose(math.acos(cos_separation), camera.fov_x / 20.0)  # rounding level: the cosine of this angle
     assert 0.0 < n_h / n_combinations < 100.0
     narrow = Camera.from_fov(np.radians(0.3), 1024, 1024)  # below the pattern catalog's 0.5 deg: no look-ups
     assert pattern_arrays(type(identifier.field)(identifier.catalog, narrow, stars.vectors[:50], stars.hip[:50],

@@ -100,7 +100,7 @@ def test_colour_and_jpeg_frames_are_read_as_luminance(tmp_path):
     Image.fromarray(rgb).save(tmp_path / "c.png")
     frame = read_frame(tmp_path / "c.png")
     expected = rgb.astype(float) @ [0.299, 0.587, 0.114]  # ITU-R BT.601 luma
-    np.testing.assert_allclose(frame.image, expected, atol=1e-9)
+    np.testing.assert_allclose(frame.image, expected, atol=1e-9)  # rounding level: the same weighted sum
     assert frame.full_scale == 255.0
     grey = np.full((40, 48), 30, np.uint8)
     grey[20, 24] = 250

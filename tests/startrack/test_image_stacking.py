@@ -40,7 +40,7 @@ def test_thresholds_of_004():
         in_range = low <= snr(peak, 100.0, 10.0) < high
         assert in_range == (peak < 150.0 and 4 * peak >= stacked_threshold(100.0, 10.0, 4))
     assert static_stacking_gain(4) == 2.0
-    assert stacked_snr(4 * 140.0, 100.0, 10.0, 4) / snr(140.0, 100.0, 10.0) == pytest.approx(2.0)
+    assert stacked_snr(4 * 140.0, 100.0, 10.0, 4) / snr(140.0, 100.0, 10.0) == pytest.approx(2.0)  # rounding level
     with pytest.raises(InputError):
         stackable_snr_range(0)
 
@@ -62,7 +62,7 @@ def test_stacked_centroid_identity_eq_17_18():
         u, v, s = grey_centroid(w, c, background=100.0)
         frame_uv.append((u, v))
         sums.append(s)
-    direct = stacked_centroid_direct(windows, centres, background=100.0)
+    direct = stacked_centroid_direct(windows, centres, background=100.0)  # rounding level below: exact identities
     np.testing.assert_allclose(stacked_centroid_from_frames(frame_uv, centres, sums), direct, atol=1e-12)
     equal = 100.0 + (windows - 100.0) / (windows - 100.0).sum(axis=(1, 2), keepdims=True) * 500.0
     frame_uv = [grey_centroid(w, c, 100.0)[:2] for w, c in zip(equal, centres)]
@@ -101,7 +101,7 @@ def test_dim_star_detected_only_after_stacking():
         single += len(detect(cut_window(frames[-1], window_centre(truth[-1]), 2), background=100.0, sigma_n=10.0)) > 0
         result = cache.stack(GAUSS.bias_dn, GAUSS.read_noise_e)
         assert result.threshold == 500.0 and result.star_id == 7
-        np.testing.assert_allclose(result.grey_uv_direct, result.grey_uv_eq17, atol=1e-9)
+        np.testing.assert_allclose(result.grey_uv_direct, result.grey_uv_eq17, atol=1e-9)  # rounding level: eq. 17
         if result.detected:
             stacked += 1
             assert np.hypot(result.u - truth[-1, 0], result.v - truth[-1, 1]) < 1.5
@@ -124,6 +124,7 @@ def test_phase_correction_recovers_current_position():
     result = cache.stack(100.0, 10.0, centroider="grey")
     phase = truth - np.rint(truth)
     delta = phase[-1] - phase.mean(axis=0)
+    # rounding level: the correction is this difference of phases
     np.testing.assert_allclose([result.u_corrected - result.u, result.v_corrected - result.v], delta, atol=1e-12)
     assert np.hypot(result.u_corrected - truth[-1, 0], result.v_corrected - truth[-1, 1]) < 0.06
     assert np.hypot(result.u - truth[-1, 0], result.v - truth[-1, 1]) > 0.1
@@ -156,5 +157,5 @@ def test_stacked_detection_matches_detect_on_sum():
     result = stack(windows, centres, 100.0, 10.0)
     direct = detect(windows.sum(axis=0), background=400.0, sigma_n=20.0)
     assert result.detected and len(direct) >= 1
-    assert result.u == pytest.approx(centres[0, 1] - 2 + direct.u[0], abs=1e-12)
+    assert result.u == pytest.approx(centres[0, 1] - 2 + direct.u[0], abs=1e-12)  # rounding level: the same detect
     assert result.peak == windows.sum(axis=0).max()

@@ -99,7 +99,7 @@ def test_camera_file_round_trip_solves_the_frame_again(tmp_path, capsys):
     camera_file = tmp_path / "camera.toml"
     assert main(["solve", str(frame), "--json", "--write-camera", str(camera_file)]) == 0
     first = json.loads(capsys.readouterr().out)
-    written = Camera.from_file(camera_file)
+    written = Camera.from_file(camera_file)  # rounding level: the same number, printed and read back
     assert written.focal_px == pytest.approx(first["camera"]["focal_px"]) and (written.width, written.height) == (1024, 768)
     assert main(["solve", str(frame), "--json", "--camera", str(camera_file)]) == 0
     again = json.loads(capsys.readouterr().out)

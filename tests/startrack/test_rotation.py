@@ -1,4 +1,7 @@
-"""The rotation floor of both packages (startrack.rotation and its compiled twin) against scipy's Rotation."""
+"""The rotation floor of both packages (startrack.rotation and its compiled twin) against scipy's Rotation.
+
+Every tolerance here is at the rounding level: exact identities of well-conditioned closed forms (round
+trips, conversions) and compiled twins of the same operations."""
 
 import numpy as np
 import pytest
@@ -39,7 +42,7 @@ def test_small_rotation_vectors_use_the_series():
 def test_nearest_rotation_is_scipys_orthogonalisation():
     """Markley's quaternion from a non-orthogonal matrix (scipy) is the Frobenius-nearest rotation."""
     R = Rotation.random(50, random_state=3).as_matrix()
-    M = R + 0.05 * RNG.standard_normal((50, 3, 3))
+    M = R + 0.05 * RNG.standard_normal((50, 3, 3))  # rounding level: SVD and Markley's eigenvector, same optimum
     np.testing.assert_allclose(rot.nearest_rotation(M), Rotation.from_matrix(M).as_matrix(), atol=1e-12)
     np.testing.assert_allclose(rot.nearest_rotation(R), R, atol=1e-14)
 
@@ -95,4 +98,6 @@ def test_compiled_wahba_svd_is_the_nearest_rotation_of_the_attitude_profile():
         ref = RNG.standard_normal((6, 3))
         ref /= np.linalg.norm(ref, axis=1, keepdims=True)
         obs = ref @ R + 1e-3 * RNG.standard_normal((6, 3))
+        # rounding level: the Jacobi sweeps stop at an off-diagonal 1e-17 of the diagonal (converged), the rest is
+        # rounding amplified by the eigen-gaps of BᵀB
         np.testing.assert_allclose(rotation_jit.wahba_svd(ref, obs), rot.nearest_rotation((obs.T @ ref).T), atol=1e-12)
