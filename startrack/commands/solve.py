@@ -90,6 +90,11 @@ def register(subparsers):
     parser.set_defaults(func=run)
 
 
+#: A given camera's refit, or the diagnosis of a frame it cannot identify, searches fields of view within
+#: this factor of its own.
+GIVEN_FOV_SPREAD = 1.3
+
+
 def _pair(option, text):
     try:
         first, second = (float(p) for p in text.split(","))
@@ -151,6 +156,9 @@ def _frame_solver(args):
         check_range("--mag", args.mag, -2.0, 8.0)
     refit = None if args.refit is None else parse_refit(args.refit)
     camera_file = None if args.camera is None else read_camera_file(args.camera)
+    if camera_file is not None or args.fov_deg is not None:  # a refit or a diagnosis searches near the given field
+        given = camera_file.camera.angular_width if camera_file is not None else args.fov_deg * DEG
+        fov_range = (max(0.5 * DEG, given / GIVEN_FOV_SPREAD), min(90.0 * DEG, given * GIVEN_FOV_SPREAD))
     plate = {"fov_range": fov_range, "epoch": args.epoch, "threshold": args.max_false_match,
              "time_budget_s": args.time_budget_s, "mag_limit": args.mag, "progress": True}
     return FrameSolver(camera_file, None if args.fov_deg is None else args.fov_deg * DEG, refit,

@@ -158,8 +158,9 @@ def test_ctrl_c_cancels_the_pending_runs_and_keeps_the_finished(tmp_path, base_s
     out = tmp_path / "interrupted"
     command = [sys.executable, "-m", "navsim.cli", "montecarlo", str(scenario), "--runs", str(runs), "--out", str(out),
                "--workers", "2"]
+    # SIGINT handled as in a terminal even when the suite itself runs with it ignored (a background job)
     process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
+                               start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     wait_for(lambda: len(finished_runs(out)) >= 3, "3 finished runs")  # runs in place, not a .partial
     os.killpg(process.pid, signal.SIGINT)
     _, err = process.communicate(timeout=HANG_S)
