@@ -1,7 +1,8 @@
 # Two commands for a newcomer: `make demo` and `make test` (both set up .venv first).
 # The set-up installs the locked versions (requirements/*.txt, exact versions with hashes, Python 3.11 on
-# Linux x86-64) with uv, itself installed hash-checked by pip; `make lock` regenerates the locks from
-# pyproject.toml's ranges (README: "Updating the locked dependencies").
+# Linux x86-64) with uv, itself installed hash-checked by pip, byte-compiled at install (a machine with
+# PYTHONDONTWRITEBYTECODE would otherwise compile every module of scipy & co. in every process: +3.5 s);
+# `make lock` regenerates the locks from pyproject.toml's ranges (README).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -20,8 +21,9 @@ $(UV): requirements/bootstrap.txt
 	touch $(UV)
 
 $(STAMP): pyproject.toml requirements/test.txt $(UV)
-	$(UV) pip install --quiet --python $(PY) --require-hashes -r requirements/test.txt
+	$(UV) pip install --quiet --python $(PY) --compile-bytecode --require-hashes -r requirements/test.txt
 	$(UV) pip install --quiet --python $(PY) --no-deps --no-build-isolation -e .
+	$(PY) -m compileall -q startrack navsim > /dev/null
 	touch $(STAMP)
 
 demo: setup
@@ -36,7 +38,7 @@ test-all: setup
 
 bench: setup
 	sh benchmarks/peers/setup_venvs.sh $(PYTHON)
-	$(UV) pip install --quiet --python $(PY) --require-hashes -r requirements/bench.txt
+	$(UV) pip install --quiet --python $(PY) --compile-bytecode --require-hashes -r requirements/bench.txt
 	$(PY) benchmarks/run_all.py
 
 # Regenerate the locks from pyproject.toml's ranges (newest versions that satisfy them), then `make setup`.
