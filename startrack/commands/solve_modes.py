@@ -43,7 +43,7 @@ def centroid_sigma(option, camera_file):
     """The centroid sigma [px]: the option's, else the camera file's fit RMS, else the default."""
     if option is not None:
         return option
-    rms = {} if camera_file is None else camera_file.fit.get("rms_px")
+    rms = None if camera_file is None else camera_file.fit.get("rms_px")
     if isinstance(rms, (int, float)) and not isinstance(rms, bool) and 0.0 < rms <= 100.0:
         return float(rms)
     return DEFAULT_CENTROID_SIGMA_PX
