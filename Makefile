@@ -1,32 +1,43 @@
 # Two commands for a newcomer: `make demo` and `make test` (both set up .venv first).
 # The set-up installs the locked versions (requirements/*.txt, exact versions with hashes, Python 3.11 on
-# Linux x86-64) with uv, itself installed hash-checked by pip, byte-compiled at install (a machine with
-# PYTHONDONTWRITEBYTECODE would otherwise compile every module of scipy & co. in every process: +3.5 s);
+# Linux x86-64) with uv, itself installed hash-checked by pip: `make demo` what the product runs
+# (requirements/run.txt), `make test` also the test tools (requirements/test.txt, the same versions) and
+# byte-compiles everything installed (a machine with PYTHONDONTWRITEBYTECODE would otherwise compile every
+# module of scipy & co. in every process of the suite: +3.5 s each; a demo is one process, which compiles
+# them once in memory in less time than compiling all of them ahead would take).
 # `make lock` regenerates the locks from pyproject.toml's ranges (README).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 UV := $(VENV)/bin/uv
-STAMP := $(VENV)/.installed
+RUN_STAMP := $(VENV)/.installed-run
+TEST_STAMP := $(VENV)/.installed-test
 PYTEST_ARGS ?=
 LOCK := $(UV) pip compile --quiet --generate-hashes --python-version 3.11 --python-platform x86_64-unknown-linux-gnu
+INSTALL := $(UV) pip install --quiet --python $(PY) --require-hashes
 
-.PHONY: setup demo test test-all bench lock clean
+.PHONY: setup setup-run demo test test-all bench lock clean
 
-setup: $(STAMP)
+setup: $(TEST_STAMP)
+
+setup-run: $(RUN_STAMP)
 
 $(UV): requirements/bootstrap.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check --require-hashes --no-deps -r requirements/bootstrap.txt
 	touch $(UV)
 
-$(STAMP): pyproject.toml requirements/test.txt $(UV)
-	$(UV) pip install --quiet --python $(PY) --compile-bytecode --require-hashes -r requirements/test.txt
+$(RUN_STAMP): pyproject.toml requirements/run.txt $(UV)
+	$(INSTALL) -r requirements/run.txt
 	$(UV) pip install --quiet --python $(PY) --no-deps --no-build-isolation -e .
-	$(PY) -m compileall -q startrack navsim > /dev/null
-	touch $(STAMP)
+	touch $(RUN_STAMP)
 
-demo: setup
+$(TEST_STAMP): requirements/test.txt $(RUN_STAMP)
+	$(INSTALL) --compile-bytecode -r requirements/test.txt
+	$(PY) -m compileall -q startrack navsim > /dev/null
+	touch $(TEST_STAMP)
+
+demo: setup-run
 	$(VENV)/bin/navsim run scenarios/demo.toml --out reports/out/demo --report reports/out/demo.pdf
 
 test: setup
@@ -38,13 +49,15 @@ test-all: setup
 
 bench: setup
 	sh benchmarks/peers/setup_venvs.sh $(PYTHON)
-	$(UV) pip install --quiet --python $(PY) --compile-bytecode --require-hashes -r requirements/bench.txt
+	$(INSTALL) --compile-bytecode -r requirements/bench.txt
 	$(PY) benchmarks/run_all.py
 
-# Regenerate the locks from pyproject.toml's ranges (newest versions that satisfy them), then `make setup`.
+# Regenerate the locks from pyproject.toml's ranges (newest versions that satisfy them), then `make setup`;
+# the run and bench locks take the test lock's versions of what they share.
 lock: $(UV)
 	$(LOCK) pyproject.toml requirements/build.in --extra test -o requirements/test.txt
-	$(LOCK) pyproject.toml requirements/build.in --extra test --extra bench -o requirements/bench.txt
+	$(LOCK) pyproject.toml requirements/build.in -c requirements/test.txt -o requirements/run.txt
+	$(LOCK) pyproject.toml requirements/build.in --extra test --extra bench -c requirements/test.txt -o requirements/bench.txt
 	$(LOCK) requirements/bootstrap.in -o requirements/bootstrap.txt
 
 clean:

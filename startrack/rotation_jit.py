@@ -5,6 +5,7 @@ numbers; each function is tested against its vectorised counterpart."""
 import numpy as np
 
 from startrack.jit import njit
+from startrack.sort_jit import argsort
 
 
 @njit
@@ -171,7 +172,7 @@ def wahba_svd(ref_I, obs_S):
         for c in range(3):
             BtB[r, c] = B[0, r] * B[0, c] + B[1, r] * B[1, c] + B[2, r] * B[2, c]
     eigenvalues, V = _symmetric_eigen(BtB)
-    order = np.argsort(-eigenvalues)
+    order = argsort(-eigenvalues)
     v1 = V[:, order[0]].copy()
     v2 = _unit(V[:, order[1]] - _dot(V[:, order[1]], v1) * v1)
     v3 = _cross(v1, v2)

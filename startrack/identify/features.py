@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from startrack.jit import njit
+from startrack.sort_jit import argsort
 
 
 @njit
@@ -76,7 +77,7 @@ _NEWTON_ITERATIONS = 12
 def brightest_first(flux, count, max_stars):  # pragma: no cover  (compiled)
     """Indices of the first ``count`` entries ordered by decreasing ``flux`` (stable; given order when
     ``flux`` is empty), at most ``max_stars`` (< 0: all)."""
-    order = np.arange(count) if flux.size == 0 else np.argsort(-flux[:count], kind="mergesort")
+    order = np.arange(count) if flux.size == 0 else argsort(-flux[:count])
     return order if max_stars < 0 else order[:max_stars]
 
 
@@ -187,7 +188,7 @@ class FrameFeatures:
     slots: one is made per frame, and a frozen dataclass takes three times as long to build.)
     """
 
-    __slots__ = ("obs_S", "index", "beta", "gate", "filled", "focal_px", "delta_px", "verify_gate")
+    __slots__ = ("beta", "delta_px", "filled", "focal_px", "gate", "index", "obs_S", "verify_gate")
 
     def __init__(self, obs_S, index, beta, gate, filled, focal_px: float, delta_px: float, verify_gate: float):
         self.obs_S, self.index, self.beta, self.gate, self.filled = obs_S, index, beta, gate, filled

@@ -55,6 +55,7 @@ from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
 from startrack.identify.warmup import load_kernels
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_matrix
+from startrack.sort_jit import argsort
 from startrack.sphere import radec_to_vector
 
 #: Strategy names in the order they are tried.
@@ -277,7 +278,7 @@ class StarIdentifier:
 def matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma: no cover  (compiled)
     """(matches (M, 2) rows (centroid index, HIP), obs_S (M, 3), ref_I (M, 3)) ordered by centroid index."""
     centroid = index[obs_index]
-    order = np.argsort(centroid)
+    order = argsort(centroid.astype(np.float64))
     matches = np.empty((order.size, 2), np.int64)
     seen = np.empty((order.size, 3))
     ref = np.empty((order.size, 3))

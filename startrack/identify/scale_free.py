@@ -37,6 +37,7 @@ from startrack.identify.self_calibration import brightest_in_field, verify_calib
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
 from startrack.rotation_jit import wahba_svd, worst_cosine
+from startrack.sort_jit import argsort
 
 #: Most detections whose combinations are searched.
 MAX_CANDIDATES = 24
@@ -249,7 +250,7 @@ def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal,
                 largest_px = max(largest_px, math.hypot(uv[stars[i], 0] - uv[stars[j], 0], uv[stars[i], 1] - uv[stars[j], 1]))
         count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors,
                                           cx, cy, region, found)
-        for k in np.argsort(mismatch):
+        for k in argsort(mismatch):
             l, eps = found[k, 0], eps_of[k]
             cat = levels[l][0][found[k, 1]]
             ok, R_IS, focal = _hypothesis(uv, stars, cat, vectors, cx, cy, level_focal[l], f_range, eps)

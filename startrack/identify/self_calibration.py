@@ -36,6 +36,7 @@ from startrack.camera_fit import fit, fold_radius_squared_jit, project, project_
 from startrack.identify.chance import chance_match_probability
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
+from startrack.sort_jit import argsort, median, unique
 
 #: Seed stars of a pattern hypothesis (matched by construction).
 SEEDS = 4
@@ -51,7 +52,7 @@ def match_pixels(obs_uv, n_obs, pred_uv, gate):  # pragma: no cover  (compiled)
     the first ``n_obs`` observed points; predictions sorted by u, each point compares those within
     +-gate in u (a nearest neighbour outside that window lies outside the gate)."""
     m = pred_uv.shape[0]
-    order = np.argsort(pred_uv[:, 0])
+    order = argsort(np.ascontiguousarray(pred_uv[:, 0]))
     u_sorted = pred_uv[order, 0]
     best_pred = np.full(n_obs, -1, np.int64)
     best_pred_d = np.full(n_obs, np.inf)
@@ -96,7 +97,7 @@ def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
     half = math.hypot(max(cx + 0.5, width - 0.5 - cx), max(cy + 0.5, height - 0.5 - cy)) / f
     near = np.empty(vectors.shape[0], np.int64)
     near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), 1.2 * math.atan(half) + 0.005, near, max_star)]
-    return np.sort(near)
+    return unique(near)
 
 
 @njit
@@ -228,7 +229,7 @@ def _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypot
             break
         obs_index, star_index = obs_index[keep], star_index[keep]
     reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
-    reached = min(max(reached, np.median(sigma)), gates[2])
+    reached = min(max(reached, median(sigma)), gates[2])
     q = local_density(pred_uv, grid) * math.pi * reached * reached
     bonferroni = n_hypotheses * (gates[0] / reached) ** (3 + int(np.sum(free)))
     probability = chance_match_probability(q, obs_index.size - SEEDS, bonferroni)

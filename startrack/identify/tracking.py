@@ -18,6 +18,7 @@ import numpy as np
 
 from startrack.identify.verify import NO_SEEDS, verify_near
 from startrack.jit import njit
+from startrack.sort_jit import unique
 
 
 @njit
@@ -68,9 +69,9 @@ _NO_STARS = np.zeros(0, np.int64)
 def changes(in_field, tracked, matched):  # pragma: no cover  (compiled)
     """(lost, entered) sorted unique HIP arrays: the ``tracked`` HIP numbers that are ``in_field`` and not
     ``matched``; the ``matched`` HIP numbers not ``tracked``."""
-    in_field = np.sort(in_field)
-    tracked = np.unique(tracked)
-    matched = np.unique(matched)
+    in_field = unique(in_field)
+    tracked = unique(tracked)
+    matched = unique(matched)
     lost = np.empty(tracked.size, np.int64)
     n_lost = 0
     for h in tracked:

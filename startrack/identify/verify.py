@@ -47,6 +47,7 @@ from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
 from startrack.rotation_jit import wahba_svd
+from startrack.sort_jit import argsort
 
 #: Default acceptance threshold of the false-match probability.
 DEFAULT_FALSE_MATCH_THRESHOLD = 1e-6
@@ -132,7 +133,7 @@ def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
     n, m = obs_S.shape[0], pred_S.shape[0]
     cos_gate = np.cos(gate)
     width = 2.0 * np.sin(0.5 * min(gate, np.pi)) * (1.0 + 1e-12)
-    order = np.argsort(pred_S[:, 0])
+    order = argsort(np.ascontiguousarray(pred_S[:, 0]))
     x = pred_S[order, 0]
     best_pred = np.full(n, -1, np.int64)
     best_pred_cos = np.full(n, -2.0)

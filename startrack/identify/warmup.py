@@ -46,3 +46,30 @@ def load_kernels(identifier) -> None:
             strategy.identify(frame, prior)
     if uv is not None:
         identifier.solve(uv, prior=Prior(q_IS=q_IS))
+
+
+# ---------------------------------------------------------------- tasks of startrack.precompile
+#: The camera of the compile-ahead tasks (the kernels' argument types do not depend on it).
+_TASK_FOV_DEG, _TASK_SIZE_PX, _TASK_MAG = 16.0, 1024, 6.0
+
+
+def _task_identifier(methods):
+    from startrack.camera import Camera
+    from startrack.identify.identifier import StarIdentifier
+    from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+
+    fov = np.radians(_TASK_FOV_DEG)
+    catalog = load_navigation_catalog(NavigationCatalogParams(mag_limit=_TASK_MAG, fov=fov), progress=False)
+    StarIdentifier(catalog, Camera.from_fov(fov, _TASK_SIZE_PX, _TASK_SIZE_PX), methods=methods)  # loads its kernels
+
+
+def pattern_search():
+    """Task: the kernels of the sub-catalog and lost-in-space searches (the pattern look-ups, the pyramid,
+    verification) and of a whole solve."""
+    _task_identifier(("subcatalog", "lost_in_space"))
+
+
+def star_tracking():
+    """Task: the kernels of tracking (verification around a prediction) and of a whole solve; after
+    :func:`pattern_search` in another lane, it loads the verification that lane compiled."""
+    _task_identifier(("tracking",))
