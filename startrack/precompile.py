@@ -6,7 +6,7 @@ A *task* is a function of no arguments named ``"module:function"`` that calls so
 public constructors and methods that a run uses, on small made-up inputs (so with the argument types of
 a run); a *lane* is a sequence of tasks run in order in one process.  :func:`compile_ahead` runs the
 lanes at once -- the first in this process, each other in a spawned process -- and marks each task that
-finished in the kernel cache folder (:func:`startrack.jit.kernel_cache_dir`, keyed by the sources, so an
+finished in the kernel cache folder (:mod:`startrack.jit`, keyed by the sources, so an
 edit starts afresh): a later run skips it.  What a child compiles reaches this process through numba's
 on-disk cache.  Lanes are ordered so that a kernel two of them call is compiled by the one that gets
 there first and loaded by the other (numba saves each kernel as soon as it is compiled).
@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numba
 
-from startrack.jit import kernel_cache_dir
+import startrack.jit  # noqa: F401  (sets numba's cache folder)
 
 
 def compile_ahead(lanes, stream=None) -> None:
@@ -48,6 +48,9 @@ def compile_ahead(lanes, stream=None) -> None:
             run_lane(lane, stream)
         for child in children:
             child.join()
+            if child.exitcode:
+                print(f"compiling ahead: the lane {', '.join(child.lane)} ended with exit code {child.exitcode}; "
+                      "kernels compile at first call", file=stream, flush=True)
     except BaseException:
         for child in children:
             child.terminate()
@@ -58,7 +61,7 @@ def compile_ahead(lanes, stream=None) -> None:
 
 def marker(task: str) -> Path:
     """The file that marks ``task`` done for this installation's kernels."""
-    return kernel_cache_dir() / "ahead" / task.replace(":", ".")
+    return Path(numba.config.CACHE_DIR) / "ahead" / task.replace(":", ".")
 
 
 def run_lane(lane, stream=None) -> None:
@@ -86,5 +89,6 @@ def _child(lane):
 
 def _spawn(lane):
     process = multiprocessing.get_context("spawn").Process(target=_child, args=(lane,), name="compile-ahead")
+    process.lane = lane
     process.start()
     return process

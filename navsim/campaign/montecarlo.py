@@ -41,8 +41,10 @@ from navsim.records import CampaignSummary, RunSummary
 from navsim.scenario import Scenario, resolve_scenario
 from navsim.simulation import add_timing, prepare, simulate
 from navsim.studies import observers
+from navsim.warmup import kernel_lanes
 from startrack import units
 from startrack.errors import InputError
+from startrack.precompile import compile_ahead
 
 RUN_DIR = "run_{:05d}"
 
@@ -249,8 +251,10 @@ def _environment(values):
 
 
 def _run_pool(scenario, chunks, n_workers, bar, truth_off=()):
-    """Local processes (freshly spawned, single-threaded BLAS); on Ctrl-C the pending chunks are
+    """Local processes (freshly spawned, single-threaded BLAS), after the kernels are compiled here (once
+    for every worker, on every core: :mod:`startrack.precompile`); on Ctrl-C the pending chunks are
     cancelled and the workers stopped at once."""
+    compile_ahead(kernel_lanes(scenario))
     with _environment(SINGLE_THREADED_BLAS):
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
         futures = {pool.submit(run_chunk, scenario.data, scenario.source, c, truth_off): len(c) for c in chunks}

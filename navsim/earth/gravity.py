@@ -22,7 +22,6 @@ south of the normal; Jekeli, *Inertial Navigation Systems with Geodetic Applicat
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from navsim.earth.wgs84 import E2, GAMMA_E, K_SOMIGLIANA, A, F, M
 from startrack.errors import InputError
@@ -100,6 +99,8 @@ class GravityDisturbance:
             rho = np.exp(-step / self.correlation_length)
             w = rng.standard_normal((grid.size, 3))
             w[1:] *= np.sqrt(1.0 - rho * rho)
+            from scipy.signal import lfilter  # here: importing scipy.signal costs 1.3 s, and only this needs it
+
             field = lfilter([1.0], [1.0, -rho], w, axis=0)
             for axis in range(3):
                 out[:, axis] += self.sigma[axis] * np.interp(distance, grid, field[:, axis])

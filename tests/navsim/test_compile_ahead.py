@@ -1,0 +1,61 @@
+"""A run compiles nothing after its compile-ahead lanes (``navsim.warmup``): the tasks call the kernels
+with the argument types of a run, so the run loads them all (``startrack.precompile``)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from navsim.scenario import resolve_scenario
+from navsim.warmup import ATTITUDE_IMAGE, ATTITUDE_VECTOR, kernel_lanes
+from tests.support import HANG_S
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+
+#: In a fresh process: the scenario's lanes, then the run, its compilations recorded.
+RUN_AFTER_LANES = """
+import sys
+from numba.core import event
+import navsim
+from navsim.scenario import resolve_scenario
+from navsim.warmup import kernel_lanes
+from startrack.precompile import compile_ahead
+
+scenario = resolve_scenario(sys.argv[1], sys.argv[2:])
+compile_ahead(kernel_lanes(scenario))
+compiled = []
+
+class Compiled(event.Listener):
+    def on_start(self, ev):
+        compiled.append(ev.data["dispatcher"].py_func.__qualname__)
+
+    def on_end(self, ev):
+        pass
+
+event.register("numba:compile", Compiled())
+navsim.run(scenario, seed=0)
+print("compiled:", " ".join(compiled))
+"""
+
+
+def test_an_image_run_compiles_nothing_after_its_lanes():
+    # 25 s of the demo: full-sky acquisition, tracking, the 5 deg knock at 20 s and the sub-catalog's re-acquisition
+    done = subprocess.run([sys.executable, "-c", RUN_AFTER_LANES, str(SCENARIOS / "demo.toml"), "duration_s=25"],
+                          capture_output=True, text=True, timeout=HANG_S, cwd=SCENARIOS.parent)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1].split() == ["compiled:"]
+
+
+@pytest.mark.parametrize("name, lanes", [("demo.toml", ATTITUDE_IMAGE), ("paper000_high_dynamic.toml", ATTITUDE_VECTOR)])
+def test_each_kind_has_its_lanes(name, lanes):
+    assert kernel_lanes(resolve_scenario(SCENARIOS / name)) == lanes
+
+
+def test_every_task_names_a_function():
+    import importlib
+
+    for lane in ATTITUDE_IMAGE + ATTITUDE_VECTOR:
+        for task in lane:
+            module, function = task.split(":")
+            assert callable(getattr(importlib.import_module(module), function)), task
