@@ -27,12 +27,10 @@ from navsim.sensors import faults
 from navsim.sensors.star_sensor import MODES
 from navsim.studies import STUDIES, StudyResult
 from navsim.truth.profiles import sample_truth
-from navsim.warmup import kernel_lanes
 from startrack import rotation as rot
 from startrack import units
 from startrack.attitude_angles import quaternion_from_radec_roll
 from startrack.errors import InputError
-from startrack.precompile import compile_ahead
 from startrack.star_catalog import load_star_catalog
 
 #: The attitude filter's NEES is over its attitude and gyro-bias errors.
@@ -70,7 +68,6 @@ def prepare(scenario, overrides=(), star_catalog=None):
     """Validate ``scenario`` and compute everything that does not depend on the seed."""
     scenario = resolve_scenario(scenario, overrides)
     scenario.require_simulation("a simulation run")
-    compile_ahead(kernel_lanes(scenario))
     if scenario.is_navigation:
         return navigation.prepare(scenario, star_catalog)
     gyro_hz = scenario["gyro"]["rate_hz"]

@@ -18,6 +18,9 @@ from startrack import rotation as rot
 #: (whose verification kernel the first lane compiles early and the second then loads).
 ATTITUDE_IMAGE = (("startrack.identify.warmup:pattern_search",),
                   ("navsim.warmup:inertial_sensors", "navsim.warmup:attitude_filter", "startrack.identify.warmup:star_tracking"))
+#: A navigation run at image fidelity: the identifier's lanes (the INS's kernels compile at first call).
+NAVIGATION_IMAGE = (("startrack.identify.warmup:pattern_search",),
+                    ("navsim.warmup:inertial_sensors", "startrack.identify.warmup:star_tracking"))
 #: At vector fidelity: one lane (compiling ahead then only says what is compiled, once).
 ATTITUDE_VECTOR = (("navsim.warmup:inertial_sensors", "navsim.warmup:attitude_filter"),)
 
@@ -44,7 +47,7 @@ def attitude_filter():
 
 def kernel_lanes(scenario):
     """The compile-ahead lanes of a run of ``scenario``."""
-    image = scenario["star_sensor"]["fidelity"] == "image"
+    image = scenario.data.get("star_sensor", {}).get("fidelity") == "image"
     if scenario.is_navigation:
-        return ()
+        return NAVIGATION_IMAGE if image else ()
     return ATTITUDE_IMAGE if image else ATTITUDE_VECTOR

@@ -12,6 +12,18 @@ def _isolated_cache(tmp_path_factory):
     yield
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _kernels_compiled_ahead(_isolated_cache):
+    """The image chain's and the plate solver's kernels compiled first, on both cores
+    (``startrack.precompile``): no test's output depends on whether it is the first to need them, and the
+    suite compiles them in about half the time."""
+    from navsim.warmup import ATTITUDE_IMAGE
+    from startrack.precompile import compile_ahead
+
+    compile_ahead((*ATTITUDE_IMAGE, ("startrack.identify.warmup:plate_solver",)))
+    yield
+
+
 @pytest.fixture(scope="session")
 def skyfield_sky():
     """skyfield's built-in timescale and JPL's DE421 ephemeris as shipped by the skyfield-data

@@ -14,11 +14,13 @@ from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
 from navsim.studies import observers as observer_kinds
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
+from navsim.warmup import kernel_lanes
 from startrack import units
 from startrack.camera import Camera
 from startrack.errors import InputError
 from startrack.identify.identifier import StarIdentifier
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+from startrack.precompile import compile_ahead
 from startrack.render import SensorModel
 
 
@@ -134,9 +136,10 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, sensor_faults):
     params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],
                                      max_delta=float(units.deg_to_rad(image["catalog_max_pointing_error_deg"])),
                                      epoch=scenario.catalog_epoch)
+    stars = _rendered_stars(star_catalog, image)
+    compile_ahead(kernel_lanes(scenario))  # the scenario checked: the identifier's kernels and the rest of the run's
     identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera,
                                 centroid_sigma_px=image["centroid_sigma_px"], max_stars=image["max_identified_stars"])
-    stars = _rendered_stars(star_catalog, image)
     return ImageStarSensor(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
                            stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],

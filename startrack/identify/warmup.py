@@ -73,3 +73,10 @@ def star_tracking():
     """Task: the kernels of tracking (verification around a prediction) and of a whole solve; after
     :func:`pattern_search` in another lane, it loads the verification that lane compiled."""
     _task_identifier(("tracking",))
+
+
+def plate_solver():
+    """Task: the kernels of the plate solver (an unknown camera's pattern search and self-calibration)."""
+    from startrack.identify.plate_solver import PlateSolver
+
+    PlateSolver()  # loads its kernels
