@@ -57,7 +57,11 @@ def _prune(base, keep):
             shutil.rmtree(folder, ignore_errors=True)
 
 
-numba.config.CACHE_DIR = str(kernel_cache_dir())
+_FOLDER = kernel_cache_dir()
+# numba reads its NUMBA_* variables again at every compilation when they changed since it last read them,
+# and would then put $NUMBA_CACHE_DIR, just set for the children, in place of the keyed folder: read now.
+numba.config.reload_config()
+numba.config.CACHE_DIR = str(_FOLDER)
 
 #: ``@njit`` with on-disk caching; kernels are pure functions of arrays and scalars.
 njit = functools.partial(numba.njit, cache=True, nogil=True)

@@ -48,3 +48,17 @@ def test_editing_a_called_module_recompiles_its_caller(tmp_path):
     (top / "startrack" / "_probe_callee.py").write_text(CALLEE.format("5.0"))  # the caller's file is untouched
     assert run() == 10.0
     assert len(list((tmp_path / "cache" / "numba").iterdir())) == 2
+
+
+def test_kernels_defined_after_a_compilation_still_go_to_the_keyed_folder(tmp_path):
+    """numba re-reads its environment at a compilation; the folder must survive it (set with no
+    ``$NUMBA_CACHE_DIR`` given, as on a newcomer's machine)."""
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(STARTRACK_CACHE_DIR=str(tmp_path / "cache"))
+    script = tmp_path / "probe.py"
+    script.write_text("import numba\nfrom startrack.jit import njit, kernel_cache_dir\n\n\n@njit\ndef first():\n"
+                      "    return 1.0\n\n\nfirst()\n\n\ndef second():\n    return 2.0\n\n\nsecond = njit(second)\n"
+                      "second()\nprint(numba.config.CACHE_DIR == str(kernel_cache_dir()), len(list(kernel_cache_dir().rglob('*.nbi'))))\n")
+    done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["True", "2"]  # both kernels' indexes in the keyed folder
