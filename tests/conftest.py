@@ -14,13 +14,13 @@ def _isolated_cache(tmp_path_factory):
 
 @pytest.fixture(autouse=True, scope="session")
 def _kernels_compiled_ahead(_isolated_cache):
-    """The image chain's and the plate solver's kernels compiled first, on both cores
+    """The kernels of the image chain, the plate solver and the INS compiled first, on both cores
     (``startrack.precompile``): no test's output depends on whether it is the first to need them, and the
     suite compiles them in about half the time."""
-    from navsim.warmup import ATTITUDE_IMAGE
+    from navsim.warmup import ATTITUDE_IMAGE, NAVIGATION_VECTOR
     from startrack.precompile import compile_ahead
 
-    compile_ahead((*ATTITUDE_IMAGE, ("startrack.identify.warmup:plate_solver",)))
+    compile_ahead((*ATTITUDE_IMAGE, ("startrack.identify.warmup:plate_solver",), *NAVIGATION_VECTOR))
     yield
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from navsim.scenario import resolve_scenario
-from navsim.warmup import ATTITUDE_IMAGE, ATTITUDE_VECTOR, kernel_lanes
+from navsim.warmup import ATTITUDE_IMAGE, ATTITUDE_VECTOR, NAVIGATION_IMAGE, NAVIGATION_VECTOR, kernel_lanes
 from tests.support import HANG_S
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -47,7 +47,10 @@ def test_an_image_run_compiles_nothing_after_its_lanes():
     assert done.stdout.splitlines()[-1].split() == ["compiled:"]
 
 
-@pytest.mark.parametrize("name, lanes", [("demo.toml", ATTITUDE_IMAGE), ("paper000_high_dynamic.toml", ATTITUDE_VECTOR)])
+@pytest.mark.parametrize("name, lanes", [("demo.toml", ATTITUDE_IMAGE), ("paper000_high_dynamic.toml", ATTITUDE_VECTOR),
+                                         ("sins_cns_aircraft.toml", NAVIGATION_IMAGE),
+                                         ("sins_cns_aircraft_vector.toml", NAVIGATION_VECTOR),
+                                         ("free_ins_navigation_aircraft.toml", NAVIGATION_VECTOR)])
 def test_each_kind_has_its_lanes(name, lanes):
     assert kernel_lanes(resolve_scenario(SCENARIOS / name)) == lanes
 
@@ -55,7 +58,7 @@ def test_each_kind_has_its_lanes(name, lanes):
 def test_every_task_names_a_function():
     import importlib
 
-    for lane in ATTITUDE_IMAGE + ATTITUDE_VECTOR:
+    for lane in ATTITUDE_IMAGE + ATTITUDE_VECTOR + NAVIGATION_IMAGE + NAVIGATION_VECTOR:
         for task in lane:
             module, function = task.split(":")
             assert callable(getattr(importlib.import_module(module), function)), task
