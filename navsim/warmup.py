@@ -13,9 +13,9 @@ from navsim.estimation.consistency import nees
 from navsim.sensors.gyro import GyroModel
 from startrack import rotation as rot
 
-#: The lanes of an attitude run at image fidelity, balanced on two cores (~30 s each on the test
-#: machine): the identifier's pattern searches, against the inertial sensor, the filter and tracking
-#: (whose verification kernel the first lane compiles early and the second then loads).
+#: The lanes of an attitude run at image fidelity, balanced on two cores (40-46 s each on the test
+#: machine, benchmarks/cold_start.py): the identifier's pattern searches, against the inertial sensor,
+#: the filter and tracking (which loads what the first lane compiled before it gets there).
 ATTITUDE_IMAGE = (("startrack.identify.warmup:pattern_search",),
                   ("navsim.warmup:inertial_sensors", "navsim.warmup:attitude_filter", "startrack.identify.warmup:star_tracking"))
 #: A navigation run at image fidelity: the identifier's lanes (the INS's kernels compile at first call).

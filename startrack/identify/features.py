@@ -188,7 +188,7 @@ class FrameFeatures:
     slots: one is made per frame, and a frozen dataclass takes three times as long to build.)
     """
 
-    __slots__ = ("beta", "delta_px", "filled", "focal_px", "gate", "index", "obs_S", "verify_gate")
+    __slots__ = ("obs_S", "index", "beta", "gate", "filled", "focal_px", "delta_px", "verify_gate")
 
     def __init__(self, obs_S, index, beta, gate, filled, focal_px: float, delta_px: float, verify_gate: float):
         self.obs_S, self.index, self.beta, self.gate, self.filled = obs_S, index, beta, gate, filled

@@ -2,6 +2,7 @@
 skipped afterwards, a failing task is one line and no failure of the run."""
 
 import io
+from pathlib import Path
 
 import numba
 
@@ -28,7 +29,7 @@ def test_lanes_run_once_and_are_marked():
 
 
 def test_the_marks_live_with_the_kernels_they_stand_for():
-    assert marker(TWICE).parent.parent == __import__("pathlib").Path(numba.config.CACHE_DIR)
+    assert marker(TWICE).parent.parent == Path(numba.config.CACHE_DIR)
 
 
 def test_a_failing_task_is_one_line_and_stays_unmarked():
