@@ -101,8 +101,23 @@ def run_chunk(scenario_data, source, members, truth_off=()):
             raise
         except Exception as error:  # recorded, not raised: one bad run must not stop the others
             shutil.rmtree(partial, ignore_errors=True)
+            if interrupted(error):
+                raise KeyboardInterrupt from error
             errors.append(_record_failure(run_dir, seed, error))
     return errors
+
+
+def interrupted(error):
+    """True when a KeyboardInterrupt is in ``error``'s chain of causes: Ctrl-C inside a compiled kernel reaches
+    Python as a SystemError (numba's dispatcher "returned a result with an exception set"), which must stop the
+    campaign like the interrupt it is, not be recorded as a failure of the run's scenario."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return False
 
 
 def _record_failure(run_dir, seed, error):

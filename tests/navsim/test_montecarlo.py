@@ -105,6 +105,32 @@ def test_failures_outside_the_scenario_are_retried_on_resume(tmp_path, base_scen
     assert summary["runs_finished"] == 3 and summary["failures"] == []
 
 
+def test_an_interrupt_inside_a_compiled_kernel_stops_the_campaign_and_records_nothing(tmp_path, base_scenario,
+                                                                                      monkeypatch):
+    """Ctrl-C inside a numba kernel reaches Python as a SystemError caused by the KeyboardInterrupt (seen in a
+    campaign interrupted under load): it stops the campaign as an interrupt, the run stays pending (no error.json,
+    no .partial) and a resume finishes it."""
+    interrupted_seed = mc.run_seed(0, 1)
+    real_simulate = mc.simulate
+
+    def interrupted(prepared, seed):
+        if seed == interrupted_seed:
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as interrupt:
+                raise SystemError("CPUDispatcher(<function run_stars>) returned a result with an exception set") from interrupt
+        return real_simulate(prepared, seed)
+
+    monkeypatch.setattr(mc, "simulate", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        mc.run_campaign(base_scenario, 3, tmp_path / "c", base_seed=0, workers=1, progress=False)
+    assert sorted(p.name for p in (tmp_path / "c" / "runs").iterdir()) == ["run_00000"]
+    assert mc.pending_runs(tmp_path / "c", {"runs": 3}) == [1, 2]
+    monkeypatch.setattr(mc, "simulate", real_simulate)
+    summary = mc.run_campaign(base_scenario, 3, tmp_path / "c", base_seed=0, workers=1, progress=False)
+    assert summary["runs_finished"] == 3 and summary["failures"] == []
+
+
 def test_pool_and_dask_give_identical_results(tmp_path, base_scenario):
     distributed = pytest.importorskip("distributed")
     base_scenario.update(duration_s=10.0)
