@@ -50,10 +50,25 @@ def run_command(prog, build_parser, argv=None) -> int:
     except MemoryError:
         return _fail(prog, "out of memory: make the run shorter or the rates lower", 1)
     except Exception as error:  # a defect of ours: say so in one line, keep the traceback for debugging
+        if interrupted(error):
+            return _fail(prog, "interrupted", 130, label="")
         if os.environ.get("STARTRACK_DEBUG"):
             traceback.print_exc()
         return _fail(prog, f"{type(error).__name__}: {error} (an internal error; set STARTRACK_DEBUG=1 "
                            "for the traceback and please report it)", 70, label="internal error: ")
+
+
+def interrupted(error):
+    """True when a KeyboardInterrupt is in ``error``'s chain of causes: Ctrl-C inside a compiled kernel reaches
+    Python as a SystemError (numba's dispatcher "returned a result with an exception set") caused by it, and is
+    an interruption, not a defect or a failure of the input."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return False
 
 
 def _fail(prog, message, status, label="error: "):

@@ -43,7 +43,7 @@ from navsim.simulation import add_timing, prepare, simulate
 from navsim.studies import observers
 from navsim.warmup import kernel_lanes
 from startrack import units
-from startrack.errors import InputError
+from startrack.errors import InputError, interrupted
 from startrack.precompile import compile_ahead
 
 RUN_DIR = "run_{:05d}"
@@ -106,18 +106,6 @@ def run_chunk(scenario_data, source, members, truth_off=()):
             errors.append(_record_failure(run_dir, seed, error))
     return errors
 
-
-def interrupted(error):
-    """True when a KeyboardInterrupt is in ``error``'s chain of causes: Ctrl-C inside a compiled kernel reaches
-    Python as a SystemError (numba's dispatcher "returned a result with an exception set"), which must stop the
-    campaign like the interrupt it is, not be recorded as a failure of the run's scenario."""
-    seen = set()
-    while error is not None and id(error) not in seen:
-        if isinstance(error, KeyboardInterrupt):
-            return True
-        seen.add(id(error))
-        error = error.__cause__ or error.__context__
-    return False
 
 
 def _record_failure(run_dir, seed, error):
