@@ -25,7 +25,8 @@ A = ∂δθ_b/∂x = C_bn [I₃ (φ), −∂δθ_n/∂(δL, δλ)].
 import numpy as np
 
 from navsim.earth.frames import q_en
-from navsim.estimation.kernels import fix_residual, gate_stars, joseph_update, mm, star_residuals
+from navsim.estimation.kernels import fix_residual, gate_stars, star_residuals
+from navsim.estimation.linalg import joseph_update, mm
 from navsim.estimation.nav_kernels import DP, flush, gated_update, reset
 from startrack.jit import njit
 from startrack.rotation_jit import quat_multiply, quat_to_matrix

@@ -9,7 +9,7 @@ two-sided 95 % interval; every summary, campaign aggregate, report and test take
 import numpy as np
 from scipy.special import gammaincinv
 
-from navsim.estimation.kernels import quadratic_forms
+from navsim.estimation.linalg import quadratic_forms
 
 BAND_PROBABILITY = 0.95
 

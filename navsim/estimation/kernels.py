@@ -21,6 +21,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t, solve3
 from navsim.kinematics_jit import rk4_hold
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, rotation_vector, skew
@@ -33,88 +34,12 @@ FilterModel = namedtuple("FilterModel", "arw rrw gm_sigma gm_tau cal_rw q_scale 
 #: Flat index in K of each calibration state: the scale factors, then the off-diagonal terms.
 K_FLAT = np.array([0, 4, 8, 1, 2, 3, 5, 6, 7])
 
-@njit
-def mm(A, B):
-    """A @ B for small matrices with explicit loops (cheaper than a BLAS call below ~20x20)."""
-    n, k = A.shape
-    m = B.shape[1]
-    C = np.zeros((n, m))
-    for i in range(n):
-        for p in range(k):
-            a = A[i, p]
-            if a != 0.0:
-                for j in range(m):
-                    C[i, j] += a * B[p, j]
-    return C
-
-
-@njit
-def mm_t(A, B):
-    """A @ B.T for small matrices with explicit loops."""
-    n, k = A.shape
-    m = B.shape[0]
-    C = np.empty((n, m))
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for p in range(k):
-                acc += A[i, p] * B[j, p]
-            C[i, j] = acc
-    return C
-
-
-@njit
-def inverse_small(S):
-    """Inverse of a small symmetric positive-definite matrix: closed form for 2x2 and 3x3, else LAPACK."""
-    n = S.shape[0]
-    if n == 3:
-        a, b, c = S[0, 0], S[0, 1], S[0, 2]
-        d, e, f = S[1, 1], S[1, 2], S[2, 2]
-        A = d * f - e * e
-        B = c * e - b * f
-        C = b * e - c * d
-        det = a * A + b * B + c * C
-        out = np.empty((3, 3))
-        out[0, 0] = A / det
-        out[0, 1] = B / det
-        out[1, 0] = B / det
-        out[0, 2] = C / det
-        out[2, 0] = C / det
-        out[1, 1] = (a * f - c * c) / det
-        out[1, 2] = (b * c - a * e) / det
-        out[2, 1] = out[1, 2]
-        out[2, 2] = (a * d - b * b) / det
-        return out
-    if n == 2:
-        det = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
-        out = np.empty((2, 2))
-        out[0, 0] = S[1, 1] / det
-        out[1, 1] = S[0, 0] / det
-        out[0, 1] = -S[0, 1] / det
-        out[1, 0] = -S[1, 0] / det
-        return out
-    return np.linalg.inv(S)
-
 
 @njit
 def calibration_flat(model):
     """Flat index in K of each calibration state, in state order."""
     first = 0 if model.n_sf else 3
     return K_FLAT[first : first + model.n_sf + model.n_gm]
-
-
-@njit
-def solve3(A, d):
-    """A⁻¹ d for a general 3x3 A (Cramer's rule)."""
-    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
-    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
-    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
-    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
-    out = np.empty(3)
-    out[0] = (c00 * d[0] + (A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]) * d[1] + (A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]) * d[2]) / det
-    out[1] = (c01 * d[0] + (A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]) * d[1] + (A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]) * d[2]) / det
-    out[2] = (c02 * d[0] + (A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]) * d[1] + (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * d[2]) / det
-    return out
 
 
 @njit
@@ -251,29 +176,6 @@ def predict(x, P, omega_measured, dt, model):
             x[4:7] -= (1.0 - decay) * x[20:23]
             x[20:23] *= decay
     return x, P
-
-
-@njit
-def joseph_update(P, H, R, z, estimated):
-    """Kalman update of a zero error state: returns (dx, P⁺) with the Joseph form
-    P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ, K = P Hᵀ S⁻¹, S = H P Hᵀ + R, symmetrised; the rows of K of
-    consider states (not ``estimated``) are zero (Schmidt), for which the Joseph form stays exact.
-
-    Formed as M = P − K (H P), P⁺ = M − (M Hᵀ) Kᵀ + K R Kᵀ: O(n² m) for m measurements.
-    """
-    HP = mm(H, P)
-    S = mm_t(HP, H) + R
-    K = mm(HP.T.copy(), inverse_small(S))
-    for i in range(K.shape[0]):
-        if not estimated[i]:
-            K[i, :] = 0.0
-    dx = np.zeros(K.shape[0])
-    for i in range(K.shape[0]):
-        for j in range(z.shape[0]):
-            dx[i] += K[i, j] * z[j]
-    M = P - mm(K, HP)
-    P_next = M - mm_t(mm_t(M, H), K) + mm_t(mm(K, R), K)
-    return dx, 0.5 * (P_next + P_next.T)
 
 
 @njit
@@ -542,30 +444,3 @@ def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, ref_I, obs_S, v
     return x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
 
 
-@njit
-def quadratic_forms(P, e):
-    """eᵢᵀ Pᵢ⁻¹ eᵢ for each i of P (N, m, m) symmetric positive definite and e (N, m), by
-    Cholesky factorisation (NEES of the logged covariances)."""
-    count, m = e.shape
-    out = np.empty(count)
-    L = np.empty((m, m))
-    y = np.empty(m)
-    for i in range(count):
-        for r in range(m):
-            for c in range(r + 1):
-                acc = P[i, r, c]
-                for k in range(c):
-                    acc -= L[r, k] * L[c, k]
-                if r == c:
-                    L[r, r] = np.sqrt(acc)
-                else:
-                    L[r, c] = acc / L[c, c]
-        total = 0.0
-        for r in range(m):
-            acc = e[i, r]
-            for k in range(r):
-                acc -= L[r, k] * y[k]
-            y[r] = acc / L[r, r]
-            total += y[r] * y[r]
-        out[i] = total
-    return out

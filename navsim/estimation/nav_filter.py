@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import q_en
 from navsim.earth.orientation import observer_velocity
 from navsim.estimation import celestial_kernels, nav_kernels
@@ -33,7 +34,6 @@ from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
 from navsim.estimation.updates import UpdateResult
 from navsim.ins import strapdown
-from navsim.sensors.apparent import fix_rotation
 from startrack import rotation as rot
 from startrack.aberration import aberrate
 from startrack.errors import InputError
@@ -72,7 +72,7 @@ class StarSensorModel:
     """What the filter knows of its star sensor: the nominal mounting ``q_BS`` (S -> B), how it treats
     the mounting error μ (``mounting``: estimate, consider or ignore), the Earth's orientation at the
     frames (:class:`~navsim.earth.orientation.EarthOrientation`) and whether its processing
-    corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.sensors.apparent`)."""
+    corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.earth.apparent`)."""
 
     q_BS: np.ndarray
     mounting: str

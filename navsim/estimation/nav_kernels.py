@@ -26,7 +26,7 @@ import numpy as np
 from navsim.earth.frames import earth_rate_n, transport_rate_n
 from navsim.earth.gravity import normal_gravity_height_gradient, normal_gravity_latitude_gradient
 from navsim.earth.wgs84 import E2, radii
-from navsim.estimation.kernels import inverse_small, joseph_update, mm, mm_t
+from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t
 from navsim.ins.strapdown import step
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, skew

@@ -32,6 +32,11 @@ class UpdateResult:
         return int(np.count_nonzero(self.accepted))
 
     @property
+    def updates(self):
+        """The frame's updates in their order: this one (as :attr:`FrameUpdate.updates`)."""
+        return (self,)
+
+    @property
     def n_rejected(self):
         return self.accepted.size - self.n_accepted
 

@@ -18,7 +18,7 @@ Schuler mean of the horizontal error (its mean over the steady frames) with eq. 
 and disturbance (``horizon_floor``).
 
 Aberration. An attitude from apparent stars is turned by the rotation r of the boresight's
-aberration (:func:`navsim.sensors.apparent.fix_rotation`); uncorrected, the filter takes its
+aberration (:func:`navsim.earth.apparent.fix_rotation`); uncorrected, the filter takes its
 horizontal part r_h (navigation axes) for a tilt and settles R·r_h away (20" -> ~600 m).
 
 Observability. Per state the ratio of the filter's σ at the end to its initial σ, and the
@@ -28,10 +28,10 @@ eigenvalue near 1 is a direction the measurements left as it was, one near 0 is 
 
 import numpy as np
 
+from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import q_en
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import radii
-from navsim.sensors.apparent import fix_rotation
 from startrack import rotation as rot
 from startrack import units
 

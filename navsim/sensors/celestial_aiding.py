@@ -7,8 +7,6 @@ own measurements only."""
 
 import dataclasses
 
-from navsim.estimation.updates import FrameUpdate
-
 
 class CelestialAidingRun:
     """The per-run sensors of a star-aided INS: ``star_run`` (a star sensor's run) and ``aiding_run``
@@ -34,11 +32,7 @@ class CelestialAidingRun:
 
     def after_update(self, update):
         """The star sensor's part of the frame's verdict (the first update, when it measured)."""
-        if not self._star_measured:
-            update = None
-        elif isinstance(update, FrameUpdate):
-            update = update.updates[0]
-        self.star_run.after_update(update)
+        self.star_run.after_update(update.updates[0] if self._star_measured else None)
 
     def lose_track(self):
         self.star_run.lose_track()

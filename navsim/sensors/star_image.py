@@ -4,7 +4,7 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
 
 1. the predicted boresight gives the sub-catalog address (eq. 7-8 of 000), logged every frame;
 2. the frame is rendered from the true attitude (true mounting, smear from the true body rate) and,
-   on a vehicle near the Earth, the stars' apparent directions (:mod:`navsim.sensors.apparent`):
+   on a vehicle near the Earth, the stars' apparent directions (:mod:`navsim.earth.apparent`):
    windows around the predicted stars while tracking, the full frame otherwise — windows sized to
    hold the smear trail the predicted rate implies;
 3. detection and centroids; identification with the prediction as prior — while tracking, the
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim import kinematics
-from navsim.sensors.apparent import field_stars
+from navsim.earth.apparent import field_stars
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame
 from startrack import rotation as rot
 from startrack.detection import detect, detect_windows

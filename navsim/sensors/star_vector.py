@@ -9,7 +9,7 @@ Two measurement models (docs/design.md, fidelity ``vector``):
 
 Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S) and, on a
 vehicle near the Earth (``v_I``: the observer's barycentric velocity at each frame), the apparent
-stars (:mod:`navsim.sensors.apparent`): the star vectors are the aberrated directions, the fix is
+stars (:mod:`navsim.earth.apparent`): the star vectors are the aberrated directions, the fix is
 turned by the aberration rotation of its boresight; the reported catalog directions stay the
 catalog's. Their noise does not depend on the filter, so a run draws every frame's measurements
 when it starts (:meth:`StarVectorSensor.start`): the loop reads them frame by frame
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.sensors.apparent import fix_rotation
+from navsim.earth.apparent import fix_rotation
 from navsim.sensors.recorded_run import RecordedRun
 from navsim.sensors.star_sensor import StarFrame
 from startrack import rotation as rot
@@ -129,7 +129,7 @@ class AttitudeFixSensor:
     def observe_frames(self, q_IB_true, rng, v_I=None):
         """Measured q_IS = q_R⁻¹ ⊗ q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true
         (F, 4): q_R the aberration rotation of the boresight for the observer velocities ``v_I`` (F, 3)
-        (:func:`navsim.sensors.apparent.fix_rotation`; None: no aberration)."""
+        (:func:`navsim.earth.apparent.fix_rotation`; None: no aberration)."""
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         if v_I is not None:
             q_R = fix_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])), np.asarray(v_I))

@@ -10,7 +10,7 @@ from scipy.linalg import expm, solve_discrete_are
 from scipy.stats import chi2
 
 import navsim
-from navsim.estimation import kernels
+from navsim.estimation import kernels, linalg
 from navsim.estimation.analytic import farrenkopf_steady_state
 from navsim.estimation.attitude_filter import AttitudeFilter
 from startrack import rotation as rot
@@ -126,7 +126,7 @@ def test_predict_and_update_equal_filterpy():
     H = RNG.standard_normal((4, n))
     R = np.diag([1e-9, 2e-9, 1e-9, 3e-9])
     z = RNG.standard_normal(4) * 1e-4
-    dx, P_post = kernels.joseph_update(P_pred, H, R, z, np.ones(n, bool))
+    dx, P_post = linalg.joseph_update(P_pred, H, R, z, np.ones(n, bool))
     kf.update(z.reshape(-1, 1), R=R, H=H)
     # rounding level: the same Joseph form, re-associated (rounding amplified by cond(S))
     np.testing.assert_allclose(dx, kf.x[:, 0], rtol=1e-10, atol=1e-20)
@@ -308,7 +308,7 @@ def test_attitude_fix_joseph_shortcut_equals_the_general_form():
     R = np.diag([1e-9, 2e-9, 4e-9])
     z = RNG.standard_normal(3) * 1e-4
     H = np.hstack([np.eye(3), np.zeros((3, 6))])
-    dx, P_general = kernels.joseph_update(P, H, R, z, np.ones(9, bool))
+    dx, P_general = linalg.joseph_update(P, H, R, z, np.ones(9, bool))
     dx_short, P_short = kernels.joseph_update_attitude(P, R, z, np.ones(9, bool))
     # rounding level: the same Joseph-form algebra, the product with H = [I 0] written out
     np.testing.assert_allclose(dx_short, dx, rtol=1e-10, atol=1e-20)
@@ -320,4 +320,4 @@ def test_quadratic_forms_equal_a_linear_solve():
     e = RNG.standard_normal((20, 6)) * 1e-4
     expected = np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
     # rounding level (times cond P): a Cholesky solve against LAPACK's LU of the same matrices
-    np.testing.assert_allclose(kernels.quadratic_forms(P, e), expected, rtol=1e-9)
+    np.testing.assert_allclose(linalg.quadratic_forms(P, e), expected, rtol=1e-9)
