@@ -3,7 +3,7 @@
 Each measurement runs in fresh processes with an empty kernel folder (``$NUMBA_CACHE_DIR`` a new temporary
 directory; the built tables stay cached):
 
-- every compile-ahead task of an image-fidelity attitude run (``navsim.warmup.ATTITUDE_IMAGE``) alone: wall
+- every compile-ahead task of an image-fidelity attitude run (``navsim.attitude.run.IMAGE_LANES``) alone: wall
   and CPU seconds -- their sum is about what one process compiling at first call pays (a kernel two tasks
   share counted in each; the set-up before
   ``startrack.precompile``);
@@ -28,7 +28,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from navsim.warmup import ATTITUDE_IMAGE
+from navsim.attitude.run import IMAGE_LANES as ATTITUDE_IMAGE
 
 ROOT = Path(__file__).resolve().parents[1]
 NAVSIM = Path(sys.executable).with_name("navsim")

@@ -6,11 +6,11 @@ solvers as the same centroids, brightest first, with the image size and nothing 
 
 * real: the eight ESA frames of ``../shared/realsky/`` (tetra3's test data, 11.4 deg; truth: cedar-solve's
   own no-FOV solutions in reference.json, whose Alt40_Azi45 attitude is ~90" off);
-* synthetic: frames rendered by :func:`startrack.identify.simulate.rendered_sky` (1024 x 768, field of
+* synthetic: frames rendered by :func:`startrack.synthetic.rendered_sky` (1024 x 768, field of
   view uniform in 8-30 deg, radial distortion k1 uniform in +-0.2, Hipparcos-2 stars V <= 8.5);
 * jpeg: rendered frames (10-33 deg) scaled to 8 bits and JPEG-compressed at quality 60-95
-  (:func:`~startrack.identify.simulate.as_jpeg`), the block noise of an ordinary camera's JPEG;
-* crowd: 1000-5000 false detections (uniform or clustered, :func:`~startrack.identify.simulate.noise_crowd`)
+  (:func:`~startrack.synthetic.as_jpeg`), the block noise of an ordinary camera's JPEG;
+* crowd: 1000-5000 false detections (uniform or clustered, :func:`~startrack.synthetic.noise_crowd`)
   on a 33 deg frame, alone (nothing must be answered) or with the 150 brightest stars of the field.
 
 Scores, per solver and set: success = answered and the pointing of the image centre within 60" of the
@@ -96,8 +96,8 @@ def real_frames():
 
 def synthetic_frames(n, seed, jpeg):
     """``n`` rendered frames (8-30 deg, |k1| <= 0.2), or JPEG-compressed ones (10-33 deg), detected."""
-    from startrack.identify.simulate import as_jpeg, rendered_sky
     from startrack.star_catalog import load_star_catalog
+    from startrack.synthetic import as_jpeg, rendered_sky
 
     stars = load_star_catalog(2000.0).brighter_than(8.5)
     frames = []
@@ -116,8 +116,8 @@ def synthetic_frames(n, seed, jpeg):
 
 def crowd_frames(n, seed):
     """``n`` crowds of 1000-5000 false detections on a 33 deg frame, every other one with its 150 brightest stars."""
-    from startrack.identify.simulate import noise_crowd, random_attitude
     from startrack.star_catalog import load_star_catalog
+    from startrack.synthetic import noise_crowd, random_attitude
 
     stars = load_star_catalog(2000.0).brighter_than(8.0)
     camera = Camera.from_fov(33.0 * DEG, WIDTH, HEIGHT)

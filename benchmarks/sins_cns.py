@@ -3,7 +3,7 @@
 Data: scenarios/sins_cns_aircraft_vector.toml (11 km, 250 m/s, turns; navigation IMU at 200 Hz, 5 m
 baro and star vectors at 1 Hz, the filter's full state with the star-sensor mounting, a random
 gravity field along the track) and its image-fidelity twin scenarios/sins_cns_aircraft.toml, each
-run through the code path of ``navsim run`` (navsim.ins.simulation: prepare once, simulate a seed).
+run through the code path of ``navsim run`` (the navigation kind's run: prepare once, simulate a seed).
 Measured:
 
 - vector fidelity: the first hour (duration_s = 3600), wall seconds of one run (simulate, best of
@@ -43,8 +43,8 @@ sys.path.insert(0, str(HERE))
 
 from strapdown import best, campaign_minutes  # noqa: E402  (the same measures as the strapdown benchmark)
 
-from navsim.ins import simulation  # noqa: E402
-from navsim.scenario import load_scenario  # noqa: E402
+from navsim.kinds import load_scenario  # noqa: E402
+from navsim.navigation import run as simulation  # noqa: E402
 from navsim.truth import trajectory  # noqa: E402
 
 HOUR = 3600.0

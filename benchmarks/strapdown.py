@@ -34,8 +34,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from navsim.campaign.montecarlo import run_campaign  # noqa: E402
+from navsim.estimation.nav_filter import NavFilter  # noqa: E402
 from navsim.ins import strapdown  # noqa: E402
-from navsim.scenario import build_navigation, load_scenario  # noqa: E402
+from navsim.kinds import load_scenario  # noqa: E402
+from navsim.navigation import build as build_navigation  # noqa: E402
 from navsim.sensors.aiding import PositionFixSensor, draw_record  # noqa: E402
 from navsim.truth import trajectory  # noqa: E402
 from navsim.truth.segments import Profile  # noqa: E402
@@ -89,9 +91,8 @@ def ours_filter(truth, dtheta, dv):
     """The scenario's filter (15 states, datasheet noise) over the whole record of 1 Hz fixes of 3 m."""
     gyro, accel = sensors()
     s = scenario()
-    P0 = build_navigation.initial_covariance(s, gyro, accel, truth.lat[0], truth.h[0])
-    start = (truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0])
-    f = build_navigation.nav_filter(s, gyro, accel, start, P0, truth.dt)
+    config = build_navigation.filter_config(s, gyro, accel, truth.lat[0], truth.h[0], truth.dt)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], config)
     frame_k = np.arange(1, int(HOUR) + 1) * int(RATE_HZ)
     record = draw_record(truth, frame_k, PositionFixSensor(every=1, sigma_ned=np.full(3, 3.0)), None, 0, 1, 2)
     f.process_record(np.hstack([dtheta, dv]) / truth.dt, int(RATE_HZ), truth.dt, record)

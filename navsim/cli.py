@@ -13,15 +13,15 @@ import json
 import sys
 from pathlib import Path
 
+from navsim.places import check_output, publish
 from startrack.errors import ArgumentParser, InputError, run_command
 
 # Each command imports what it needs when it runs, so ``navsim --help`` starts at once.
 
 
-def _print_summary(summary, out):
+def _print_summary(kind, summary, out):
     nees, updates = summary["nees"], summary["updates"]
-    lines = _navigation_lines(summary) if summary.kind == "navigation" else _attitude_lines(summary)
-    lines += [
+    lines = kind.run_lines(summary) + [
         f"NEES                mean {nees['mean']:.2f} (dof {nees['dof']}), "
         f"{100 * nees['fraction_in_band']:.1f} % inside the 95 % band",
         f"updates             {updates['accepted']} accepted, {updates['rejected']} rejected",
@@ -31,65 +31,48 @@ def _print_summary(summary, out):
     print("\n".join(lines))
 
 
-def _attitude_lines(summary):
-    err = summary["attitude_error_rms_arcsec"]
-    return [
-        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, "
-        f"{summary['fidelity']}/{summary['measurement']})",
-        f"attitude RMS        x {err['x']:.2f}\"  y {err['y']:.2f}\"  z {err['z']:.2f}\"   "
-        f"cross-boresight {summary['cross_boresight_rms_arcsec']:.2f}\"  roll {summary['roll_rms_arcsec']:.2f}\"",
-        "final bias error    " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h",
-    ]
-
-
-def _navigation_lines(summary):
-    nav, position = summary["navigation"], summary["position_error_m"]
-    horizontal, vertical, nmi = position["horizontal"], position["vertical"], summary["position_error_nmi"]["horizontal"]
-    velocity = summary["velocity_error_m_per_s"]
-    return [
-        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, INS at "
-        f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
-        f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
-        f"RMS {horizontal['rms']:.2f} m  max {horizontal['max']:.2f} m",
-        f"vertical error      final {vertical['final']:.2f} m  RMS {vertical['rms']:.2f} m  max {vertical['max']:.2f} m",
-        f"velocity error RMS  horizontal {velocity['horizontal']['rms']:.3f} m/s  vertical {velocity['vertical']['rms']:.3f} m/s",
-        f"attitude error RMS  tilt {summary['tilt_error_arcsec']['rms']:.1f}\"  heading {summary['heading_error_arcsec']['rms']:.1f}\"",
-        "final bias error    gyro " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h, "
-        "accelerometer " + "  ".join(f"{v:+.1f}" for v in summary["accel_bias_error_final_micro_g"]) + " µg",
-    ]
-
-
 def _run(args):
-    from navsim.output import write_run, write_study
-    from navsim.places import check_output, publish
-    from navsim.scenario import resolve_scenario
-    from navsim.simulation import run, run_study
-    from navsim.studies import STUDIES
+    from navsim.kinds import STUDY, resolve_scenario
     from startrack.paths import check_file
 
     _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
-    kind = "study" if scenario.is_study else "run"
-    check_output(args.out, kind)
+    output = "study" if scenario.kind == STUDY else "run"
+    check_output(args.out, output)
     if args.report:
         check_file(args.report, "--report", (".pdf",))
-    if scenario.is_study:
-        result = run_study(scenario, seed=args.seed, progress=True)
-        out = publish(args.out, kind, lambda directory: write_study(directory, result))
-        print(f"study               {scenario.name} ({scenario['study']['kind']}, seed {result.summary['seed']}, "
-              f"{result.summary['wall_seconds']:.1f} s)")
-        print("\n".join(STUDIES[scenario["study"]["kind"]].text(result.summary, scenario.study_parameters)))
-        print(f"written to          {out}")
-    else:
-        result = run(scenario, seed=args.seed)
-        out = publish(args.out, kind, lambda directory: write_run(directory, result))
-        _print_summary(result.summary, out)
+    out = _run_study(scenario, args) if scenario.kind == STUDY else _run_simulation(scenario, args)
     if args.report is not None:
         from navsim.report import write_report
 
         pdf = write_report(out, args.report or Path(out) / "report.pdf")
         print(f"report              {pdf}")
     return 0
+
+
+def _run_study(scenario, args):
+    from navsim import studies
+    from navsim.output import write_study
+    from navsim.simulation import run_study
+
+    result = run_study(scenario, seed=args.seed, progress=True)
+    out = publish(args.out, "study", lambda directory: write_study(directory, result))
+    print(f"study               {scenario.name} ({scenario['study']['kind']}, seed {result.summary['seed']}, "
+          f"{result.summary['wall_seconds']:.1f} s)")
+    print("\n".join(studies.STUDIES[scenario["study"]["kind"]].text(result.summary, studies.parameters(scenario))))
+    print(f"written to          {out}")
+    return out
+
+
+def _run_simulation(scenario, args):
+    from navsim.kinds import run_kind
+    from navsim.output import write_run
+    from navsim.simulation import run
+
+    result = run(scenario, seed=args.seed)
+    out = publish(args.out, "run", lambda directory: write_run(directory, result))
+    _print_summary(run_kind(scenario, "a simulation run"), result.summary, out)
+    return out
 
 
 def _report(args):
@@ -108,15 +91,18 @@ def _check_seed(seed):
 
 def _montecarlo(args):
     from navsim.campaign.montecarlo import run_campaign
+    from navsim.kinds import resolve_scenario, run_kind
 
     if args.workers is not None and args.scheduler is not None:
         raise InputError("give either --workers or --scheduler, not both")
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     _check_seed(args.seed)
-    summary = run_campaign(args.scenario, args.runs, args.out, base_seed=args.seed, overrides=args.set or (),
-                           workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed)
-    cross, roll, nees = summary.get("cross_boresight_rms_arcsec", {}), summary.get("roll_rms_arcsec", {}), summary.get("nees", {})
+    scenario = resolve_scenario(args.scenario, args.set or ())
+    kind = run_kind(scenario, "a Monte Carlo campaign")
+    summary = run_campaign(scenario, args.runs, args.out, base_seed=args.seed, workers=args.workers,
+                           scheduler=args.scheduler, retry_failed=args.retry_failed)
+    nees = summary.get("nees", {})
     print(f"campaign            {summary['scenario']}: {summary['runs_finished']} of {summary['runs_requested']} runs "
           f"finished, {summary['runs_failed']} failed")
     if summary["failures"]:
@@ -125,16 +111,8 @@ def _montecarlo(args):
                  else "add --retry-failed to run them again")
         print(f"first failure       run {first['run']}: {first['error']} (all in {args.out}/runs/*/error.json; "
               f"once the cause is fixed, {again})")
-    if cross:
-        print(f"cross-boresight RMS mean {cross['mean']:.2f}\"  p95 {cross['p95']:.2f}\"   roll RMS mean {roll['mean']:.2f}\"  p95 {roll['p95']:.2f}\"")
-    if summary.get("position_error_m"):
-        horizontal, nmi = summary["position_error_m"]["horizontal"], summary["position_error_nmi"]["horizontal"]
-        print(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 {horizontal['cep95']:.2f} m "
-              f"({nmi['cep95']:.3f} nmi)   vertical p95 {summary['position_error_m']['vertical']['p95']:.2f} m")
-    accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
-    if accel:
-        print(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "
-              f"(normalised RMS {', '.join(f'{v:.2f}' for v in accel['normalised_error_rms'])})")
+    for line in kind.campaign_lines(summary):
+        print(line)
     if nees:
         print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof; {100 * nees['fraction_in_band']:.1f} % of frames "
               f"inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
@@ -171,13 +149,15 @@ def _tune(args):
 
 
 def _budget(args):
-    from navsim.campaign.budget import run_budget, text
-    from navsim.scenario import resolve_scenario
+    from navsim.campaign.budget import run_budget
+    from navsim.kinds import resolve_scenario, run_kind
+    from navsim.report import write_report
 
     _check_seed(args.seed)
-    budget = run_budget(resolve_scenario(args.scenario, args.set or ()), args.out, runs=args.runs, workers=args.workers,
-                        base_seed=args.seed)
-    print("\n".join(text(budget)))
+    scenario = resolve_scenario(args.scenario, args.set or ())
+    budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed)
+    write_report(args.out, Path(args.out) / "budget.pdf")
+    print("\n".join(run_kind(scenario, "an error budget").budget_text(budget)))
     print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
     return 1 if any(row["status"] == "failed" for row in [*budget["parts"], budget["total"]]) else 0
 

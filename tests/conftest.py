@@ -17,10 +17,11 @@ def _kernels_compiled_ahead(_isolated_cache):
     """The kernels of the image chain, the plate solver and the INS compiled first, on both cores
     (``startrack.precompile``): no test's output depends on whether it is the first to need them, and the
     suite compiles them in about half the time."""
-    from navsim.warmup import ATTITUDE_IMAGE, NAVIGATION_VECTOR
+    from navsim.attitude.run import IMAGE_LANES
+    from navsim.navigation.run import VECTOR_LANES
     from startrack.precompile import compile_ahead
 
-    compile_ahead((*ATTITUDE_IMAGE, ("startrack.identify.warmup:plate_solver",), *NAVIGATION_VECTOR))
+    compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES))
     yield
 
 

@@ -1,1 +1,1 @@
-"""Campaigns over many seeded runs: Monte Carlo (local processes or Dask) and filter tuning."""
+"""Campaigns over many seeded runs: Monte Carlo (local processes or Dask), filter tuning and the error budget."""

@@ -1,251 +1,44 @@
-"""The error budget of a star-aided navigation scenario (SINS/CNS): which error source leaves how many
-metres of horizontal position error, from Monte Carlo campaigns with one source at a time.
+"""The error budget of a scenario: one Monte Carlo campaign per part (each error source alone in the
+truth under the scenario's own filter, then the whole scenario), resumable, and the budget the kind
+draws from them (:func:`navsim.navigation.budget.budget_parts`, ``summarize_budget``: the star-aided navigation
+kind's sources, metres and predictions).
 
     navsim budget SCENARIO.toml --out DIR [--runs N] [--workers W]
 
-The sources (:data:`SOURCES`) are the accelerometer bias ∇, the gravity disturbance (deflections of
-the vertical, anomaly), the star sensor's noise, its mounting error, the rest of the inertial errors
-(gyro errors, IMU noise, scale factors), the filter's initial errors (in straight flight an initial
-tilt is not told from the mounting error and swings the Schuler loop) and the baro's and position
-fixes' errors (with ``filter.baro_states = "all"`` the baro reaches the horizontal channels). A part
-is the scenario's own filter (the same P0, Q, R, consider states, gains) on a truth with every other
-source switched off (``truth_off``, :data:`navsim.ins.simulation.TRUTH_SOURCES`), so the navigation
-errors are one linear system driven by the sources one at a time: per run the parts' Schuler-mean
-error vectors add up to the total's (the superposition residual in budget.json) and, over the runs,
-the parts add up in root-sum-square (their ratio to the total is given) up to the runs' cross terms:
-sampling noise for a source drawn per run, but a source the scenario fixes (a constant deflection,
-the given mounting error) is the same vector in every run and two of them add linearly. Every run
-draws each source from the same seeded sub-stream whatever is switched off, so the parts share the
-other sources' draws exactly.
-
-The aberration is another thing: the truth's stars are always apparent, and its part is what skipping
-the correction costs — the filter without the correction on a truth without any other source. When
-the scenario corrects the aberration (the default) that part is left out of the root-sum-square and
-the superposition; when it does not, the other parts run with the correction (their filter otherwise
-the scenario's) and the aberration part is one of the sources. At image fidelity the star noise
-comes from the pixels: it is not isolable and stays in every part. A source the scenario does not
-have is listed as absent and not run.
-
-Each part and the whole scenario (the total) is a campaign of N runs with the same seeds in
-``DIR/parts/<source>/`` (resumable: a second call runs only what is missing; its campaign.json
-records what the truth leaves out). Per part, over the runs: the RMS of the Schuler-mean horizontal
-error (the mean over the steady frames, :mod:`navsim.ins.celestial`), of the final and of the RMS
-horizontal error [m], and the prediction of eq. (1) where it gives one (∇: R·∇/g; gravity: R times the
-deflection; aberration: R·r_h of its horizontal part); the total beside the root-sum-square of the
-parts and their ratio. ``DIR/budget.json`` (``navsim.error-budget/2``) and ``DIR/budget.pdf`` hold them.
+Each part is a campaign of N runs with the same seeds in ``DIR/parts/<key>/`` (a second call runs only
+what is missing; its campaign.json records what the truth leaves out); ``DIR/budget.json`` holds the
+budget, and ``navsim report DIR`` (:mod:`navsim.report.budget`) typesets it.
 """
 
-from dataclasses import dataclass
-
-import numpy as np
-
-from navsim.ins.simulation import TRUTH_SOURCES
+from navsim.campaign.montecarlo import run_campaign
+from navsim.kinds import resolve_scenario, run_kind
 from navsim.output import write_json
 from navsim.places import check_output, mark
-from navsim.records import RunSummary
-from navsim.scenario import build_navigation, resolve_scenario
 from startrack.errors import InputError
 
-FORMAT = "navsim.error-budget/2"
 #: Runs per source by default.
 DEFAULT_RUNS = 5
 MAX_RUNS = 10_000
 
-#: The model terms of the "inertial" source (:class:`~navsim.sensors.gyro.GyroModel`, accelerometer).
-GYRO_TERMS = ("arw", "rrw", "bias_turn_on_sigma", "bias_instability_sigma", "scale_factor_sigma", "misalignment_sigma",
-              "quantization")
-ACCEL_TERMS = ("vrw", "scale_factor_sigma", "misalignment_sigma", "quantization")
 
-
-@dataclass(frozen=True)
-class Source:
-    """An error source: its key (the part's directory and, but for the aberration, its name in
-    ``truth_off``), label, and where eq. (1) or the aberration's R·r_h predicts its metres in a run's
-    ``celestial`` summary."""
-
-    key: str
-    label: str
-    prediction: tuple | None = None
-
-
-SOURCES = (
-    Source("accel_bias", "accelerometer bias ∇", ("horizon_floor", "accel_bias_m")),
-    Source("gravity", "gravity disturbance (deflection)", ("horizon_floor", "gravity_m")),
-    Source("star_noise", "star-sensor noise"),
-    Source("mounting", "star-sensor mounting error"),
-    Source("aberration", "aberration, cost of not correcting", ("aberration", "uncorrected_position_m")),
-    Source("inertial", "gyro errors and IMU noise"),
-    Source("initial", "filter's initial errors"),
-    Source("aiding", "baro and position-fix errors"),
-)
-#: The prediction of the whole scenario: the floor of eq. (1) (∇ and gravity together).
-TOTAL_PREDICTION = ("horizon_floor", "floor_m")
-
-
-def check_request(scenario, runs, workers):
-    """The validated star-aided navigation scenario of a budget; InputError (nothing written) otherwise."""
+def run_budget(scenario, out, runs=DEFAULT_RUNS, workers=None, base_seed=None, overrides=(), progress=True):
+    """Run (or resume) the budget of ``scenario`` into ``out``; returns the budget (also ``out/budget.json``).
+    Bad input (runs, workers, a scenario whose kind or tables have no budget) is an InputError before
+    anything is written."""
+    scenario = resolve_scenario(scenario, overrides)
     if not 1 <= runs <= MAX_RUNS:
         raise InputError(f"--runs must be from 1 to {MAX_RUNS:,}, got {runs}")
     if workers is not None and workers < 1:
         raise InputError(f"--workers must be at least 1, got {workers}")
-    if scenario.is_study or not scenario.is_navigation:
-        raise InputError(f"{scenario.source}: not a navigation scenario (no [trajectory] table): an error budget "
-                         "needs a star-aided INS")
-    if "star_sensor" not in scenario.data:
-        raise InputError(f"{scenario.source}: no [star_sensor] table: an error budget needs a star-aided INS (SINS/CNS)")
-    return scenario
-
-
-def absent_reason(scenario, key):
-    """Why source ``key`` is not run for ``scenario`` ('absent: ...', 'not isolable: ...'), or None."""
-    data, sensor = scenario.data, scenario["star_sensor"]
-    gyro, accel = build_navigation.imu(scenario)
-    if key == "accel_bias" and not (accel.bias_turn_on_sigma or accel.bias_instability_sigma or accel.bias_rw):
-        return "absent: the accelerometer has no bias"
-    if key == "gravity" and not any((data.get("gravity") or {}).get(k) for k in ("xi_arcsec", "eta_arcsec", "anomaly_mgal")):
-        return "absent: no gravity disturbance ([gravity])"
-    if key == "star_noise" and sensor["fidelity"] == "image":
-        return "not isolable: at image fidelity the star noise comes from the pixels and is in every part"
-    if key == "mounting" and not any(sensor["misalignment_arcsec"]):
-        return "absent: star_sensor.misalignment_arcsec is zero"
-    if key == "aiding" and not (data.get("baro") or data["aiding"].get("position")):
-        return "absent: neither a baro nor position fixes"
-    if key == "inertial" and not (any(getattr(gyro, name) for name in GYRO_TERMS)
-                                  or any(getattr(accel, name) for name in ACCEL_TERMS) or data["faults"]["gyro_bias_steps"]):
-        return "absent: the gyro errors and IMU noise are zero"
-    return None
-
-
-def variants(scenario):
-    """{source key: (the part's Scenario and the truth sources it switches off, or None and the reason
-    it is not run)}: each source alone under the scenario's own filter."""
-    sensor = scenario["star_sensor"]
-    switchable = set(TRUTH_SOURCES) - ({"star_noise"} if sensor["fidelity"] == "image" else set())
-    out = {}
-    for source in SOURCES:
-        reason = absent_reason(scenario, source.key)
-        if reason is not None:
-            out[source.key] = (None, reason)
-            continue
-        overrides = {"name": f"{scenario.name}.{source.key}"}
-        if source.key == "aberration" or not sensor["aberration_correction"]:
-            overrides["star_sensor.aberration_correction"] = source.key != "aberration"
-        out[source.key] = ((resolve_scenario(scenario, overrides), tuple(sorted(switchable - {source.key}))), None)
-    return out
-
-
-def run_budget(scenario, out, runs=DEFAULT_RUNS, workers=None, base_seed=None, overrides=(), progress=True):
-    """Run (or resume) the budget of ``scenario`` into ``out``; returns the budget (also budget.json and
-    budget.pdf in ``out``)."""
-    from navsim.campaign.montecarlo import run_campaign
-    from navsim.report.budget import budget_report
-
-    scenario = check_request(resolve_scenario(scenario, overrides), runs, workers)
-    parts = variants(scenario)
+    kind = run_kind(scenario, "an error budget")
+    parts = kind.budget_parts(scenario)
     directory = check_output(out, "budget")
     mark(directory, "budget")
     seed = scenario["seed"] if base_seed is None else int(base_seed)
-    rows = []
-    for source in SOURCES:
-        variant, reason = parts[source.key]
-        if variant is not None:
-            part, truth_off = variant
-            run_campaign(part, runs, directory / "parts" / source.key, base_seed=seed, workers=workers, progress=progress,
-                         truth_off=truth_off)
-        rows.append({**_part(directory, source.key, source.label, reason, source.prediction),
-                     "truth_off": None if variant is None else list(variant[1])})
-    total_scenario = resolve_scenario(scenario, {"name": f"{scenario.name}.total"})
-    run_campaign(total_scenario, runs, directory / "parts" / "total", base_seed=seed, workers=workers, progress=progress)
-    total = _part(directory, "total", "all sources", None, TOTAL_PREDICTION)
-    corrected = bool(scenario["star_sensor"]["aberration_correction"])
-    rss = _root_sum_square(rows, corrected, total)
-    budget = {"format": FORMAT, "scenario": scenario.name, "source": scenario.source, "runs": runs, "base_seed": seed,
-              "aberration_corrected": corrected, "parts": rows, "total": total, "root_sum_square": rss,
-              "superposition": _superposition(rows, total, rss["parts"]),
-              "in_every_part": _in_every_part(scenario)}
+    for part in parts:
+        if part.scenario is not None:
+            run_campaign(part.scenario, runs, directory / "parts" / part.key, base_seed=seed, workers=workers,
+                         progress=progress, truth_off=part.truth_off)
+    budget = kind.summarize_budget(scenario, directory, parts, runs, seed)
     write_json(directory / "budget.json", budget)
-    (directory / "budget.pdf").write_bytes(budget_report(budget))
     return budget
-
-
-METRICS = ("schuler_mean_m", "final_m", "rms_m")
-
-
-def _part(directory, key, label, reason, prediction):
-    """A part's row: status, runs, the RMS over its runs of each metric and of the prediction."""
-    row = {"key": key, "label": label, "status": "run" if reason is None else reason.split(":")[0], "note": reason}
-    if reason is not None:
-        return row
-    paths = sorted((directory / "parts" / key / "runs").glob("run_*/summary.json"))
-    summaries = [RunSummary.read(p) for p in paths]
-    if not summaries:
-        return {**row, "status": "failed", "note": f"failed: no run finished (parts/{key}/runs/*/error.json)"}
-    horizontal = [s["position_error_m"]["horizontal"] for s in summaries]
-    values = {"schuler_mean_m": [s.celestial["horizon_floor"]["position_error_mean_m"] for s in summaries],
-              "final_m": [h["final"] for h in horizontal], "rms_m": [h["rms"] for h in horizontal]}
-    vectors = [s.celestial["horizon_floor"]["position_error_mean_ne_m"] for s in summaries]
-    if prediction is not None:
-        values["prediction_m"] = [s.celestial[prediction[0]][prediction[1]] for s in summaries]
-    row.update({"runs": len(summaries), **{name: _rms(v) for name, v in values.items()},
-                "per_run": {"run": [int(p.parent.name.split("_")[1]) for p in paths], **values,
-                            "schuler_mean_ne_m": vectors}})
-    return row
-
-
-def _rms(values):
-    return float(np.sqrt(np.mean(np.square(values)))) if len(values) else None
-
-
-def _in_every_part(scenario):
-    """What no part switches off in the truth."""
-    if scenario["star_sensor"]["fidelity"] == "image":
-        return "the star noise (image fidelity: it comes from the pixels)"
-    return "nothing"
-
-
-def _root_sum_square(rows, aberration_corrected, total):
-    """The RSS of the parts that were run, per metric, and its ratio to the total; the aberration part
-    only when the scenario itself leaves the aberration uncorrected (otherwise the total has it
-    corrected and that part is the cost of not correcting)."""
-    included = [r for r in rows if r["status"] == "run" and not (r["key"] == "aberration" and aberration_corrected)]
-    rss = {m: float(np.sqrt(sum(r[m] ** 2 for r in included))) for m in METRICS}
-    ratio = {m: rss[m] / total[m] if total.get(m) else None for m in METRICS}
-    return {"parts": [r["key"] for r in included], **rss, "ratio_to_total": ratio}
-
-
-def _superposition(rows, total, keys):
-    """Per run, the total's Schuler-mean error vector (north, east) against the sum of the parts'
-    (the same filter, the same draws: a linear system adds them up): the RMS over the runs of the
-    total's and of the difference [m], and their ratio; None unless every part finished the same runs."""
-    included = [r for r in rows if r["key"] in keys]
-    runs = total.get("per_run", {}).get("run")
-    if not runs or any(r["per_run"]["run"] != runs for r in included):
-        return None
-    parts_sum = np.sum([r["per_run"]["schuler_mean_ne_m"] for r in included], axis=0)
-    whole = np.asarray(total["per_run"]["schuler_mean_ne_m"])
-    residual = _rms(np.linalg.norm(whole - parts_sum, axis=1))
-    size = _rms(np.linalg.norm(whole, axis=1))
-    return {"total_m": size, "residual_m": residual, "relative": residual / size if size else None}
-
-
-def text(budget):
-    """The budget as lines of text (the command's output)."""
-    lines = [f"error budget        {budget['scenario']}: {budget['runs']} runs per source (RMS over the runs, metres)",
-             f"{'source':<36} {'Schuler mean':>12} {'final':>10} {'RMS':>10} {'eq. (1)':>10}"]
-    for row in [*budget["parts"], budget["total"]]:
-        if row["status"] != "run":
-            lines.append(f"{row['label']:<36} {row['note']}")
-            continue
-        predicted = f"{row['prediction_m']:10.2f}" if row.get("prediction_m") is not None else f"{'-':>10}"
-        lines.append(f"{row['label']:<36} {row['schuler_mean_m']:12.2f} {row['final_m']:10.2f} {row['rms_m']:10.2f} {predicted}")
-    rss = budget["root_sum_square"]
-    lines.append(f"{'root-sum-square of the parts':<36} {rss['schuler_mean_m']:12.2f} {rss['final_m']:10.2f} {rss['rms_m']:10.2f}")
-    ratio = rss["ratio_to_total"]
-    lines.append(f"{'  its ratio to the total':<36} " + " ".join(f"{'-' if ratio[m] is None else f'{ratio[m]:.3f}':>{w}}"
-                                                            for m, w in zip(METRICS, (12, 10, 10))))
-    sup = budget["superposition"]
-    if sup is not None:
-        lines.append(f"superposition: per run, total minus the sum of the parts' Schuler-mean error vectors: RMS "
-                     f"{sup['residual_m']:.2f} m against {sup['total_m']:.2f} m")
-    lines.append(f"in every part: {budget['in_every_part']}")
-    return lines

@@ -14,8 +14,8 @@ was interrupted. Each run is written to a temporary directory and renamed into p
 complete, so a killed campaign leaves only whole runs; rerunning the command runs only the missing
 ones. The aggregate is computed from the files, in run order, and is therefore identical whichever
 way the runs were produced. A navigation campaign may switch error sources off in the truth alone
-(``truth_off``, :data:`navsim.ins.simulation.TRUTH_SOURCES`: the filter stays the scenario's), as
-the parts of ``navsim budget`` do.
+(``truth_off``, the kind's ``TRUTH_SOURCES``: the filter stays the scenario's), as the parts of
+``navsim budget`` do. The statistics are the runs' kind's (:mod:`navsim.kinds`: ``pool``).
 """
 
 import contextlib
@@ -32,17 +32,13 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from navsim.campaign import navigation
-from navsim.campaign.pooling import averaged_nees, calibration, diverged, spread
-from navsim.ins import simulation as ins_simulation
+from navsim.kinds import of, resolve_scenario, run_kind
 from navsim.output import read_npz, write_json, write_run
 from navsim.places import campaign_lock, check_output, mark
-from navsim.records import CampaignSummary, RunSummary
-from navsim.scenario import Scenario, resolve_scenario
-from navsim.simulation import add_timing, prepare, simulate
+from navsim.scenario import Scenario
+from navsim.simulation import prepare, simulate
 from navsim.studies import observers
-from navsim.warmup import kernel_lanes
-from startrack import units
+from navsim.studies.common import add_timing
 from startrack.errors import InputError, interrupted
 from startrack.precompile import compile_ahead
 
@@ -67,13 +63,11 @@ ENVIRONMENT_ERRORS = (OSError, MemoryError, TimeoutError)
 
 @functools.lru_cache(maxsize=1)
 def _prepared(scenario_json, source, truth_off=()):
-    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`; with truth
-    sources switched off, a navigation scenario's :func:`navsim.ins.simulation.prepare`), computed once
-    per process and kept for every chunk it runs (a navigation truth takes seconds per hour)."""
-    scenario = Scenario(data=json.loads(scenario_json), source=source)
-    if truth_off:
-        return ins_simulation.prepare(scenario, truth_off=frozenset(truth_off))
-    return prepare(scenario)
+    """The seed-free part of a campaign's scenario (:func:`navsim.simulation.prepare`, with the truth
+    sources ``truth_off`` switched off), computed once per process and kept for every chunk it runs (a
+    navigation truth takes seconds per hour)."""
+    data = json.loads(scenario_json)
+    return prepare(Scenario(data=data, source=source, kind=of(data).NAME), truth_off=frozenset(truth_off))
 
 
 def run_chunk(scenario_data, source, members, truth_off=()):
@@ -182,19 +176,14 @@ def run_campaign(scenario, runs, out, base_seed=None, overrides=(), workers=None
     chunks of at most ``chunk_size`` that share the scenario's seed-free part. Runs that failed
     for a cause outside the scenario are run again; ``retry_failed`` runs every failed run again.
     Interrupted (Ctrl-C), it cancels what is pending and keeps every finished run. ``truth_off``
-    (navigation only): error sources the truth leaves out, the filter not
-    (:data:`navsim.ins.simulation.TRUTH_SOURCES`).
+    names error sources the truth leaves out, the filter not (the kind's ``TRUTH_SOURCES``).
     """
     if not 1 <= runs <= MAX_RUNS:
         raise InputError(f"--runs must be from 1 to {MAX_RUNS:,}, got {runs}; for more, run several campaigns "
                          "with different --seed")
     scenario = resolve_scenario(scenario, overrides)
-    scenario.require_simulation("a Monte Carlo campaign")
-    truth_off = sorted(truth_off)
-    if truth_off:
-        if not scenario.is_navigation:
-            raise InputError(f"{scenario.source}: truth_off needs a navigation scenario")
-        ins_simulation.check_truth_off(scenario, truth_off)
+    kind = run_kind(scenario, "a Monte Carlo campaign")
+    truth_off = sorted(kind.check_truth_off(scenario, truth_off))
     directory = check_output(out, "campaign")
     base_seed = scenario["seed"] if base_seed is None else int(base_seed)
     n_workers = 1 if workers == 1 else (workers or os.cpu_count() or 1)
@@ -257,7 +246,7 @@ def _run_pool(scenario, chunks, n_workers, bar, truth_off=()):
     """Local processes (freshly spawned, single-threaded BLAS), after the kernels are compiled here (once
     for every worker, on every core: :mod:`startrack.precompile`); on Ctrl-C the pending chunks are
     cancelled and the workers stopped at once."""
-    compile_ahead(kernel_lanes(scenario))
+    compile_ahead(run_kind(scenario, "a Monte Carlo campaign").lanes(scenario))
     with _environment(SINGLE_THREADED_BLAS):
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
         futures = {pool.submit(run_chunk, scenario.data, scenario.source, c, truth_off): len(c) for c in chunks}
@@ -320,14 +309,16 @@ def _pooled_findings(summaries):
 
 
 def load_runs(directory):
-    """(index, summary, series) of every finished run and (index, error, cause) of every failed one."""
+    """(request, [(index, summary, series) of every finished run], [(index, error, cause) of every failed
+    one]): the summaries are the records of the campaign's kind."""
     directory = Path(directory)
     request = _read_request(directory / "campaign.json")
+    kind = of(request["scenario_data"])
     finished, failed = [], []
     for k in range(request["runs"]):
         run_dir = directory / "runs" / RUN_DIR.format(k)
         if (run_dir / "summary.json").exists():
-            finished.append((k, RunSummary.read(run_dir / "summary.json"), read_npz(run_dir / "timeseries.npz")))
+            finished.append((k, kind.RunSummary.read(run_dir / "summary.json"), read_npz(run_dir / "timeseries.npz")))
         elif (run_dir / "error.json").exists():
             record = json.loads((run_dir / "error.json").read_text())
             failed.append((k, record["error"], record.get("cause", "scenario")))
@@ -335,57 +326,16 @@ def load_runs(directory):
 
 
 def aggregate(directory):
-    """The :class:`~navsim.records.CampaignSummary` of the run files (deterministic: no wall-clock
-    values), with the statistics of the runs' kind (attitude or navigation, dispatched once)."""
+    """The campaign summary of the run files (deterministic: no wall-clock values): the kind's record with
+    the statistics the kind pools (:mod:`navsim.kinds`), the updates and the observers' findings."""
     request, finished, failed = load_runs(directory)
+    kind = of(request["scenario_data"])
     base = {"scenario": request["scenario"], "base_seed": request["base_seed"], "runs_requested": request["runs"],
             "runs_finished": len(finished), "runs_failed": len(failed),
             "failures": [{"run": k, "error": message, "cause": cause} for k, message, cause in failed]}
     if not finished:
-        return CampaignSummary(**base)
+        return kind.CampaignSummary(**base)
     summaries = [summary for _, summary, _ in finished]
-    statistics = navigation.statistics if summaries[0].kind == "navigation" else _attitude_statistics
-    return CampaignSummary(**base, **statistics(finished, request["scenario_data"]["settle_s"]),
-                           updates={key: int(sum(s["updates"][key] for s in summaries)) for key in ("accepted", "rejected")},
-                           **_pooled_findings(summaries))
-
-
-def _attitude_statistics(finished, settle):
-    """Attitude errors pooled over every steady frame, per-run RMS spread, run-averaged NEES, divergent
-    runs, the gyro calibration states and the image-fidelity identification."""
-    errors, sigmas, divergent = [], [], []
-    for k, summary, series in finished:
-        steady = series["t"] >= settle
-        errors.append(series["attitude_error"][steady])
-        sigmas.append(np.sqrt(series["P_diag"][steady, :3]))
-        if diverged(summary, errors[-1], sigmas[-1]):
-            divergent.append(k)
-    stacked, sigma = np.concatenate(errors), np.concatenate(sigmas)
-    arcsec = units.rad_to_arcsec
-    summaries = [summary for _, summary, _ in finished]
-    return {
-        "attitude_error_rms_arcsec": {axis: float(arcsec(np.sqrt(np.mean(stacked[:, i] ** 2)))) for i, axis in enumerate("xyz")},
-        "attitude_error_percentiles_arcsec": {
-            axis: {f"p{p}": float(arcsec(np.percentile(np.abs(stacked[:, i]), p))) for p in (50, 95, 99)}
-            for i, axis in enumerate("xyz")},
-        "filter_sigma_mean_arcsec": {axis: float(arcsec(np.mean(sigma[:, i]))) for i, axis in enumerate("xyz")},
-        "cross_boresight_rms_arcsec": spread([s["cross_boresight_rms_arcsec"] for s in summaries]),
-        "roll_rms_arcsec": spread([s["roll_rms_arcsec"] for s in summaries]),
-        "nees": averaged_nees(finished, settle),
-        "divergent_runs": divergent,
-        "gyro_calibration": calibration([s.gyro_calibration for s in summaries]),
-        "identification": _identification(summaries),
-    }
-
-
-def _identification(summaries):
-    """Frames per identification mode over the runs and the fraction of frames with a fix (image fidelity)."""
-    per_mode = {}
-    for summary in summaries:
-        for mode, stats in (summary.identification or {}).get("per_mode", {}).items():
-            per_mode[mode] = per_mode.get(mode, 0) + stats["frames"]
-    if not per_mode:
-        return None
-    frames = sum(per_mode.values())
-    lost = sum(per_mode.get(mode, 0) for mode in ("no_fix", "outage", "dropped"))
-    return {"frames_per_mode": per_mode, "fix_fraction": 1.0 - lost / frames}
+    return kind.CampaignSummary(**base, **kind.pool(finished, request["scenario_data"]["settle_s"]),
+                                updates={key: int(sum(s["updates"][key] for s in summaries)) for key in ("accepted", "rejected")},
+                                **_pooled_findings(summaries))

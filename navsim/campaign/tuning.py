@@ -18,16 +18,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize
 
-from navsim.scenario import resolve_scenario
-from navsim.scenario.navigation import aiding_rates
+from navsim.kinds import resolve_scenario, run_kind
 from navsim.simulation import run_batch
-from startrack.errors import InputError
 
 
 @dataclass
 class TuneStep:
     """Statistics of one iteration's batch with the scales it used; ``errors``: the batch mean of
-    each headline error of the runs' kind, {label: (value, unit)} (:data:`navsim.records.HEADLINE`)."""
+    each headline error of the runs' kind, {label: (value, unit)} (:meth:`navsim.records.RunSummary.headline`)."""
 
     process_noise_scale: float
     measurement_noise_scale: float
@@ -79,10 +77,7 @@ def tune(scenario, runs=20, seed=None, overrides=(), evaluations=30, tolerance=0
     best scales found.
     """
     scenario = resolve_scenario(scenario, overrides)
-    scenario.require_simulation("filter tuning")
-    if scenario.is_navigation and not aiding_rates(scenario.data):
-        raise InputError(f"{scenario.source}: filter tuning needs measurements to judge the NIS by; a free INS without "
-                         "[baro] has none (add [aiding.position] or [baro])")
+    run_kind(scenario, "filter tuning").check_tuning(scenario)
     base_seed = scenario["seed"] if seed is None else int(seed)
     seeds = [base_seed + k for k in range(runs)]
     outcome = TuneResult()

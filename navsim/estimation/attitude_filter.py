@@ -30,16 +30,18 @@ The linear algebra is compiled (:mod:`navsim.estimation.kernels`); it is tested 
 filterpy's ``KalmanFilter.predict``/``update`` (Joseph form), which is the reference engine.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from navsim.estimation import kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
+from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult
 from startrack import rotation as rot
+from startrack.errors import InputError
 
-#: How a group of extra states is treated.
-TREATMENTS = ("estimate", "consider", "ignore")
 #: The groups of extra states in error-state order, with their sizes.
 GROUPS = (("bias_instability", 3), ("scale_factor", 3), ("gyro_misalignment", 6), ("mounting", 3))
 
@@ -50,46 +52,90 @@ def _read_only(array):
     return view
 
 
+@dataclass(frozen=True, eq=False)
+class AttitudeFilterConfig:
+    """Everything the MEKF is built from but its initial estimate, validated here: ``P0`` (its initial
+    covariance, n x n in the state order of the module docstring: the initial σ of every state),
+    ``arw``/``rrw`` (gyro noise the filter assumes, SI), ``q_BS`` (nominal sensor mounting, rotating S
+    vectors into B), ``bias_instability``, ``scale_factor``, ``gyro_misalignment``, ``mounting`` (each
+    one of :data:`~navsim.estimation.treatments.TREATMENTS`), ``bias_instability_sigma`` σ_g [rad/s] and
+    ``bias_correlation_time`` τ [s] of the Gauss-Markov bias, ``calibration_rw`` (σ of a random walk of the
+    calibration terms, 1/√s), ``process_noise_scale`` (multiplies Q) and ``measurement_noise_scale``
+    (multiplies the sensor's σ) for tuning studies, and ``gate_probability`` (chi-square gate)."""
+
+    P0: np.ndarray
+    arw: float
+    rrw: float
+    q_BS: tuple = (0.0, 0.0, 0.0, 1.0)
+    bias_instability: str = "ignore"
+    scale_factor: str = "ignore"
+    gyro_misalignment: str = "ignore"
+    mounting: str = "ignore"
+    bias_instability_sigma: float = 0.0
+    bias_correlation_time: float = np.inf
+    calibration_rw: float = 0.0
+    process_noise_scale: float = 1.0
+    measurement_noise_scale: float = 1.0
+    gate_probability: float = 0.9999
+
+    def __post_init__(self):
+        for group in dict(GROUPS):
+            if getattr(self, group) not in TREATMENTS:
+                raise InputError(f"filter.{group}: must be one of {', '.join(TREATMENTS)}, got {getattr(self, group)!r}")
+        for name in ("arw", "rrw", "bias_instability_sigma", "calibration_rw"):
+            if not 0.0 <= float(getattr(self, name)) < np.inf:
+                raise InputError(f"filter: {name} must be a finite number >= 0, got {getattr(self, name)!r}")
+        for name in ("bias_correlation_time", "process_noise_scale", "measurement_noise_scale"):
+            if not float(getattr(self, name)) > 0.0:
+                raise InputError(f"filter: {name} must be > 0, got {getattr(self, name)!r}")
+        if not 0.0 < self.gate_probability < 1.0:
+            raise InputError(f"filter.gate_probability: must be in (0, 1), got {self.gate_probability!r}")
+        P0 = np.array(self.P0, dtype=float)
+        if P0.shape != (self.n, self.n):
+            raise InputError(f"filter: P0 must be {self.n}x{self.n} for the chosen states, got {P0.shape}")
+        P0.flags.writeable = False
+        object.__setattr__(self, "P0", P0)
+
+    @property
+    def model(self):
+        """The :data:`~navsim.estimation.kernels.FilterModel` the compiled kernels take."""
+        return FilterModel(arw=float(self.arw), rrw=float(self.rrw), gm_sigma=float(self.bias_instability_sigma),
+                           gm_tau=float(self.bias_correlation_time), cal_rw=float(self.calibration_rw),
+                           q_scale=float(self.process_noise_scale), n_bi=3 * int(self.bias_instability != "ignore"),
+                           n_sf=3 * int(self.scale_factor != "ignore"), n_gm=6 * int(self.gyro_misalignment != "ignore"),
+                           mounting=self.mounting != "ignore")
+
+    @property
+    def estimated(self):
+        """(n,) True for the states the updates correct, False for consider states."""
+        return np.array([True] * 6 + [getattr(self, g) == "estimate" for g, size in GROUPS if getattr(self, g) != "ignore"
+                                      for _ in range(size)])
+
+    @property
+    def n(self):
+        """The size of the error state."""
+        return 6 + sum(size for group, size in GROUPS if getattr(self, group) != "ignore")
+
+
 class AttitudeFilter:
     """MEKF with textbook names: error state x, covariance P; Φ, Q, H, R, K inside each step.
 
-    Parameters: ``q`` (q_IB estimate), ``b`` (bias estimate, rad/s), ``P`` (initial covariance,
-    n x n, in the state order of the module docstring), ``arw``/``rrw`` (gyro noise the filter
-    assumes, SI), ``q_BS`` (nominal sensor mounting, rotating S vectors into B; identity by default),
-    ``bias_instability``, ``scale_factor``, ``gyro_misalignment``, ``mounting`` (each "estimate",
-    "consider" or "ignore"), ``bias_instability_sigma`` σ_g [rad/s] and ``bias_correlation_time`` τ [s]
-    of the Gauss-Markov bias, ``calibration_rw`` (σ of a random walk of the calibration terms, 1/√s),
-    ``process_noise_scale``
-    (multiplies Q) and ``measurement_noise_scale`` (multiplies the sensor's σ) for tuning studies,
-    and ``gate_probability`` (chi-square gate).
+    Built from ``q`` (q_IB estimate), ``b`` (bias estimate, rad/s) and its :class:`AttitudeFilterConfig`
+    (P0, noise, state treatments, tuning).
     """
 
-    def __init__(self, q, b, P, arw, rrw, q_BS=None, bias_instability="ignore", scale_factor="ignore",
-                 gyro_misalignment="ignore", mounting="ignore", bias_instability_sigma=0.0, bias_correlation_time=np.inf,
-                 calibration_rw=0.0, process_noise_scale=1.0, measurement_noise_scale=1.0, gate_probability=0.9999):
-        treatment = {"bias_instability": bias_instability, "scale_factor": scale_factor,
-                     "gyro_misalignment": gyro_misalignment, "mounting": mounting}
-        for group, value in treatment.items():
-            if value not in TREATMENTS:
-                raise ValueError(f"{group} must be one of {', '.join(TREATMENTS)}, got {value!r}")
-        used = [(group, size) for group, size in GROUPS if treatment[group] != "ignore"]
-        self.model = FilterModel(arw=float(arw), rrw=float(rrw), gm_sigma=float(bias_instability_sigma),
-                                 gm_tau=float(bias_correlation_time), cal_rw=float(calibration_rw),
-                                 q_scale=float(process_noise_scale), n_bi=3 * int(bias_instability != "ignore"),
-                                 n_sf=3 * int(scale_factor != "ignore"), n_gm=6 * int(gyro_misalignment != "ignore"),
-                                 mounting=mounting != "ignore")
-        self.estimated = np.array([True] * 6 + [treatment[g] == "estimate" for g, size in used for _ in range(size)])
-        self.n = self.estimated.size
-        P = np.array(P, dtype=float)
-        if P.shape != (self.n, self.n):
-            raise ValueError(f"P must be {self.n}x{self.n} for the chosen states, got {P.shape}")
+    def __init__(self, q, b, config):
+        self.config = config
+        self.model = config.model
+        self.estimated = config.estimated
+        self.n = config.n
         q = np.asarray(q, dtype=float)
-        q_BS = np.array([0.0, 0.0, 0.0, 1.0] if q_BS is None else q_BS, dtype=float)
+        q_BS = np.array(config.q_BS, dtype=float)
         self._x = np.concatenate([q / np.linalg.norm(q), np.asarray(b, dtype=float), np.zeros(9), q_BS, np.zeros(3)])
-        self._P = P
-        self._P0_attitude = P[0:3, 0:3].copy()
-        self.variance_scale = float(measurement_noise_scale) ** 2
-        self.gate = {dof: float(chi2_quantile(gate_probability, dof)) for dof in (2, 3)}
+        self._P = np.array(config.P0)
+        self._P0_attitude = self._P[0:3, 0:3].copy()
+        self.variance_scale = float(config.measurement_noise_scale) ** 2
+        self.gate = {dof: float(chi2_quantile(config.gate_probability, dof)) for dof in (2, 3)}
 
     q = property(lambda self: _read_only(self._x[0:4]), doc="q_IB estimate (4,)")
     b = property(lambda self: _read_only(self._x[4:7]), doc="total gyro bias estimate (3,) [rad/s]")

@@ -32,14 +32,13 @@ from navsim.earth.orientation import observer_velocity
 from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
+from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult
 from navsim.ins import strapdown
 from startrack import rotation as rot
 from startrack.aberration import aberrate
 from startrack.errors import InputError
 
-#: How the mounting states are treated (as the attitude filter's groups).
-MOUNTING_TREATMENTS = ("estimate", "consider", "ignore")
 #: Which states a baro height updates: the vertical channel (:data:`nav_kernels.BARO_STATES`), or every
 #: estimated state (a white-noise height reference).
 BARO_CHOICES = ("vertical", "all")
@@ -89,60 +88,95 @@ class GravityUncertainty:
     correlation_length: float
 
 
+@dataclass(frozen=True, eq=False)
+class NavFilterConfig:
+    """Everything the navigation filter is built from but its initial estimate, validated here: ``P0`` (its
+    initial covariance, n x n in the state order of the module docstring: the initial σ of every state);
+    ``noise`` (:class:`ImuNoise`); ``dt`` the IMU interval [s]; ``estimate_scale_factors``; ``star_sensor``
+    (:class:`StarSensorModel`, or None without one; its ``mounting`` one of
+    :data:`~navsim.estimation.treatments.TREATMENTS`); ``gravity`` (:class:`GravityUncertainty` for the three
+    consider states, or None); ``covariance_interval`` the number of increments per covariance propagation;
+    ``gate_probability`` of the chi-square gates; ``process_noise_scale`` (multiplies Q) and
+    ``measurement_noise_scale`` (multiplies each measurement's σ) for tuning; ``baro_states``
+    (:data:`BARO_CHOICES`)."""
+
+    P0: np.ndarray
+    noise: ImuNoise
+    dt: float
+    estimate_scale_factors: bool = False
+    star_sensor: StarSensorModel | None = None
+    gravity: GravityUncertainty | None = None
+    covariance_interval: int = 20
+    gate_probability: float = 0.9999
+    process_noise_scale: float = 1.0
+    measurement_noise_scale: float = 1.0
+    baro_states: str = "vertical"
+
+    def __post_init__(self):
+        if self.mounting not in TREATMENTS:
+            raise InputError(f"filter.mounting: must be one of {', '.join(TREATMENTS)}, got {self.mounting!r}")
+        if not self.dt > 0.0:
+            raise InputError(f"imu.rate_hz: the IMU interval must be > 0, got {self.dt!r} s")
+        if int(self.covariance_interval) < 1:
+            raise InputError(f"filter.covariance_interval: must be >= 1 IMU interval, got {self.covariance_interval!r}")
+        if self.baro_states not in BARO_CHOICES:
+            raise InputError(f"filter.baro_states: must be one of {', '.join(BARO_CHOICES)}, got {self.baro_states!r}")
+        if not 0.0 < self.gate_probability < 1.0:
+            raise InputError(f"filter.gate_probability: must be in (0, 1), got {self.gate_probability!r}")
+        for name in ("process_noise_scale", "measurement_noise_scale"):
+            if not float(getattr(self, name)) > 0.0:
+                raise InputError(f"filter.{name}: must be > 0, got {getattr(self, name)!r}")
+        P0 = np.array(self.P0, dtype=float)
+        if P0.shape != (self.layout.n, self.layout.n):
+            raise InputError(f"filter.P: must be {self.layout.n}x{self.layout.n} for the chosen states, got {P0.shape}")
+        P0 = 0.5 * (P0 + P0.T)
+        P0.flags.writeable = False
+        object.__setattr__(self, "P0", P0)
+
+    @property
+    def mounting(self):
+        """How the star sensor's mounting error is treated ("ignore" without a star sensor)."""
+        return "ignore" if self.star_sensor is None else self.star_sensor.mounting
+
+    @property
+    def layout(self):
+        """The error state's layout (:func:`navsim.estimation.nav_kernels.layout`)."""
+        return nav_kernels.layout(self.estimate_scale_factors, self.mounting != "ignore", self.gravity is not None)
+
+
 class NavFilter:
     """Error-state filter with textbook names: error state x (zero between updates), covariance P;
     F, Φ, Q, H, R, K inside each compiled step.
 
-    Parameters: the initial navigation state ``lat``, ``lon`` [rad], ``h`` [m], ``v_n`` (3,)
-    [m/s], ``q_nb``; ``P`` (n x n in the state order of the module docstring); ``noise``
-    (:class:`ImuNoise`); ``dt`` the IMU interval [s]; ``estimate_scale_factors``; ``star_sensor``
-    (:class:`StarSensorModel`, or None without one); ``gravity`` (:class:`GravityUncertainty` for the
-    three consider states, or None); ``covariance_interval`` the number of increments per covariance
-    propagation; ``gate_probability`` of the chi-square gates; ``process_noise_scale`` (multiplies Q)
-    and ``measurement_noise_scale`` (multiplies each measurement's σ) for tuning; ``baro_states``
-    (:data:`BARO_CHOICES`); ``gyro_bias``/``accel_bias`` initial estimates [rad/s, m/s²].
+    Built from the initial navigation state ``lat``, ``lon`` [rad], ``h`` [m], ``v_n`` (3,) [m/s],
+    ``q_nb`` (the IMU error estimates start at zero) and its :class:`NavFilterConfig`.
     """
 
-    def __init__(self, lat, lon, h, v_n, q_nb, P, noise, dt, estimate_scale_factors=False, star_sensor=None,
-                 gravity=None, covariance_interval=20, gate_probability=0.9999, process_noise_scale=1.0,
-                 measurement_noise_scale=1.0, baro_states="vertical", gyro_bias=(0.0, 0.0, 0.0),
-                 accel_bias=(0.0, 0.0, 0.0)):
-        mounting = "ignore" if star_sensor is None else star_sensor.mounting
-        if mounting not in MOUNTING_TREATMENTS:
-            raise InputError(f"filter.mounting: must be one of {', '.join(MOUNTING_TREATMENTS)}, got {mounting!r}")
-        self.layout = nav_kernels.layout(estimate_scale_factors, mounting != "ignore", gravity is not None)
+    def __init__(self, lat, lon, h, v_n, q_nb, config):
+        self.config = config
+        self.layout = config.layout
         self.n = self.layout.n
-        if not dt > 0.0:
-            raise InputError(f"imu.rate_hz: the IMU interval must be > 0, got {dt!r} s")
-        if int(covariance_interval) < 1:
-            raise InputError(f"filter.covariance_interval: must be >= 1 IMU interval, got {covariance_interval!r}")
-        P = np.array(P, dtype=float)
-        if P.shape != (self.n, self.n):
-            raise InputError(f"filter.P: must be {self.n}x{self.n} for the chosen states, got {P.shape}")
         gm = np.zeros(4)
-        if gravity is not None:
-            gm[0:3], gm[3] = np.square(gravity.sigma), 1.0 / gravity.correlation_length
-        self.model = NavModel(q_c=float(process_noise_scale) * noise.spectral_densities(self.layout), gm=gm,
-                              dt=float(dt), every=int(covariance_interval), layout=self.layout)
-        self.star_sensor = star_sensor
+        if config.gravity is not None:
+            gm[0:3], gm[3] = np.square(config.gravity.sigma), 1.0 / config.gravity.correlation_length
+        self.model = NavModel(q_c=float(config.process_noise_scale) * config.noise.spectral_densities(self.layout), gm=gm,
+                              dt=float(config.dt), every=int(config.covariance_interval), layout=self.layout)
+        self.star_sensor = config.star_sensor
         self.estimated = np.ones(self.n, dtype=np.bool_)
-        if mounting == "consider":
+        if config.mounting == "consider":
             self.estimated[self.layout.mounting:self.layout.mounting + 3] = False
-        if gravity is not None:
+        if config.gravity is not None:
             self.estimated[self.layout.gravity:] = False
-        if baro_states not in BARO_CHOICES:
-            raise InputError(f"filter.baro_states: must be one of {', '.join(BARO_CHOICES)}, got {baro_states!r}")
         self.baro_estimated = self.estimated.copy()
-        if baro_states == "vertical":
+        if config.baro_states == "vertical":
             self.baro_estimated[:] = False
             self.baro_estimated[list(nav_kernels.BARO_STATES)] = True
-        self.sigma_scale = float(measurement_noise_scale)
-        self.gates = np.array([chi2_quantile(gate_probability, dof) for dof in (3, 1, 2)], dtype=float)
+        self.sigma_scale = float(config.measurement_noise_scale)
+        self.gates = np.array([chi2_quantile(config.gate_probability, dof) for dof in (3, 1, 2)], dtype=float)
         self._calib = np.zeros(CALIB_SIZE)
-        self._calib[0:3], self._calib[3:6] = gyro_bias, accel_bias
-        self._calib[12:16] = (0.0, 0.0, 0.0, 1.0) if star_sensor is None else rot.normalize(star_sensor.q_BS)
+        self._calib[12:16] = (0.0, 0.0, 0.0, 1.0) if config.star_sensor is None else rot.normalize(config.star_sensor.q_BS)
         self._nav = strapdown.initial_state(lat, lon, h, v_n, q_nb)
-        self._P = 0.5 * (P + P.T)
+        self._P = np.array(config.P0)
         self._P0_attitude = self._P[0:3, 0:3].copy()
         self._acc = np.zeros(nav_kernels.ACC_SIZE)
         self._intervals = 0

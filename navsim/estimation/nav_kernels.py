@@ -58,7 +58,7 @@ def layout(scale_factors=False, mounting=False, gravity=False):
 #: (Estimating them all, the filter draws horizontal information from the height through the Coriolis
 #: and v²/R couplings of the vertical channel and f^n × φ in manoeuvres, which no biased, lagging baro
 #: really carries; a white-noise height reference does, and the filter may then update every state:
-#: ``NavFilter(baro_states="all")``, as PSINS's SINS/CNS height measurement.)
+#: ``NavFilterConfig(baro_states="all")``, as PSINS's SINS/CNS height measurement.)
 BARO_STATES = (5, DP + 2, 14)
 #: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
 #: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].

@@ -1,15 +1,15 @@
-"""The PDF of an error budget (:mod:`navsim.campaign.budget`): which source leaves how many metres of
-horizontal position error, as a table and a bar chart, with the total and the root-sum-square of the
-parts."""
+"""The PDF of an error budget (``budget.json``: :mod:`navsim.campaign.budget`, the star-aided navigation
+kind's :mod:`navsim.navigation.budget`): which source leaves how many metres of horizontal position
+error, as a table and a bar chart, with the total and the root-sum-square of the parts."""
 
 import tempfile
 from pathlib import Path
 
 import matplotlib
 
-from navsim.report import figures
-from navsim.report import navigation_figures as nav_figures
-from navsim.report.document import Document, markup, number, table
+from navsim.navigation import figures as nav_figures
+from navsim.typeset import figures
+from navsim.typeset.document import Document, markup, number, table
 
 METRIC_LABELS = {"schuler_mean_m": "Schuler mean", "final_m": "final", "rms_m": "RMS"}
 

@@ -70,7 +70,7 @@ STAR_SENSOR = {
 }
 
 #: The faults both kinds of run take: outages, attitude jumps, false-star storms, gyro bias steps and
-#: dropped frames.
+#: dropped frames; and the tracking-failure probes of 000 §5 (a per-frame observer, :mod:`navsim.studies`).
 FAULTS = {
     "outages": ListOfTables(Table({"start_s": Value("float", minimum=0.0),
                                    "end_s": Value("float", minimum=0.0),
@@ -85,10 +85,18 @@ FAULTS = {
     "gyro_bias_steps": ListOfTables(Table({"time_s": Value("float", minimum=0.0),
                                            "step_deg_per_h": Value("vector", minimum=-MAX_BIAS, maximum=MAX_BIAS)})),
     "dropped_frames_s": Value("list", default=[], minimum=0.0, doc="times of frames that are lost"),
+    "tracking_failure_probes": Table(
+        {"count": Value("int", minimum=1, maximum=100000),
+         "angle_3sigma_deg": Value("float", exclusive_minimum=0.0, maximum=90.0)},
+        optional=True,
+        doc="000 §5: at `count` random frames the prior is disturbed (Rayleigh angle of "
+            "3σ = angle_3sigma_deg) and the predicted sub-catalog and full-sky methods are both "
+            "run on that frame's centroids; the filter is not disturbed",
+    ),
 }
 
-#: The faults that act on frames, which only image fidelity has.
-FRAME_FAULTS = ("attitude_jumps", "false_star_storms")
+#: The faults (and probes) that act on frames, which only image fidelity has.
+FRAME_FAULTS = ("tracking_failure_probes", "attitude_jumps", "false_star_storms")
 
 
 def mounting(sensor):

@@ -1,4 +1,4 @@
-"""Faults a scenario can switch on (``[faults]``), built once in SI units.
+"""Faults a scenario can switch on (``[faults]``, built in SI units by :mod:`navsim.build.faults`).
 
 Gyro bias steps change the true bias (and so the gyro output) from their time on
 (:func:`apply_bias_steps`); outages, dropped frames and false-star storms act on the star sensor
@@ -9,16 +9,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack import units
-
-
-def bias_steps(faults):
-    """The gyro bias steps of ``scenario['faults']`` in SI: ((time [s], step (3,) [rad/s]), ...)."""
-    return tuple((s["time_s"], units.deg_per_h_to_rad_per_s(s["step_deg_per_h"])) for s in faults["gyro_bias_steps"])
-
 
 def apply_bias_steps(omega, bias, t_samples, steps):
-    """Gyro output and true bias with each of :func:`bias_steps` added from its time on.
+    """Gyro output and true bias with each of the bias ``steps`` ((time [s], step (3,) [rad/s]), ...)
+    added from its time on.
 
     ``t_samples`` (M,) are the sample times [s] (end of each gyro interval)."""
     if not steps:
@@ -40,13 +34,6 @@ class SensorFaults:
     dropped_s: np.ndarray
     storms: tuple
     frame_interval: float
-
-    @classmethod
-    def from_scenario(cls, faults, frame_interval):
-        return cls(outages=tuple((o["start_s"], o["end_s"], o["reason"]) for o in faults["outages"]),
-                   dropped_s=np.asarray(faults["dropped_frames_s"], dtype=float),
-                   storms=tuple((s["start_s"], s["end_s"], s["count"]) for s in faults["false_star_storms"]),
-                   frame_interval=frame_interval)
 
     def status(self, t):
         """(mode, reason) when the frame at t [s] is lost to an outage or dropped, else None."""
@@ -72,14 +59,9 @@ class SensorFaults:
         return next((count for start, end, count in self.storms if start <= t < end), 0)
 
 
-def attitude_jumps(faults):
-    """The attitude jumps of ``scenario['faults']`` in time order: ((time [s], angle [rad]), ...)."""
-    ordered = sorted(faults["attitude_jumps"], key=lambda j: j["time_s"])
-    return tuple((j["time_s"], float(units.deg_to_rad(j["angle_deg"]))) for j in ordered)
-
-
 class AttitudeJumps:
-    """The attitude-jump fault of one run: at each time of ``jumps`` (:func:`attitude_jumps`) the
+    """The attitude-jump fault of one run: at each time of ``jumps`` ((time [s], angle [rad]), ... in time
+    order) the
     filter's estimate is knocked off by its angle about a random axis drawn from ``rng`` (a tracking
     loss the sensor must recover)."""
 

@@ -57,7 +57,7 @@ TIMING_FIELDS = {"id_ms": ((), np.float64, np.nan)}
 
 @dataclass(frozen=True)
 class ImageStarSensor:
-    """The seed-free image-fidelity sensor, built once per scenario (:func:`navsim.scenario.build.star_sensor`):
+    """The seed-free image-fidelity sensor, built once per scenario (:func:`navsim.build.star_sensor.star_sensor`):
     camera and detector model, the identifier over the navigation catalog, the stars drawn into the
     frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n,
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already

@@ -17,9 +17,12 @@ a campaign pool (``pool(run summaries)``). Their findings carry ``key``, ``stats
 comparison table), ``notes`` and extra ``series``.
 """
 
+import functools
 import importlib
 from collections.abc import Mapping
 
+from navsim.scenario import checked_table, only_chosen
+from navsim.scenario.schema import Table, Value
 from navsim.studies.common import StudyResult
 
 
@@ -46,6 +49,39 @@ class _Modules(Mapping):
 STUDIES = _Modules(("attitude_precision", "contest_starmap"))
 
 
+@functools.cache
+def schema():
+    """The schema of a static study: its kind and the kind's own parameters (built when first needed,
+    so that validating one study imports every study module only once)."""
+    return Table(
+        {
+            "name": Value("str"),
+            "description": Value("str", default=""),
+            "seed": Value("int", default=0, minimum=0),
+            "study": Table({"kind": Value("str", choices=tuple(STUDIES))}
+                           | {kind: Table(module.PARAMETERS.entries, optional=True)
+                              for kind, module in STUDIES.items()}),
+        }
+    )
+
+
+def validate(data, source):
+    """The checked dictionary of a static study: the kind's own table (all defaults when absent), no
+    other kind's table."""
+    checked = checked_table(schema(), data, source)
+    study = checked["study"]
+    kind = study["kind"]
+    only_chosen(study, "study", "kind", STUDIES, source)
+    if kind not in study:
+        study[kind] = STUDIES[kind].PARAMETERS.check(f"study.{kind}", {})
+    return checked
+
+
+def parameters(scenario):
+    """The parameters of a static study's kind (a validated study scenario)."""
+    return scenario["study"][scenario["study"]["kind"]]
+
+
 def observers():
     """The per-frame observer kinds, in the order their findings appear in a summary."""
     from navsim.studies.dim_star_comparison import DimStarComparison
@@ -54,4 +90,4 @@ def observers():
     return (TrackingFailureProbes, DimStarComparison)
 
 
-__all__ = ["STUDIES", "StudyResult", "observers"]
+__all__ = ["STUDIES", "StudyResult", "observers", "parameters", "schema", "validate"]

@@ -41,3 +41,16 @@ def percent(ours, paper):
 def progress_bar(items, enabled, description):
     """``items`` with a tqdm bar on stderr when ``enabled`` (shown after a second)."""
     return tqdm(items, desc=description, disable=not enabled, file=sys.stderr, delay=1.0, leave=False)
+
+
+def add_timing(timing, findings):
+    """Put the findings' wall-clock figures, time comparisons and notes into a summary's ``timing``."""
+    for found in findings:
+        if found.timing:
+            timing[found.key] = found.timing
+    rows = [r for f in findings for r in f.timing_rows]
+    notes = [n for f in findings for n in f.timing_notes]
+    if rows:
+        timing["paper_comparison"] = rows
+    if notes:
+        timing["notes"] = notes

@@ -30,10 +30,10 @@ from startrack import boresight as bs
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
 from startrack.identify import StarIdentifier
-from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
 from startrack.sphere import angular_distance, vector_to_radec
 from startrack.star_catalog import load_star_catalog
+from startrack.synthetic import centroid_frame, random_attitude
 from startrack.units import ARCSEC
 
 FALSE_MATCH_ARCSEC = 60.0

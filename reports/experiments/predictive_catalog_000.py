@@ -37,10 +37,10 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 from startrack.camera import Camera  # noqa: E402
 from startrack.identify import Prior, StarIdentifier  # noqa: E402
-from startrack.identify.simulate import centroid_frame  # noqa: E402
 from startrack.navigation_catalog import load_navigation_catalog  # noqa: E402
 from startrack.sphere import vector_to_radec  # noqa: E402
 from startrack.star_catalog import load_star_catalog  # noqa: E402
+from startrack.synthetic import centroid_frame  # noqa: E402
 from startrack.units import ARCSEC, DEG  # noqa: E402
 
 AXIS = np.array([math.sqrt(2.0) / 2.0, 0.5, 0.5])

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from navsim.earth.wgs84 import radii
-from navsim.scenario import load_scenario
+from navsim.kinds import load_scenario
 from navsim.truth.segments import Profile
 from startrack import rotation as rot
 

@@ -12,8 +12,10 @@ from pathlib import Path
 import pytest
 
 from navsim import cli
-from navsim.scenario import SCHEMA, navigation, study_schema
+from navsim.attitude.scenario import SCHEMA
+from navsim.navigation import scenario as navigation
 from navsim.scenario.schema import ListOfTables, Table, Tagged, Value
+from navsim.studies import schema as study_schema
 from tests.support import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]

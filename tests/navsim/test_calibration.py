@@ -12,7 +12,7 @@ from scipy.linalg import solve_discrete_are
 import navsim
 from navsim.campaign.montecarlo import run_campaign
 from navsim.estimation import kernels
-from navsim.estimation.attitude_filter import AttitudeFilter
+from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
 from startrack import units
 from startrack.errors import InputError
 
@@ -109,9 +109,9 @@ def test_extended_filter_reaches_the_riccati_solution_without_calibration_errors
     n = 6 + 3 + 3 + 6
     P0 = np.zeros((n, n))
     P0[:6, :6] = np.diag([1e-4] * 3 + [1e-10] * 3)
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=arw, rrw=rrw, bias_instability="estimate",
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=arw, rrw=rrw, bias_instability="estimate",
                           scale_factor="estimate", gyro_misalignment="estimate", bias_instability_sigma=0.0,
-                          bias_correlation_time=300.0)
+                          bias_correlation_time=300.0))
     for _ in range(30000):
         filt.predict(omega[None, :], dt)
         P_pre = filt.P[:6, :6].copy()

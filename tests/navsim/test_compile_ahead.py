@@ -1,4 +1,4 @@
-"""A run compiles nothing after its compile-ahead lanes (``navsim.warmup``): the tasks call the kernels
+"""A run compiles nothing after its compile-ahead lanes (each kind's ``lanes``): the tasks call the kernels
 with the argument types of a run, so the run loads them all (``startrack.precompile``)."""
 
 import subprocess
@@ -7,8 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from navsim.scenario import resolve_scenario
-from navsim.warmup import ATTITUDE_IMAGE, ATTITUDE_VECTOR, NAVIGATION_IMAGE, NAVIGATION_VECTOR, kernel_lanes
+from navsim.attitude.run import IMAGE_LANES as ATTITUDE_IMAGE
+from navsim.attitude.run import VECTOR_LANES as ATTITUDE_VECTOR
+from navsim.kinds import resolve_scenario, run_kind
+from navsim.navigation.run import IMAGE_LANES as NAVIGATION_IMAGE
+from navsim.navigation.run import VECTOR_LANES as NAVIGATION_VECTOR
 from tests.support import HANG_S
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -18,12 +21,11 @@ RUN_AFTER_LANES = """
 import sys
 from numba.core import event
 import navsim
-from navsim.scenario import resolve_scenario
-from navsim.warmup import kernel_lanes
+from navsim.kinds import resolve_scenario, run_kind
 from startrack.precompile import compile_ahead
 
 scenario = resolve_scenario(sys.argv[1], sys.argv[2:])
-compile_ahead(kernel_lanes(scenario))
+compile_ahead(run_kind(scenario, "a run").lanes(scenario))
 compiled = []
 
 class Compiled(event.Listener):
@@ -52,7 +54,8 @@ def test_an_image_run_compiles_nothing_after_its_lanes():
                                          ("sins_cns_aircraft_vector.toml", NAVIGATION_VECTOR),
                                          ("free_ins_navigation_aircraft.toml", NAVIGATION_VECTOR)])
 def test_each_kind_has_its_lanes(name, lanes):
-    assert kernel_lanes(resolve_scenario(SCENARIOS / name)) == lanes
+    scenario = resolve_scenario(SCENARIOS / name)
+    assert run_kind(scenario, "a run").lanes(scenario) == lanes
 
 
 def test_every_task_names_a_function():

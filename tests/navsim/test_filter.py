@@ -12,7 +12,7 @@ from scipy.stats import chi2
 import navsim
 from navsim.estimation import kernels, linalg
 from navsim.estimation.analytic import farrenkopf_steady_state
-from navsim.estimation.attitude_filter import AttitudeFilter
+from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
 from startrack import rotation as rot
 from startrack import units
 
@@ -135,7 +135,7 @@ def test_predict_and_update_equal_filterpy():
 
 def _steady_state_filter(omega, dt, steps_per_fix, arw, rrw, sigma_n, n_fixes=30000):
     P0 = np.diag([1e-4] * 3 + [1e-10] * 3)
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=arw, rrw=rrw)
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=arw, rrw=rrw))
     R_S = np.eye(3) * sigma_n**2
     omega_measured = np.tile(omega, (steps_per_fix, 1))
     for _ in range(n_fixes):
@@ -244,7 +244,7 @@ def test_torque_free_tumble_with_10_arcsec_fixes(base_scenario):
 
 def test_one_star_update_only_shrinks_the_two_axes_across_it():
     P0 = np.diag([1e-6] * 3 + [1e-10] * 3)
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=1e-5, rrw=1e-8)
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=1e-5, rrw=1e-8))
     star = np.array([[0.0, 0.0, 1.0]])  # along z_S = z_B
     result = filt.update_stars(star, star, units.arcsec_to_rad(5.0))
     assert result.n_accepted == 1
@@ -257,7 +257,7 @@ def test_two_stars_make_the_attitude_fully_observable():
     cross-track residual carries roll and the x tilt the first star fixes to σ)."""
     P0 = np.diag([1e-2] * 3 + [1e-10] * 3)
     sigma = units.arcsec_to_rad(5.0)
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=1e-5, rrw=1e-8)
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=1e-5, rrw=1e-8))
     stars = np.array([[0.0, 0.0, 1.0], [np.sin(0.1), 0.0, np.cos(0.1)]])
     filt.update_stars(stars, stars, sigma)
     assert np.sqrt(filt.P[2, 2]) == pytest.approx(np.sqrt(2.0) * sigma / np.sin(0.1), rel=0.01)
@@ -268,7 +268,7 @@ def test_a_star_update_moves_the_estimate_to_the_truth():
     """Noise-free stars and a 90 arcsec initial error: one update leaves only the second-order
     linearisation error (< 0.1 arcsec)."""
     q_true = rot.from_rotation_vector([2e-4, -3e-4, 2.5e-4])
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=np.diag([1e-6] * 3 + [1e-10] * 3), arw=1e-5, rrw=1e-8)
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=np.diag([1e-6] * 3 + [1e-10] * 3), arw=1e-5, rrw=1e-8))
     ref_I = np.array([[0, 0, 1.0], [0.1, 0, 1.0], [0, 0.12, 1.0], [-0.08, -0.05, 1.0]])
     ref_I /= np.linalg.norm(ref_I, axis=1, keepdims=True)
     obs_S = rot.rotate(rot.conjugate(q_true), ref_I)
@@ -278,7 +278,7 @@ def test_a_star_update_moves_the_estimate_to_the_truth():
 
 def test_gating_rejects_an_outlier_and_leaves_the_state_alone():
     P0 = np.diag([units.arcsec_to_rad(20.0) ** 2] * 3 + [1e-10] * 3)
-    filt = AttitudeFilter(q=[0, 0, 0, 1.0], b=np.zeros(3), P=P0, arw=1e-5, rrw=1e-8, gate_probability=0.9999)
+    filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=1e-5, rrw=1e-8, gate_probability=0.9999))
     outlier = rot.from_rotation_vector(np.radians([1.0, 0, 0]))
     P_before = filt.P.copy()
     result = filt.update_attitude(outlier, np.eye(3) * units.arcsec_to_rad(10.0) ** 2)

@@ -118,7 +118,7 @@ import re  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 from navsim.estimation.consistency import chi2_band  # noqa: E402
-from navsim.estimation.nav_filter import ImuNoise, NavFilter  # noqa: E402
+from navsim.estimation.nav_filter import ImuNoise, NavFilter, NavFilterConfig  # noqa: E402
 from navsim.sensors.accelerometer import AccelerometerModel  # noqa: E402
 from navsim.sensors.gyro import GyroModel  # noqa: E402
 from navsim.simulation import prepare, run_batch, simulate  # noqa: E402
@@ -197,7 +197,7 @@ def test_perfect_imu_and_perfect_start_stay_on_the_truth():
     truth = trajectory.generate(Profile.from_table(TURNS), 50.0)
     noise = ImuNoise(arw=1e-5, vrw=1e-4, gyro_bias_rw=1e-8, accel_bias_rw=1e-6)
     P = np.diag([1e-8] * 3 + [1e-4] * 3 + [1e-14, 1e-14, 1.0] + [1e-12] * 3 + [1e-8] * 3)
-    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], P, noise, truth.dt)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], NavFilterConfig(P, noise, truth.dt))
     for k0 in range(0, truth.dtheta.shape[0], 50):
         f.predict(_samples(truth.dtheta[k0:k0 + 50], truth.dv[k0:k0 + 50], truth.dt), truth.dt)
         k1 = min(k0 + 50, truth.dtheta.shape[0])
@@ -211,7 +211,7 @@ def test_perfect_imu_and_perfect_start_stay_on_the_truth():
 def test_baro_update_pulls_the_height():
     noise = ImuNoise(arw=1e-5, vrw=1e-3)
     P = np.diag([1e-6] * 3 + [1e-2] * 3 + [1e-12, 1e-12, 100.0] + [1e-10] * 3 + [1e-6] * 3)
-    f = NavFilter(0.5, 0.1, 120.0, np.zeros(3), [0, 0, 0, 1.0], P, noise, 0.01)
+    f = NavFilter(0.5, 0.1, 120.0, np.zeros(3), [0, 0, 0, 1.0], NavFilterConfig(P, noise, 0.01))
     result = f.update_baro(100.0, 1.0)  # rounding level below: the scalar Kalman update's closed form
     assert result.accepted[0] and result.nis[0] == pytest.approx(400.0 / 101.0)
     assert f.position[2] == pytest.approx(100.0 + 20.0 / 101.0)
@@ -223,7 +223,7 @@ def test_baro_update_pulls_the_height():
 def test_bad_filter_input_is_named():
     noise = ImuNoise(arw=1e-5, vrw=1e-3)
     with pytest.raises(InputError, match="filter.P: must be 15x15"):
-        NavFilter(0.5, 0.1, 0.0, np.zeros(3), [0, 0, 0, 1.0], np.eye(9), noise, 0.01)
+        NavFilter(0.5, 0.1, 0.0, np.zeros(3), [0, 0, 0, 1.0], NavFilterConfig(np.eye(9), noise, 0.01))
 
 
 def test_scale_factor_states_are_estimated_within_three_sigma():
@@ -239,8 +239,8 @@ def test_scale_factor_states_are_estimated_within_three_sigma():
     sigma0 = np.array([np.radians(0.05)] * 2 + [np.radians(0.3)] + [0.1] * 3 + [5.0 / 6.4e6] * 2 + [5.0]
                       + [gyro.bias_turn_on_sigma] * 3 + [accel.bias_turn_on_sigma] * 3 + [100e-6] * 3 + [300e-6] * 3)
     noise = ImuNoise(gyro.arw, accel.vrw, gyro.filter_rrw, accel.filter_bias_rw)
-    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0], np.diag(sigma0**2), noise, truth.dt,
-                  estimate_scale_factors=True)
+    f = NavFilter(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0],
+                  NavFilterConfig(np.diag(sigma0**2), noise, truth.dt, estimate_scale_factors=True))
     for k in range(0, truth.dtheta.shape[0], 50):
         f.predict(np.hstack([g_rec.omega[k:k + 50], a_rec.force[k:k + 50]]), truth.dt)
         f.update_position(truth.lat[k + 50], truth.lon[k + 50], truth.h[k + 50], 3.0)

@@ -14,7 +14,7 @@ import pytest
 from navsim import cli
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import radii
-from navsim.records import RunSummary
+from navsim.navigation.records import RunSummary
 from navsim.simulation import run_batch
 from startrack import units
 from tests.support import HANG_S, pdf_text

@@ -13,10 +13,13 @@ from scipy.stats import chi2
 
 import navsim
 from navsim import cli
+from navsim.attitude.report_statistics import envelopes
 from navsim.campaign.montecarlo import aggregate, run_campaign
 from navsim.output import read_npz, write_json, write_npz, write_run
-from navsim.report import statistics, write_report
-from navsim.report.inputs import RunData
+from navsim.pooling import averaged_nees
+from navsim.report import write_report
+from navsim.typeset import statistics
+from navsim.typeset.inputs import RunData
 from startrack import address
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
@@ -164,16 +167,20 @@ def fake_campaign(nees_runs, P_runs=None):
 def test_averaged_nees_band_holds_95_percent_for_a_consistent_filter():
     rng = np.random.default_rng(5)
     m, frames = 25, 4000
-    avg = statistics.averaged_nees(fake_campaign(rng.chisquare(6, size=(m, frames))))
-    assert avg.band == pytest.approx(tuple(chi2.ppf([0.025, 0.975], 6 * m) / m))  # rounding level: the same ppf
-    assert avg.fraction_in_band == pytest.approx(0.95, abs=0.015)  # binomial σ over 4000 frames: 0.0034
-    inflated = statistics.averaged_nees(fake_campaign(1.5 * rng.chisquare(6, size=(m, frames))))
-    assert inflated.fraction_in_band < 0.5
+
+    def finished(nees_runs):
+        return [(k, run.summary, run.series) for k, run in enumerate(fake_campaign(nees_runs).runs)]
+
+    avg = averaged_nees(finished(rng.chisquare(6, size=(m, frames))), 0.0)
+    assert avg["band_95"] == pytest.approx(list(chi2.ppf([0.025, 0.975], 6 * m) / m))  # rounding level: the same ppf
+    assert avg["fraction_in_band"] == pytest.approx(0.95, abs=0.015)  # binomial σ over 4000 frames: 0.0034
+    inflated = averaged_nees(finished(1.5 * rng.chisquare(6, size=(m, frames))), 0.0)
+    assert inflated["fraction_in_band"] < 0.5
 
 
 def test_filter_sigma_envelope_averages_the_covariance_not_the_sigma():
     P = np.stack([np.full((5, 6), 1.0), np.full((5, 6), 9.0)]) * (np.pi / 180 / 3600) ** 2  # (1")², (3")²
-    env = statistics.envelopes(fake_campaign(np.ones((2, 5)), P))  # rounding level below: closed forms
+    env = envelopes(fake_campaign(np.ones((2, 5)), P))  # rounding level below: closed forms
     assert env.final_sigma_filter == pytest.approx(np.full(3, np.sqrt(5.0)))
     assert env.sigma3_filter[0] == pytest.approx(np.full(3, 3 * np.sqrt(5.0)))
 

@@ -4,7 +4,8 @@ import copy
 
 import pytest
 
-from navsim.scenario import load_scenario, parse_override, scenario_from_dict
+from navsim.kinds import load_scenario, scenario_from_dict
+from navsim.scenario import parse_override
 from startrack.errors import InputError
 
 

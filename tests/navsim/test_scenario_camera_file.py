@@ -4,8 +4,8 @@ from pathlib import Path
 
 import pytest
 
-from navsim.scenario import load_scenario
-from navsim.scenario.build import image_star_sensor
+from navsim.build.star_sensor import image_star_sensor
+from navsim.kinds import load_scenario
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
@@ -43,7 +43,7 @@ def test_camera_file_sets_the_image_sensor_camera(tmp_path):
     scenario = load_scenario(path)
     image = scenario["star_sensor"]["image"]
     assert (image["width_px"], image["height_px"]) == (640, 480)
-    sensor = image_star_sensor(scenario, load_star_catalog(2000.0), [0.0, 0.0, 0.0, 1.0], None)
+    sensor = image_star_sensor(scenario, load_star_catalog(2000.0), [0.0, 0.0, 0.0, 1.0], None, 2000.0)
     camera = sensor.camera
     assert (camera.width, camera.height, camera.focal_px, camera.cx, camera.cy, camera.k1) == (
         640, 480, 2600.5, 322.25, 236.75, -0.08)

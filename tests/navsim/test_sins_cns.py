@@ -1,7 +1,7 @@
 """SINS/CNS physics (issue 16): the analytic horizon. A star sensor fixes the INS's inertial
 attitude, its accelerometers the local vertical, so the horizontal position error stops growing
 and oscillates at the Schuler period about R·∇/g plus R times the deflection of the vertical
-(eq. (1) of navsim.ins.celestial), whatever the gyro drift; manoeuvres make ∇ observable. Checked
+(eq. (1) of navsim.navigation.celestial), whatever the gyro drift; manoeuvres make ∇ observable. Checked
 on tests/navsim/data/sins_cns_level.toml (10 min plus two Schuler periods due east at 11 km) against
 the closed form computed here from the truth's bias, and the PSINS-settings scenario's mounting."""
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from navsim import cli
-from navsim.scenario import load_scenario
-from navsim.scenario.navigation import boresight_elevation
+from navsim.kinds import load_scenario
+from navsim.navigation.scenario import boresight_elevation
 from startrack.errors import InputError
 from tests.support import run_cli
 
@@ -24,7 +24,7 @@ DURATION_S = 33.0
 DOWN, LEFT_WING_LOW = [0.0, 0.0, 0.0], [80.0, 0.0, 0.0]
 #: A star sensor alone (no faults) on the base flight, for the cases that only look at the validation.
 NO_FAULTS = {"faults.outages": [], "faults.attitude_jumps": [], "faults.false_star_storms": [],
-             "faults.gyro_bias_steps": [], "faults.dropped_frames_s": []}
+             "faults.gyro_bias_steps": [], "faults.dropped_frames_s": [], "faults.tracking_failure_probes": None}
 
 BAD = [
     ("star_sensor.rate_hz=40", "star_sensor.rate_hz", "faster than the IMU"),

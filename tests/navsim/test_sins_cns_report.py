@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from navsim import cli
-from navsim.ins import simulation as ins_simulation
-from navsim.scenario import resolve_scenario
+from navsim.kinds import resolve_scenario
+from navsim.navigation import run as ins_simulation
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
 from startrack import units
@@ -103,7 +103,7 @@ def test_truth_off_switches_the_truth_not_the_filter(level):
     assert a["mounting_true"].any() and not b["mounting_true"].any()
     assert np.linalg.norm(a["position_error_m"][0]) > 0.1 > 100.0 * np.linalg.norm(b["position_error_m"][0])  # x0, baro
     sky = SkyTruth.of(whole.truth, whole.orientation, whole.grid.frame_k)
-    noisy, exact = (ins_simulation._star_run(p, sky, np.random.SeedSequence(5))[0].record()
+    noisy, exact = (ins_simulation._star_run(p, sky, np.random.SeedSequence(5), None)[0].record()
                     for p in (whole, dataclasses.replace(whole, truth_off=frozenset({"star_noise"}))))
     assert np.array_equal(noisy.R_S, exact.R_S)  # the filter's R
     noise = units.rad_to_arcsec(rot.to_rotation_vector(rot.multiply(rot.conjugate(exact.fixes), noisy.fixes)))

@@ -12,8 +12,9 @@ import pypdf
 import pytest
 
 import navsim
+from navsim import studies
+from navsim.kinds import load_scenario, scenario_from_dict
 from navsim.report import write_report
-from navsim.scenario import load_scenario, scenario_from_dict
 from startrack.errors import InputError
 from tests.support import HANG_S
 
@@ -48,15 +49,15 @@ def contest():
 
 def test_study_files_load_with_the_papers_settings():
     p = load_scenario(PRECISION)
-    assert p.is_study and p["study"]["kind"] == "attitude_precision"
-    assert p.study_parameters["trials"] == 300 and p.study_parameters["stars"] == list(range(3, 22))
+    assert p.kind == "study" and p["study"]["kind"] == "attitude_precision"
+    assert studies.parameters(p)["trials"] == 300 and studies.parameters(p)["stars"] == list(range(3, 22))
     c = load_scenario(CONTEST)
-    assert c.study_parameters["maps"] == 1000 and c.study_parameters["gate_sigmas"] == [3.0, 1.0]
+    assert studies.parameters(c)["maps"] == 1000 and studies.parameters(c)["gate_sigmas"] == [3.0, 1.0]
 
 
 def test_a_study_table_may_be_left_out_and_takes_the_defaults():
     s = scenario_from_dict({"name": "x", "study": {"kind": "attitude_precision"}})
-    assert s.study_parameters["fov_deg"] == 16.0 and s.study_parameters["distribution"] == "radec_window"
+    assert studies.parameters(s)["fov_deg"] == 16.0 and studies.parameters(s)["distribution"] == "radec_window"
 
 
 @pytest.mark.parametrize("overrides, message", [

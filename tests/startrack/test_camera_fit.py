@@ -8,8 +8,8 @@ from scipy.optimize import least_squares
 
 from startrack.camera import Camera
 from startrack.camera_fit import CameraCalibration, fit
-from startrack.identify.simulate import random_attitude
 from startrack.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
+from startrack.synthetic import random_attitude
 
 TRUE = Camera(1024, 768, 2100.0, cx=520.0, cy=380.0, k1=-0.12, k2=0.03)
 FREE_ALL = np.array([True, True, True, True, True])

@@ -16,8 +16,8 @@ import pytest
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
 from startrack.cli import main
-from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.star_catalog import load_star_catalog
+from startrack.synthetic import centroid_frame, random_attitude
 
 SIZE = ["--width", "1024", "--height", "1024"]
 GEOMETRY = ["--fov-deg", "16", *SIZE]

@@ -19,8 +19,8 @@ import pytest
 
 from startrack.camera import Camera
 from startrack.identify import StarIdentifier
-from startrack.identify.simulate import random_attitude
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+from startrack.synthetic import random_attitude
 
 FOV = np.radians(12.0)
 SIGMA_PX = 0.05

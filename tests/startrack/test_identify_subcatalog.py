@@ -7,10 +7,10 @@ from scipy.spatial.transform import Rotation
 from startrack.camera import Camera
 from startrack.identify import Prior, StarIdentifier
 from startrack.identify.pairs import SubCatalogPairs
-from startrack.identify.simulate import centroid_frame, random_attitude
 from startrack.navigation_catalog import load_navigation_catalog
 from startrack.sphere import vector_to_radec
 from startrack.star_catalog import load_star_catalog
+from startrack.synthetic import centroid_frame, random_attitude
 
 DEG = np.pi / 180.0
 

@@ -6,9 +6,9 @@ from scipy.spatial.transform import Rotation
 
 from startrack.camera import Camera
 from startrack.identify import Prior, StarIdentifier
-from startrack.identify.simulate import centroid_frame
 from startrack.navigation_catalog import load_navigation_catalog
 from startrack.star_catalog import load_star_catalog
+from startrack.synthetic import centroid_frame
 
 DEG = np.pi / 180.0
 

@@ -24,8 +24,8 @@ from startrack.camera import Camera
 from startrack.detection import detect
 from startrack.identify import plate_solver
 from startrack.identify.plate_solver import PlateSolver
-from startrack.identify.simulate import as_jpeg, noise_crowd, random_attitude, rendered_sky
 from startrack.star_catalog import load_star_catalog
+from startrack.synthetic import as_jpeg, noise_crowd, random_attitude, rendered_sky
 from startrack.units import ARCSEC, DEG
 from tests.support import SteppedClock
 

@@ -1,15 +1,16 @@
 """From a validated navigation scenario (units in key names) to model objects in SI units: the
 trajectory, the IMU, the baro, the position-fix sensor, the star sensor, the gravity disturbance and
-the navigation filter with its initial covariance and its models of the star sensor and of the
-gravity disturbance (datasheet in, filter model out)."""
+the navigation filter's configuration with its initial covariance and its models of the star sensor
+and of the gravity disturbance (datasheet in, filter model out)."""
 
 import numpy as np
 
+from navsim.build import star_sensor as star_sensors
+from navsim.build.inertial import accelerometer_model, gyro_model
+from navsim.earth.frames import julian_year
 from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.wgs84 import OMEGA_IE, radii
-from navsim.estimation.nav_filter import GravityUncertainty, ImuNoise, NavFilter, StarSensorModel
-from navsim.scenario import build
-from navsim.scenario.build import accelerometer_model, gyro_model
+from navsim.estimation.nav_filter import GravityUncertainty, ImuNoise, NavFilterConfig, StarSensorModel
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel
@@ -68,12 +69,19 @@ def gravity_disturbance(scenario):
     return GravityDisturbance.random(xi, eta, anomaly, table["correlation_length_m"])
 
 
-def star_sensor(scenario, star_catalog):
+def catalog_epoch(scenario):
+    """The star catalog's epoch [Julian year]: the scenario's ``epoch_utc``."""
+    return julian_year(scenario["epoch_utc"])
+
+
+def star_sensor(scenario, star_catalog, lanes=()):
     """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with its faults, seeing
-    the stars of ``star_catalog`` (:func:`navsim.scenario.build.star_sensor`), or None."""
+    the stars of ``star_catalog`` (:func:`navsim.build.star_sensor.star_sensor`; ``lanes`` compiled
+    ahead at image fidelity), or None."""
     if "star_sensor" not in scenario.data:
         return None
-    return build.star_sensor(scenario, star_catalog, 1.0 / scenario["star_sensor"]["rate_hz"])
+    return star_sensors.star_sensor(scenario, star_catalog, 1.0 / scenario["star_sensor"]["rate_hz"],
+                                    catalog_epoch(scenario), lanes)
 
 
 def star_sensor_model(scenario, orientation):
@@ -152,16 +160,16 @@ def initial_covariance(scenario, gyro, accel, lat, h):
     return np.diag(np.square(np.array(sigma, dtype=float)))
 
 
-def nav_filter(scenario, gyro, accel, start, P0, dt, orientation=None, gravity=None):
-    """The :class:`~navsim.estimation.nav_filter.NavFilter` of ``scenario['filter']`` from ``start``
-    = (L, λ, h, v_n, q_nb), with zero IMU error estimates, P0, the noise of the datasheets, its star
-    sensor (with the Earth's ``orientation`` at the frames) and ``gravity`` model
-    (:func:`gravity_uncertainty`, the one P0 was built with)."""
+def filter_config(scenario, gyro, accel, lat, h, dt, orientation=None):
+    """The :class:`~navsim.estimation.nav_filter.NavFilterConfig` of ``scenario['filter']`` at the start (L, h)
+    [rad, m] on IMU intervals of ``dt`` [s]: its initial covariance (:func:`initial_covariance`), the noise of
+    the datasheets, its star sensor (with the Earth's ``orientation`` at the frames), its gravity model
+    (:func:`gravity_uncertainty`), tuning and gates."""
     f = scenario["filter"]
     noise = ImuNoise(arw=gyro.arw, vrw=accel.vrw, gyro_bias_rw=gyro.filter_rrw, accel_bias_rw=accel.filter_bias_rw)
-    return NavFilter(*start, P0, noise, dt, estimate_scale_factors=estimates_scale_factors(scenario, gyro, accel),
-                     star_sensor=star_sensor_model(scenario, orientation),
-                     gravity=gravity,
-                     covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"],
-                     process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"],
-                     baro_states=f["baro_states"])
+    return NavFilterConfig(initial_covariance(scenario, gyro, accel, lat, h), noise, dt,
+                           estimate_scale_factors=estimates_scale_factors(scenario, gyro, accel),
+                           star_sensor=star_sensor_model(scenario, orientation), gravity=gravity_uncertainty(scenario, lat, h),
+                           covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"],
+                           process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"],
+                           baro_states=f["baro_states"])

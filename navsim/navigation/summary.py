@@ -13,7 +13,7 @@ import numpy as np
 from navsim.earth.wgs84 import radii
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.estimation.nav_filter import error_state, mounting_error, state_names
-from navsim.records import RunSummary
+from navsim.navigation.records import RunSummary
 from startrack import units
 
 #: Slices of the error state: tilt (φ_N, φ_E), heading (φ_D), velocity, position, biases; the optional

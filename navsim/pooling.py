@@ -16,14 +16,18 @@ def diverged(summary, errors, sigmas):
     return bool(np.any(np.abs(errors) > DIVERGENCE_SIGMAS * sigmas)) or summary["nees"]["mean"] > DIVERGENCE_SIGMAS * summary["nees"]["dof"]
 
 
+def run_averaged_nees(series):
+    """(t, mean): the NEES averaged over the runs (their ``series``, each with ``t`` and ``nees``) at every
+    frame they share (the shortest run's), and those frames' times [s] (the first run's)."""
+    frames = min(len(s["nees"]) for s in series)
+    return series[0]["t"][:frames], np.mean(np.array([s["nees"][:frames] for s in series]), axis=0)
+
+
 def averaged_nees(finished, settle):
-    """The NEES averaged over the runs at every steady frame against the band of that many runs, with
-    the dof the runs' summaries record ({} when the runs differ in length)."""
-    nees_runs = [series["nees"] for _, _, series in finished]
-    if len({len(n) for n in nees_runs}) != 1:
-        return {}
-    mean_nees = np.mean(np.array(nees_runs), axis=0)
-    return nees_statistics(mean_nees[finished[0][2]["t"] >= settle], finished[0][1]["nees"]["dof"], len(finished))
+    """The run-averaged NEES at the steady frames (after ``settle`` [s]) against the band of that many runs,
+    with the dof the runs' summaries record (:func:`navsim.estimation.consistency.nees_statistics`)."""
+    t, mean_nees = run_averaged_nees([series for _, _, series in finished])
+    return nees_statistics(mean_nees[t >= settle], finished[0][1]["nees"]["dof"], len(finished))
 
 
 def spread(values):

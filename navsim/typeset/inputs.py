@@ -1,11 +1,11 @@
-"""Read what a report is made from: a run directory, a static-study directory or a Monte Carlo
-campaign directory.
+"""Read what a report is made from: a run directory or a Monte Carlo campaign directory.
 
-A run directory holds ``summary.json`` (a :class:`~navsim.records.RunSummary`), ``timeseries.npz``
+A run directory holds ``summary.json`` (its kind's :class:`~navsim.records.RunSummary`), ``timeseries.npz``
 and ``scenario.json`` (optionally ``frame.npy`` with ``frame_detections.json``). A campaign directory
 holds ``campaign.json`` (with the validated scenario) and ``runs/run_NNNNN/`` run directories (a run
-that raised leaves ``error.json`` instead), with the aggregate in ``summary.json`` (a
-:class:`~navsim.records.CampaignSummary`). Only the arrays a report
+that raised leaves ``error.json`` instead), with the aggregate in ``summary.json`` (its kind's
+:class:`~navsim.records.CampaignSummary`). Which kind's records they are the caller says (the scenario's
+kind, :mod:`navsim.kinds`). Only the arrays a report
 draws are checked; everything optional may be absent. Bad input raises
 :class:`~startrack.errors.InputError` with one sentence naming the file and the problem.
 """
@@ -18,15 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from navsim.records import CampaignSummary, RunSummary
-from navsim.studies import STUDIES
 from startrack.errors import InputError
 
 #: A finished or failed run's directory (a leftover ``run_NNNNN.partial`` is neither).
 RUN_NAME = re.compile(r"run_\d{5,}")
-#: Arrays every run of a kind must have; the report cannot say anything without them.
-REQUIRED_SERIES = {"attitude": ("t", "attitude_error"),
-                   "navigation": ("t", "lat", "lon", "lat_true", "lon_true", "error_state", "error_sigma", "position_error_m")}
 #: Per-frame arrays with columns of their own count: the least number of columns (the filter's states).
 MIN_COLUMNS = {"P_diag": 6, "error_state": 15, "error_sigma": 15}
 #: Per-frame arrays and the trailing shape each must have when present (() for one number per frame,
@@ -67,11 +62,6 @@ SERIES_SHAPES = {
     "subcatalog_index": (),
     "subcatalog_address": (2,),
 }
-#: The arrays a campaign report reads from each run of a kind (the rest are not loaded).
-CAMPAIGN_SERIES = {"attitude": ("t", "attitude_error", "P_diag", "nees", "mode", "n_identified", "n_stacked", "n_accepted"),
-                   "navigation": ("t", "error_state", "error_sigma", "position_error_m", "lat_true", "h_true", "nees")}
-
-
 @dataclass
 class RunData:
     """One run: its summary, per-frame series (SI units), scenario and optional rendered frame."""
@@ -86,16 +76,6 @@ class RunData:
     @property
     def frames(self) -> int:
         return int(self.series["t"].size)
-
-
-@dataclass
-class StudyData:
-    """A static study: its summary, scenario (with the kind's parameters) and per-sample arrays."""
-
-    directory: Path
-    summary: dict
-    scenario: dict
-    arrays: dict
 
 
 @dataclass
@@ -126,8 +106,9 @@ def read_json(path: Path) -> dict:
     return payload
 
 
-def read_series(path: Path, kind, names=None) -> dict:
-    """The arrays of ``timeseries.npz`` of a run of ``kind`` (all, or those of ``names`` present), shape-checked."""
+def read_series(path: Path, required, names=None) -> dict:
+    """The arrays of ``timeseries.npz`` of a run (all, or those of ``names`` present), shape-checked; each of
+    ``required`` must be there."""
     if not zipfile.is_zipfile(path):
         raise InputError(f"{path}: not an .npz array file (not a zip archive).")
     try:
@@ -136,7 +117,7 @@ def read_series(path: Path, kind, names=None) -> dict:
             series = {name: data[name] for name in present}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
         raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
-    for name in REQUIRED_SERIES[kind]:
+    for name in required:
         if name not in series and (names is None or name in names):
             raise InputError(f"{path}: the array '{name}' is missing.")
     n = series["t"].shape[0] if series["t"].ndim == 1 else -1
@@ -157,24 +138,28 @@ def read_series(path: Path, kind, names=None) -> dict:
 
 
 def directory_kind(directory: Path) -> str:
-    """'run', 'study' or 'campaign'; anything else is an InputError."""
+    """'run', 'study', 'campaign' or 'budget'; anything else is an InputError."""
     if not directory.exists():
         raise InputError(f"{directory}: no such directory.")
     if not directory.is_dir():
         raise InputError(f"{directory}: is not a directory (expected a run or campaign output directory).")
     if (directory / "campaign.json").is_file():
         return "campaign"
+    if (directory / "budget.json").is_file():
+        return "budget"
     if (directory / "timeseries.npz").is_file() and (directory / "summary.json").is_file():
         return "run"
     if (directory / "study.npz").is_file() and (directory / "summary.json").is_file():
         return "study"
     raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz), a static-study "
-                     "directory (summary.json and study.npz) nor a campaign directory (campaign.json).")
+                     "directory (summary.json and study.npz), a campaign directory (campaign.json) nor an error "
+                     "budget's (budget.json).")
 
 
-def load_run(directory: Path) -> RunData:
-    summary = RunSummary.read(directory / "summary.json")
-    series = read_series(directory / "timeseries.npz", summary.kind)
+def load_run(directory: Path, kind) -> RunData:
+    """A run directory of the run ``kind`` (:mod:`navsim.kinds`; its scenario.json says which)."""
+    summary = kind.RunSummary.read(directory / "summary.json")
+    series = read_series(directory / "timeseries.npz", kind.REQUIRED_SERIES)
     if (directory / "timing.npz").is_file():  # wall-clock times per frame, kept apart from the reproducible series
         series |= _read_timing(directory / "timing.npz", series["t"].size)
     scenario = read_json(directory / "scenario.json")
@@ -185,27 +170,6 @@ def load_run(directory: Path) -> RunData:
         if detections_path.is_file():
             detections = _read_detections(detections_path)
     return RunData(directory, summary, series, scenario, frame, detections)
-
-
-def load_study(directory: Path) -> StudyData:
-    summary = read_json(directory / "summary.json")
-    scenario = read_json(directory / "scenario.json") if (directory / "scenario.json").is_file() else {}
-    kind = summary.get("study")
-    if kind not in STUDIES:
-        raise InputError(f"{directory / 'summary.json'}: 'study' must name a static study "
-                         f"({', '.join(STUDIES)}), got {kind!r}.")
-    parameters = scenario.get("study", {}).get(kind)
-    if not isinstance(parameters, dict):
-        raise InputError(f"{directory / 'scenario.json'}: missing, or without the study.{kind} parameters.")
-    path = directory / "study.npz"
-    if not zipfile.is_zipfile(path):
-        raise InputError(f"{path}: not an .npz array file (not a zip archive).")
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {name: data[name] for name in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
-        raise InputError(f"{path}: cannot read it as an .npz array file ({error}).") from None
-    return StudyData(directory, summary, scenario, arrays)
 
 
 def _read_timing(path: Path, frames: int) -> dict:
@@ -252,23 +216,34 @@ def _read_detections(path: Path) -> list:
     return detections
 
 
-def load_campaign(directory: Path) -> CampaignData:
-    campaign = read_json(directory / "campaign.json")
-    summary_path = directory / "summary.json"
-    summary = CampaignSummary.read(summary_path) if summary_path.is_file() else None
-    data = CampaignData(directory, campaign, summary, scenario=campaign.get("scenario_data"))
+def campaign_runs(directory: Path):
+    """(the finished runs' directories, the failed runs) of a campaign directory, in name order; an InputError
+    when no run finished."""
     runs_dir = directory / "runs"
     run_dirs = sorted(p for p in runs_dir.iterdir() if p.is_dir() and RUN_NAME.fullmatch(p.name)) if runs_dir.is_dir() else []
+    finished, failed = [], []
     for run_dir in run_dirs:
         if (run_dir / "error.json").is_file():
             error = read_json(run_dir / "error.json")
             message = error.get("error") or error.get("message") or json.dumps(error, sort_keys=True)
-            data.failed.append(FailedRun(run_dir.name, str(message)))
+            failed.append(FailedRun(run_dir.name, str(message)))
         elif (run_dir / "summary.json").is_file() and (run_dir / "timeseries.npz").is_file():
-            summary = RunSummary.read(run_dir / "summary.json")
-            series = read_series(run_dir / "timeseries.npz", summary.kind, CAMPAIGN_SERIES[summary.kind])
-            data.runs.append(RunData(run_dir, summary, series))
-    if not data.runs:
+            finished.append(run_dir)
+    if not finished:
         raise InputError(f"{directory}: the campaign has no finished runs under runs/ "
-                         f"({len(data.failed)} failed); nothing to report.")
-    return data
+                         f"({len(failed)} failed); nothing to report.")
+    return finished, failed
+
+
+def load_campaign(directory: Path, campaign, kind, finished, failed) -> CampaignData:
+    """A campaign directory of the run ``kind`` (its ``campaign`` request read already, its
+    :func:`campaign_runs`); its aggregate summary.json, which the report quotes, must be there."""
+    summary_path = directory / "summary.json"
+    if not summary_path.is_file():
+        raise InputError(f"{summary_path}: missing: the campaign stopped before its aggregate; run the same "
+                         "`navsim montecarlo` command again (it keeps the finished runs) to write it.")
+    runs = [RunData(run_dir, kind.RunSummary.read(run_dir / "summary.json"),
+                    read_series(run_dir / "timeseries.npz", kind.REQUIRED_SERIES, kind.CAMPAIGN_SERIES))
+            for run_dir in finished]
+    return CampaignData(directory, campaign, kind.CampaignSummary.read(summary_path), runs, failed,
+                        scenario=campaign.get("scenario_data"))

@@ -15,6 +15,8 @@ import dataclasses
 import numpy as np
 
 from navsim.earth.frames import utc_epoch
+from navsim.estimation.treatments import TREATMENTS
+from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
 from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor, mounting
@@ -166,7 +168,7 @@ SCHEMA = Table(
                                  doc="the states a baro height updates: the vertical channel (δv_D, δh, the body-z "
                                      "accelerometer bias), or all (a white-noise height reference: its Coriolis and "
                                      "manoeuvre couplings then inform the horizontal channels, as in PSINS)"),
-            "mounting": Value("str", default="estimate", choices=("estimate", "consider", "ignore"),
+            "mounting": Value("str", default="estimate", choices=TREATMENTS,
                               doc="the star-sensor mounting error μ (star_sensor.misalignment_arcsec is its truth): "
                                   "three states estimated, consider states (Schmidt) or ignored"),
             "initial_mounting_sigma_arcsec": Value("float", default=60.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC),
@@ -186,9 +188,10 @@ SCHEMA = Table(
 )
 
 
-def validate(checked, source):
-    """The cross-key rules of a navigation scenario already checked against :data:`SCHEMA`; fills
-    the derived defaults (``duration_s``, ``settle_s``) and returns the checked dictionary."""
+def validate(data, source):
+    """The checked dictionary of a navigation scenario: :data:`SCHEMA` and the cross-key rules (derived
+    defaults filled: ``duration_s``, ``settle_s``); one InputError naming the key otherwise."""
+    checked = checked_table(SCHEMA, data, source)
     try:
         utc_epoch(checked["epoch_utc"])
         flown = segments.Profile.from_table(checked["trajectory"]).duration
@@ -215,6 +218,13 @@ def validate(checked, source):
     if checked["settle_s"] >= checked["duration_s"]:
         raise InputError(f"{source}: settle_s: must be shorter than duration_s")
     return checked
+
+
+def check_tuning(scenario):
+    """Filter tuning judges the NIS: an InputError for a free INS without [baro] (no measurement at all)."""
+    if not aiding_rates(scenario.data):
+        raise InputError(f"{scenario.source}: filter tuning needs measurements to judge the NIS by; a free INS without "
+                         "[baro] has none (add [aiding.position] or [baro])")
 
 
 def aiding_rates(checked):

@@ -3,14 +3,14 @@ velocity and attitude errors with the filter's ±3σ, the IMU error estimates, a
 horizontal error percentiles (CEP) over time and the final errors with their CEP circles.
 
 Units at this edge: degrees of latitude and longitude, metres, m/s, arcsec, deg/h and µg; time in
-minutes. The error state and its σ are the filter's (:mod:`navsim.ins.summary`).
+minutes. The error state and its σ are the filter's (:mod:`navsim.navigation.summary`).
 """
 
 import numpy as np
 
-from navsim.ins.celestial import floor_ned
-from navsim.ins.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
-from navsim.report.figures import COLORS, new_figure
+from navsim.navigation.celestial import floor_ned
+from navsim.navigation.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
+from navsim.typeset.figures import COLORS, new_figure
 from startrack import units
 
 NED = ("north", "east", "down")
@@ -69,7 +69,7 @@ def position_errors(run):
 
 def horizon_floor(run):
     """Horizontal position error north and east [m] with ±3σ and the analytic-horizon floor of eq. (1)
-    (:func:`navsim.ins.celestial.floor_ned`) of the true accelerometer bias and of the bias the
+    (:func:`navsim.navigation.celestial.floor_ned`) of the true accelerometer bias and of the bias the
     filter's estimate leaves (its ∇ state), each with the gravity disturbance."""
     s = run.series
     floors = ((sum(floor_ned(s)), "floor of eq. (1), true ∇", "tab:red"),

@@ -4,12 +4,12 @@ run-averaged NEES over the filter's own error state, divergent runs and the IMU 
 
 import numpy as np
 
-from navsim.campaign.pooling import averaged_nees, calibration, diverged, spread
+from navsim.pooling import averaged_nees, calibration, diverged, spread
 from startrack import units
 
 
-def statistics(finished, settle):
-    """The navigation fields of a :class:`~navsim.records.CampaignSummary` from the finished runs
+def pool(finished, settle):
+    """The navigation fields of a :class:`~navsim.navigation.records.CampaignSummary` from the finished runs
     [(index, summary, series), ...]: CEP50/CEP95 are the median and 95th percentile over the runs
     of the final horizontal position error (its radial distance from the truth)."""
     summaries = [summary for _, summary, _ in finished]

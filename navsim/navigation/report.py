@@ -2,8 +2,9 @@
 position, velocity and attitude errors with the filter's ±3σ, the IMU error estimates, NEES; across
 a campaign CEP50/95 over time and at the end, error envelopes and the pooled IMU error states.
 
-Built with the run report's typesetting (:mod:`navsim.report.document`); key numbers are written as
-plain text ("horizontal error at the end 12.34 m") so they can be extracted from the PDF.
+Built with :mod:`navsim.typeset`; key numbers are written as plain text ("horizontal error at the end
+12.34 m") so they can be extracted from the PDF; the campaign's pooled statistics (CEP, run-averaged
+NEES) are its summary's.
 """
 
 import tempfile
@@ -12,25 +13,17 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-from navsim.campaign.navigation import cep
-from navsim.report import figures
-from navsim.report import navigation_figures as nav_figures
-from navsim.report import statistics as stats
-from navsim.report.document import (
-    Document,
-    campaign_headline,
-    campaign_summary_section,
-    campaign_tables,
-    general,
-    markup,
-    number,
-    scenario_name,
-    scenario_section,
-    table,
-)
-from navsim.report.navigation_statistics import RUN_METRICS, horizontal_percentiles, position_envelopes
+from navsim.navigation import figures as nav_figures
+from navsim.navigation.report_statistics import RUN_METRICS, horizontal_percentiles, position_envelopes
+from navsim.typeset import figures
+from navsim.typeset import statistics as stats
+from navsim.typeset.document import Document, general, markup, number, scenario_name, table
+from navsim.typeset.sections import campaign_headline, campaign_summary_section, campaign_tables, scenario_section
 from startrack import units
 
+#: Arrays every navigation run must have, and those a campaign report reads from each run.
+REQUIRED_SERIES = ("t", "lat", "lon", "lat_true", "lon_true", "error_state", "error_sigma", "position_error_m")
+CAMPAIGN_SERIES = ("t", "error_state", "error_sigma", "position_error_m", "lat_true", "h_true", "nees")
 CALIBRATION_LABELS = {"gyro_bias_deg_per_h": ("gyro bias", "deg/h", 4), "accel_bias_micro_g": ("accelerometer bias", "µg", 1),
                       "gyro_scale_factor_ppm": ("gyro scale factor", "ppm", 1),
                       "accel_scale_factor_ppm": ("accelerometer scale factor", "ppm", 1)}
@@ -228,14 +221,14 @@ def campaign_report(campaign) -> bytes:
     percentiles, env = horizontal_percentiles(campaign), position_envelopes(campaign)
     avg, metrics = stats.averaged_nees(campaign), stats.metric_table(campaign, RUN_METRICS)
     final_ne = env.final[:, :2]
-    final = cep(np.hypot(final_ne[:, 0], final_ne[:, 1]))
+    final = campaign.summary["position_error_m"]["horizontal"]
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
         doc = Document(Path(tmp), f"navsim Monte Carlo report: {name}", f"navsim Monte Carlo · {name}")
         doc.title(f"Monte Carlo campaign report: {name}", str(campaign.directory))
         doc.paragraph(markup(campaign_headline(campaign, f"{env.t.size} frames per run over "
                                                        f"{number(float(env.t[-1]) / 60.0, 1)} min")))
         doc.heading("Key results")
-        sentences = [f"At the last logged frame the horizontal position error has CEP50 {number(final['cep50'])} m "
+        sentences = [f"At the end of the runs the horizontal position error has CEP50 {number(final['cep50'])} m "
                      f"({number(final['cep50'] / units.NAUTICAL_MILE, 3)} nmi) and CEP95 {number(final['cep95'])} m "
                      f"({number(final['cep95'] / units.NAUTICAL_MILE, 3)} nmi) over the {len(campaign.runs)} runs."]
         if avg is not None:

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.ins.summary import ned_metres
-from navsim.report.statistics import common_frames, envelopes_of
+from navsim.navigation.summary import ned_metres
+from navsim.typeset.statistics import common_frames, envelopes_of
 
 #: Per-run metrics of navigation runs tabulated across a campaign: (label, unit, path in summary.json).
 RUN_METRICS = (
@@ -54,7 +54,7 @@ def horizontal_percentiles(campaign):
 
 
 def position_envelopes(campaign):
-    """:class:`~navsim.report.statistics.Envelopes` of the NED position error [m] with the filter's ±3σ."""
+    """:class:`~navsim.typeset.statistics.Envelopes` of the NED position error [m] with the filter's ±3σ."""
     t = common_frames(campaign)
     n = t.size
     err = np.stack([r.series["position_error_m"][:n] for r in campaign.runs])

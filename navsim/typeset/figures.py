@@ -1,5 +1,7 @@
-"""Report figures (matplotlib, no pyplot: each function returns a Figure, or None when the run
-did not log the quantity it draws). Units at this edge: arcsec, deg/h, degrees, milliseconds.
+"""Report figures every kind of run shares (matplotlib, no pyplot: each function returns a Figure, or
+None when the run did not log the quantity it draws): the style, NEES and NIS with their bands, error
+envelopes across a campaign, and the image-fidelity star sensor's modes, stars, identification times,
+boresight track and a rendered frame. Units at this edge: arcsec, degrees, milliseconds.
 """
 
 import numpy as np
@@ -7,8 +9,9 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from navsim.report import statistics as stats
-from startrack import address, units
+from navsim.estimation.consistency import chi2_band
+from navsim.typeset import statistics as stats
+from startrack import address
 
 WIDTH_IN = 6.5
 AXES = "xyz"
@@ -32,7 +35,7 @@ def new_figure(height_in, rows=1, cols=1, sharex=True):
     return fig, axes
 
 
-def _log_y(ax):
+def log_y(ax):
     """Log y axis labelled at 1, 2 and 5 times the powers of ten only."""
     ax.set_yscale("log")
     ax.yaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
@@ -48,25 +51,7 @@ def save(fig, path):
 # ------------------------------------------------------------------------------- one run
 
 
-def attitude_error(run):
-    """Estimation error per body axis [arcsec] with the filter's ±3σ bounds."""
-    s = run.series
-    t, err = s["t"], units.rad_to_arcsec(s["attitude_error"])
-    fig, axes = new_figure(4.2, 3, 1)
-    for i, ax in enumerate(axes[:, 0]):
-        ax.plot(t, err[:, i], color=COLORS[i], lw=0.8, label=f"error {AXES[i]}")
-        if "P_diag" in s:
-            bound = 3.0 * units.rad_to_arcsec(np.sqrt(s["P_diag"][:, i]))
-            ax.plot(t, bound, "k--", lw=0.7, label="±3σ (filter)")
-            ax.plot(t, -bound, "k--", lw=0.7)
-            _clip_to(ax, err[:, i], bound)
-        ax.set_ylabel(f"δθ{AXES[i]} [arcsec]")
-        ax.legend(loc="upper right", ncols=2)
-    axes[-1, 0].set_xlabel("time [s]")
-    return fig
-
-
-def _clip_to(ax, *curves):
+def clip_to(ax, *curves):
     """Symmetric y axis scaled to the steady part: the largest |value| of the curves after 10 % of the run."""
     finite = np.concatenate([np.abs(c[c.size // 10:]) for c in curves])
     finite = finite[np.isfinite(finite)]
@@ -74,33 +59,6 @@ def _clip_to(ax, *curves):
         lim = 1.15 * float(finite.max())
         if lim > 0:
             ax.set_ylim(-lim, lim)
-
-
-def gyro_bias(run):
-    """Gyro bias truth and estimate per axis [deg/h], with the estimate's ±3σ."""
-    s = run.series
-    if "bias_true" not in s or "bias_est" not in s:
-        return None
-    t = s["t"]
-    true = units.rad_per_s_to_deg_per_h(s["bias_true"])
-    est = units.rad_per_s_to_deg_per_h(s["bias_est"])
-    fig, axes = new_figure(4.2, 3, 1)
-    for i, ax in enumerate(axes[:, 0]):
-        ax.plot(t, true[:, i], color="k", lw=1.0, label="truth")
-        ax.plot(t, est[:, i], color=COLORS[i], lw=0.8, label="estimate")
-        if "P_diag" in s:
-            sig3 = 3.0 * units.rad_per_s_to_deg_per_h(np.sqrt(s["P_diag"][:, 3 + i]))
-            ax.fill_between(t, est[:, i] - sig3, est[:, i] + sig3, color=COLORS[i], alpha=0.15, lw=0,
-                            label="estimate ±3σ")
-            span = np.concatenate([true[t.size // 10:, i], (est[:, i] - sig3)[t.size // 10:],
-                                   (est[:, i] + sig3)[t.size // 10:]])
-            lo, hi = float(span.min()), float(span.max())
-            pad = 0.1 * max(hi - lo, 1e-6)
-            ax.set_ylim(lo - pad, hi + pad)
-        ax.set_ylabel(f"b{AXES[i]} [deg/h]")
-        ax.legend(loc="upper right", ncols=3)
-    axes[-1, 0].set_xlabel("time [s]")
-    return fig
 
 
 def consistency(run):
@@ -115,9 +73,9 @@ def consistency(run):
     if has_nees:
         ax = axes[row, 0]
         dof = int(run.summary["nees"]["dof"])
-        lo, hi = stats.chi2_band(dof)
+        lo, hi = chi2_band(dof)
         ax.plot(t, s["nees"], lw=0.7, color="tab:blue", label=f"NEES ({dof} dof)")
-        _log_y(ax)
+        log_y(ax)
         ax.axhline(dof, color="k", lw=0.8, label="expected")
         ax.axhspan(lo, hi, color="tab:green", alpha=0.15, label="95 % χ² band")
         ax.set_ylabel("NEES")
@@ -132,10 +90,10 @@ def consistency(run):
         lo = np.full(t.size, np.nan)
         hi = np.full(t.size, np.nan)
         if ok.any():
-            lo[ok], hi[ok] = stats.chi2_band(dof[ok])
+            lo[ok], hi[ok] = chi2_band(dof[ok])
             lo[ok], hi[ok] = lo[ok] / dof[ok], hi[ok] / dof[ok]
         ax.plot(t, ratio, ".", ms=1.5, color="tab:purple", label="NIS / dof")
-        _log_y(ax)
+        log_y(ax)
         ax.fill_between(t, lo, hi, step="mid", color="tab:green", alpha=0.15, lw=0, label="95 % χ² band")
         ax.axhline(1.0, color="k", lw=0.8)
         ax.set_ylabel("NIS / dof")
@@ -210,7 +168,7 @@ def identification_time(run):
                whis=(5, 95), showfliers=True, flierprops={"markersize": 2})
     ax.set_ylabel("identification time [ms]")
     if max(float(v.max()) for _, v in groups) > 20 * min(float(np.median(v)) for _, v in groups):
-        _log_y(ax)
+        log_y(ax)
     return fig
 
 
@@ -303,7 +261,7 @@ def error_envelopes(env, labels=tuple(f"δθ{axis} [arcsec]" for axis in AXES), 
         if env.sigma3_filter is not None:
             ax.plot(t, env.sigma3_filter[:, i], "k--", lw=0.7, label="filter ±3σ (mean P)")
             ax.plot(t, -env.sigma3_filter[:, i], "k--", lw=0.7)
-        _clip_to(ax, env.p05[:, i], env.p95[:, i], bound)
+        clip_to(ax, env.p05[:, i], env.p95[:, i], bound)
         ax.set_ylabel(labels[i])
         ax.legend(loc="upper right", ncols=5)
     axes[0, 0].set_title(f"{env.runs} runs")
@@ -316,32 +274,13 @@ def nees_band(avg):
     fig, axes = new_figure(2.4)
     ax = axes[0, 0]
     ax.plot(avg.t, avg.mean, lw=0.8, color="tab:blue", label=f"NEES averaged over {avg.runs} runs")
-    _log_y(ax)
+    log_y(ax)
     ax.axhline(avg.dof, color="k", lw=0.8, label=f"expected ({avg.dof})")
     ax.axhspan(*avg.band, color="tab:green", alpha=0.2, label=f"95 % band for {avg.runs} runs")
     if avg.settle_s > avg.t[0]:
         ax.axvline(avg.settle_s, color="0.4", lw=0.7, ls=":", label="settle time")
     ax.set(xlabel="time [s]", ylabel="average NEES")
     ax.legend(loc="upper right", ncols=2)
-    return fig
-
-
-def final_error_histogram(env):
-    """Final attitude error across runs per axis [arcsec], with the normal law of the filter's final σ."""
-    fig, axes = new_figure(2.3, 1, 3, sharex=False)
-    bins = int(np.clip(np.sqrt(env.runs) * 2, 5, 40))
-    for i, ax in enumerate(axes[0]):
-        x = env.final[:, i]
-        ax.hist(x, bins=bins, density=True, color=COLORS[i], alpha=0.6, label="runs")
-        if env.final_sigma_filter is not None:
-            sig = env.final_sigma_filter[i]
-            lim = max(4.0 * sig, float(np.abs(x).max()) * 1.05)
-            grid = np.linspace(-lim, lim, 200)
-            ax.plot(grid, np.exp(-0.5 * (grid / sig) ** 2) / (sig * np.sqrt(2 * np.pi)), "k", lw=0.8,
-                    label="N(0, σ_filter²)")
-        ax.set_xlabel(f"final δθ{AXES[i]} [arcsec]")
-        ax.legend(loc="upper right", fontsize=6)
-    axes[0, 0].set_ylabel("density")
     return fig
 
 

@@ -1,8 +1,9 @@
-"""The numbers a report quotes and draws, computed once from a run or a campaign.
+"""The numbers a report of any kind quotes and draws, computed once from a run or a campaign: the image-
+fidelity star sensor's modes, identifications and sub-catalog addresses, error envelopes across runs,
+the run-averaged NEES (as the campaign summary pooled it) and the per-run metrics' spread.
 
-Units at this edge: attitude in arcsec, gyro bias in deg/h, times in seconds and milliseconds.
-The consistency bands are those of :mod:`navsim.estimation.consistency`; the NEES dof is the one
-each run's summary records.
+Units at this edge: arcsec, times in seconds and milliseconds. The consistency bands are those of
+:mod:`navsim.estimation.consistency`; the NEES dof is the one each run's summary records.
 """
 
 from collections.abc import Mapping
@@ -10,14 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.estimation.consistency import chi2_band
-from startrack import address, units
+from navsim.pooling import run_averaged_nees
+from startrack import address
 from startrack.errors import InputError
 
 #: A frame counts as identified when at least this many stars were identified (two fix an attitude).
 MIN_IDENTIFIED = 2
-#: Error of the attitude states is rows 0:3 of the filter state, the gyro bias rows 3:6.
-ATTITUDE, BIAS = slice(0, 3), slice(3, 6)
 
 
 def mode_names(summary, codes):
@@ -115,8 +114,6 @@ def sub_catalog_indices(series, n_d):
     return index[(index >= 0) & (index < address.base_point_count(n_d))]
 
 
-
-
 # --------------------------------------------------------------------------- campaigns
 
 
@@ -148,18 +145,6 @@ def common_frames(campaign):
     return t
 
 
-def envelopes(campaign):
-    """:class:`Envelopes` of the attitude error [arcsec] with the filter's ±3σ (when P_diag was logged)."""
-    t = common_frames(campaign)
-    n = t.size
-    err = units.rad_to_arcsec(np.stack([r.series["attitude_error"][:n] for r in campaign.runs]))
-    sigma = None
-    if all("P_diag" in r.series for r in campaign.runs):
-        var = np.mean(np.stack([r.series["P_diag"][:n, ATTITUDE] for r in campaign.runs]), axis=0)
-        sigma = units.rad_to_arcsec(np.sqrt(var))
-    return envelopes_of(t, err, sigma)
-
-
 def envelopes_of(t, err, sigma):
     """:class:`Envelopes` of the errors ``err`` (M runs, F frames, 3) with the filter's σ (F, 3) from
     the covariance averaged over the runs (or None)."""
@@ -175,6 +160,9 @@ def envelopes_of(t, err, sigma):
 
 @dataclass(frozen=True)
 class AveragedNees:
+    """The run-averaged NEES of a campaign: per frame (``t``, ``mean``) and the campaign summary's
+    statistics of it after the settling time (its dof, runs, 95 % band, fraction inside and mean)."""
+
     t: np.ndarray
     runs: int
     dof: int
@@ -186,21 +174,15 @@ class AveragedNees:
 
 
 def averaged_nees(campaign):
-    """NEES averaged over the runs with its chi-square band for M runs, or None if not logged."""
+    """:class:`AveragedNees` of a campaign: its statistics as the campaign summary pooled them
+    (:func:`navsim.pooling.averaged_nees`), its curve by the same function from the runs' series; None when
+    the runs did not log NEES."""
     if not all("nees" in r.series for r in campaign.runs):
         return None
-    t = common_frames(campaign)
-    mean = np.mean(np.stack([r.series["nees"][: t.size] for r in campaign.runs]), axis=0)
-    m = len(campaign.runs)
-    dof = int(campaign.runs[0].summary["nees"]["dof"])
-    lo, hi = chi2_band(dof, m)
-    settle = float(campaign.runs[0].summary["settle_s"])
-    steady = t >= settle
-    if not steady.any():
-        steady = np.ones_like(t, dtype=bool)
-    inside = (mean[steady] >= lo) & (mean[steady] <= hi)
-    return AveragedNees(t, m, dof, mean, (float(lo), float(hi)), settle, float(inside.mean()),
-                        float(mean[steady].mean()))
+    t, mean = run_averaged_nees([r.series for r in campaign.runs])
+    pooled = campaign.summary["nees"]
+    return AveragedNees(t, int(pooled["runs"]), int(pooled["dof"]), mean, tuple(pooled["band_95"]),
+                        float(campaign.scenario["settle_s"]), float(pooled["fraction_in_band"]), float(pooled["mean"]))
 
 
 @dataclass(frozen=True)
@@ -249,20 +231,6 @@ def campaign_modes_source(campaign):
     return campaign.runs[0].summary
 
 
-#: Per-run metrics tabulated across a campaign: (label, unit, path in summary.json).
-RUN_METRICS = (
-    ("cross-boresight RMS", "arcsec", ("cross_boresight_rms_arcsec",)),
-    ("roll RMS", "arcsec", ("roll_rms_arcsec",)),
-    ("x RMS", "arcsec", ("attitude_error_rms_arcsec", "x")),
-    ("y RMS", "arcsec", ("attitude_error_rms_arcsec", "y")),
-    ("z RMS", "arcsec", ("attitude_error_rms_arcsec", "z")),
-    ("NEES mean", "", ("nees", "mean")),
-    ("NEES in 95 % band", "%", ("nees", "fraction_in_band")),
-    ("NIS mean per dof", "", ("nis", "mean_per_dof")),
-    ("wall time", "s", ("timing", "wall_seconds")),
-)
-
-
 @dataclass(frozen=True)
 class MetricRow:
     label: str
@@ -275,7 +243,7 @@ class MetricRow:
     maximum: float
 
 
-def metric_table(campaign, metrics=RUN_METRICS):
+def metric_table(campaign, metrics):
     """Across-run statistics of each per-run metric (label, unit, path) found in the run summaries."""
     rows = []
     for label, unit, path in metrics:

@@ -6,17 +6,17 @@ the frames and the star sensor); :func:`simulate` is one seeded run: the IMU and
 are drawn, the navigation filter starts from an error drawn from its P0 and runs through
 :func:`navsim.closed_loop.run_loop` (its compiled fast path for the open-loop position and baro
 aiding; frame by frame with a star sensor, which sees the sky from the truth and, at image
-fidelity, points itself with the filter's prediction), and the run's series and
-:class:`~navsim.records.RunSummary` follow (:mod:`navsim.ins.summary`, :mod:`navsim.ins.celestial`).
+fidelity, points itself with the filter's prediction, with the per-frame observers the scenario
+asks for), and the run's series and :class:`~navsim.navigation.records.RunSummary` follow
+(:mod:`navsim.navigation.summary`, :mod:`navsim.navigation.celestial`).
 
 Random sub-streams (``SeedSequence(seed).spawn(7)``, in this fixed order): 0 gyro, 1 accelerometer,
 2 the filter's initial error, 3 position fixes, 4 baro, 5 a random gravity disturbance (the truth
 is then generated per run), 6 the star sensor (at vector fidelity its noise directly; at image
-fidelity it spawns three, all before the first frame: 0 attitude jumps, 1 false-star storms,
-2 rendering).
+fidelity it spawns four, all before the first frame: :func:`navsim.star_run.start_image`).
 
 A run may switch error sources off in the truth alone (``truth_off``, :data:`TRUTH_SOURCES`; the
-error budget of :mod:`navsim.campaign.budget`): the filter is still built from the unchanged scenario
+error budget, :mod:`navsim.navigation.budget`): the filter is still built from the unchanged scenario
 (the same P0, Q, R, consider states and mounting σ) and every draw still comes from its sub-stream
 (a source switched off has its terms zero, not its draws skipped), so runs with different sources
 off share the other sources' draws exactly.
@@ -28,19 +28,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.closed_loop import FrameGrid, mode_statistics, mode_timing, run_loop
+from navsim import star_run
+from navsim.build import faults
+from navsim.build.star_sensor import observers
+from navsim.closed_loop import FrameGrid, run_loop
 from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
-from navsim.ins import celestial
-from navsim.ins.summary import navigation_series, summarize
+from navsim.estimation.nav_filter import NavFilter
+from navsim.navigation import build, celestial
+from navsim.navigation.scenario import frame_rate
+from navsim.navigation.summary import navigation_series, summarize
 from navsim.records import RunResult
-from navsim.scenario import build_navigation as build
-from navsim.scenario.navigation import frame_rate
 from navsim.scenario.star_sensor_fields import mounting
-from navsim.sensors import faults
 from navsim.sensors.aiding import AidingRun, draw_record
 from navsim.sensors.celestial_aiding import CelestialAidingRun
-from navsim.sensors.star_sensor import MODES
+from navsim.sensors.faults import apply_bias_steps
 from navsim.sensors.star_vector import AttitudeFixSensor, VectorRun
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
@@ -48,12 +50,19 @@ from startrack import rotation as rot
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
+#: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity: the identifier's
+#: (the INS's kernels compile at first call).
+IMAGE_LANES = (("startrack.identify.warmup:pattern_search",),
+               ("navsim.sensors.warmup:inertial_sensors", "startrack.identify.warmup:star_tracking"))
+#: Without a star sensor or at vector fidelity: one lane (a campaign's parent compiles it once for its workers).
+VECTOR_LANES = (("navsim.navigation.warmup:run",),)
 
 @dataclass(frozen=True)
-class NavigationPrepared:
+class Prepared:
     """The seed-free part of a navigation scenario: the truth (None when a random gravity disturbance
-    makes it the run's own: then its seed-free ``kinematics``, which every run completes), the frame grid, the IMU, baro and position-fix models, the star sensor
-    (None without one) with the Earth's orientation at the frames, and the faults."""
+    makes it the run's own: then its seed-free ``kinematics``, which every run completes), the frame grid,
+    the IMU, baro and position-fix models, the star sensor (None without one) with the Earth's orientation
+    at the frames and its per-frame observers, and the faults."""
 
     scenario: object
     truth: trajectory.Trajectory | None
@@ -66,6 +75,7 @@ class NavigationPrepared:
     disturbance: GravityDisturbance | None
     star_sensor: object = None
     orientation: EarthOrientation | None = None
+    observers: tuple = ()
     bias_steps: tuple = ()
     attitude_jumps: tuple = ()
     truth_off: frozenset = frozenset()
@@ -105,8 +115,14 @@ def check_truth_off(scenario, truth_off):
     return truth_off
 
 
+def lanes(scenario):
+    """The compile-ahead lanes of a run of ``scenario``."""
+    image = scenario.data.get("star_sensor", {}).get("fidelity") == "image"
+    return IMAGE_LANES if image else VECTOR_LANES
+
+
 def prepare(scenario, star_catalog=None, truth_off=frozenset()):
-    """The :class:`NavigationPrepared` of a validated navigation scenario; ``star_catalog`` (a
+    """The :class:`Prepared` of a validated navigation scenario; ``star_catalog`` (a
     startrack StarCatalog) is loaded at the scenario's epoch when a star sensor needs it;
     ``truth_off`` names error sources the truth leaves out (:data:`TRUTH_SOURCES`), not the filter."""
     truth_off = check_truth_off(scenario, truth_off)
@@ -123,15 +139,16 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     baro = build.baro(scenario)
     star_sensor = orientation = None
     if "star_sensor" in scenario.data:
-        star_catalog = star_catalog or load_star_catalog(epoch=scenario.catalog_epoch)
-        star_sensor = build.star_sensor(scenario, star_catalog)
+        star_catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
+        star_sensor = build.star_sensor(scenario, star_catalog, lanes(scenario))
         if "mounting" in truth_off:
             star_sensor = dataclasses.replace(star_sensor, q_BS_true=mounting(scenario["star_sensor"])[0])
         orientation = EarthOrientation.compute(scenario["epoch_utc"], grid.frame_k * grid.dt)
-    return NavigationPrepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
+    return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
                               baro_every=0 if baro is None else int(round(frame_hz / baro.rate_hz)),
                               position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
                               star_sensor=star_sensor, orientation=orientation,
+                              observers=() if star_sensor is None else observers(scenario, star_sensor),
                               bias_steps=faults.bias_steps(scenario["faults"]),
                               attitude_jumps=faults.attitude_jumps(scenario["faults"]), truth_off=truth_off,
                               kinematics=kinematics if random_field else None)
@@ -149,35 +166,31 @@ def simulate(prepared, seed, compiled=True):
     gyro_truth, accel_truth = truth_imu(p)
     gyro = gyro_truth.measure(truth.dtheta[:n] / grid.dt, gyro_ss)
     if "inertial" not in p.truth_off:
-        omega, bias = faults.apply_bias_steps(gyro.omega, gyro.bias, truth.t[1:n + 1], p.bias_steps)
+        omega, bias = apply_bias_steps(gyro.omega, gyro.bias, truth.t[1:n + 1], p.bias_steps)
         gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
     accel = accel_truth.measure(truth.dv[:n] / grid.dt, accel_ss)
-    gravity = build.gravity_uncertainty(scenario, truth.lat[0], truth.h[0])
-    P0 = build.initial_covariance(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0])
-    start = _start(truth, P0, init_ss, zero="initial" in p.truth_off)
-    filt = build.nav_filter(scenario, p.gyro, p.accel, start, P0, grid.dt, p.orientation, gravity)
+    config = build.filter_config(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0], grid.dt, p.orientation)
+    filt = NavFilter(*_start(truth, config.P0, init_ss, zero="initial" in p.truth_off), config)
     record = _aiding_record(p, truth, position_ss, baro_ss)
-    sensor_run, loop_truth, jumps, sky = AidingRun(record), truth, None, None
+    sensor_run, loop_truth, jumps, sky, observer_runs = AidingRun(record), truth, None, None, []
     if p.star_sensor is not None:
         sky = SkyTruth.of(truth, p.orientation, grid.frame_k)
-        star_run, jumps = _star_run(p, sky, star_ss)
-        sensor_run, loop_truth = CelestialAidingRun(star_run, sensor_run), sky
-    log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, compiled=compiled)
+        stars, observer_runs, jumps = _star_run(p, sky, star_ss, filt)
+        sensor_run, loop_truth = CelestialAidingRun(stars, sensor_run), sky
+    log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, observer_runs,
+                   compiled)
     q_BS_true = p.star_sensor.q_BS_true if p.star_sensor is not None else None
     series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true)
-    series["error_sigma_initial"] = np.sqrt(np.diag(P0))
+    series["error_sigma_initial"] = np.sqrt(np.diag(config.P0))
     if p.star_sensor is not None:
         series["mounting_true"] = np.broadcast_to(rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
                                                                                       q_BS_true)), (grid.n_frames, 3)).copy()
         series["mounting_estimate"] = rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
                                                                           series["q_bs"]))
     summary = summarize(scenario, seed, series, grid)
-    timing = {}
     if p.star_sensor is not None:
         summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true))
-        if log.logs_modes:
-            summary = summary.replace(identification=mode_statistics(series, log.transitions), modes=list(MODES))
-            timing = mode_timing(series["mode"], log.timing)
+    summary, timing = star_run.finish(summary, series, log, observer_runs, series["t"] >= scenario["settle_s"])
     summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
     return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,
                      timing_series=log.timing)
@@ -208,24 +221,21 @@ def _aiding_record(prepared, truth, position_ss, baro_ss):
     return dataclasses.replace(exact, position_sigma=record.position_sigma, baro_sigma=record.baro_sigma)
 
 
-def _star_run(prepared, sky, seed):
-    """(the star sensor's run, its attitude jumps or None) for the sky truth ``sky``: at vector fidelity
-    every frame drawn from ``seed`` (without noise when ``truth_off`` has "star_noise": the record keeps
-    the sensor's σ, the filter's R); at image fidelity the streams of jumps, storms and rendering."""
+def _star_run(prepared, sky, seed, filt):
+    """(the star sensor's run, the observers' runs, its attitude jumps or None) for the sky truth ``sky``:
+    at vector fidelity every frame drawn from ``seed`` (without noise when ``truth_off`` has "star_noise":
+    the record keeps the sensor's σ, the filter's R); at image fidelity :func:`navsim.star_run.start_image`."""
     sensor, grid = prepared.star_sensor, prepared.grid
-    if prepared.scenario["star_sensor"]["fidelity"] != "image":
-        if "star_noise" not in prepared.truth_off:
-            return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), None
-        if isinstance(sensor, AttitudeFixSensor):
-            quiet, kept = dataclasses.replace(sensor, sigma_cross=0.0, sigma_roll=0.0), {"R_S": sensor.R_S}
-        else:
-            quiet, kept = dataclasses.replace(sensor, sigma=0.0), {"sigma": sensor.sigma}
-        record = quiet.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I).record()
-        return VectorRun(dataclasses.replace(record, **kept)), None
-    jump_ss, storm_ss, render_ss = seed.spawn(3)
-    run = sensor.start(np.random.default_rng(storm_ss), np.random.default_rng(render_ss), grid.n_frames)
-    jumps = faults.AttitudeJumps(prepared.attitude_jumps, np.random.default_rng(jump_ss)) if prepared.attitude_jumps else None
-    return run, jumps
+    if prepared.scenario["star_sensor"]["fidelity"] == "image":
+        return star_run.start_image(sensor, seed, grid.n_frames, filt, prepared.observers, prepared.attitude_jumps)
+    if "star_noise" not in prepared.truth_off:
+        return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), [], None
+    if isinstance(sensor, AttitudeFixSensor):
+        quiet, kept = dataclasses.replace(sensor, sigma_cross=0.0, sigma_roll=0.0), {"R_S": sensor.R_S}
+    else:
+        quiet, kept = dataclasses.replace(sensor, sigma=0.0), {"sigma": sensor.sigma}
+    record = quiet.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I).record()
+    return VectorRun(dataclasses.replace(record, **kept)), [], None
 
 
 def _start(truth, P0, seed, zero=False):

@@ -1,0 +1,36 @@
+"""What the command line prints of a navigation run and campaign beside what it prints of every run
+(consistency, updates, wall time)."""
+
+
+def run_lines(summary):
+    """The scenario, the position, velocity and attitude errors and the final IMU bias errors of a run."""
+    nav, position = summary["navigation"], summary["position_error_m"]
+    horizontal, vertical, nmi = position["horizontal"], position["vertical"], summary["position_error_nmi"]["horizontal"]
+    velocity = summary["velocity_error_m_per_s"]
+    return [
+        f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, INS at "
+        f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
+        f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
+        f"RMS {horizontal['rms']:.2f} m  max {horizontal['max']:.2f} m",
+        f"vertical error      final {vertical['final']:.2f} m  RMS {vertical['rms']:.2f} m  max {vertical['max']:.2f} m",
+        f"velocity error RMS  horizontal {velocity['horizontal']['rms']:.3f} m/s  vertical {velocity['vertical']['rms']:.3f} m/s",
+        f"attitude error RMS  tilt {summary['tilt_error_arcsec']['rms']:.1f}\"  heading {summary['heading_error_arcsec']['rms']:.1f}\"",
+        "final bias error    gyro " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h, "
+        "accelerometer " + "  ".join(f"{v:+.1f}" for v in summary["accel_bias_error_final_micro_g"]) + " µg",
+    ]
+
+
+def campaign_lines(summary):
+    """CEP50/95 of the final horizontal error and the vertical p95 [m], and the pooled accelerometer bias
+    states, of a campaign with finished runs."""
+    lines = []
+    if summary.get("position_error_m"):
+        horizontal, nmi = summary["position_error_m"]["horizontal"], summary["position_error_nmi"]["horizontal"]
+        lines.append(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 "
+                     f"{horizontal['cep95']:.2f} m ({nmi['cep95']:.3f} nmi)   vertical p95 "
+                     f"{summary['position_error_m']['vertical']['p95']:.2f} m")
+    accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
+    if accel:
+        lines.append(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "
+                     f"(normalised RMS {', '.join(f'{v:.2f}' for v in accel['normalised_error_rms'])})")
+    return lines
