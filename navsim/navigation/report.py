@@ -18,7 +18,14 @@ from navsim.navigation.report_statistics import RUN_METRICS, horizontal_percenti
 from navsim.typeset import figures
 from navsim.typeset import statistics as stats
 from navsim.typeset.document import Document, general, markup, number, scenario_name, table
-from navsim.typeset.sections import campaign_headline, campaign_summary_section, campaign_tables, scenario_section
+from navsim.typeset.sections import (
+    campaign_headline,
+    campaign_summary_section,
+    campaign_tables,
+    comparison_section,
+    notes_section,
+    scenario_section,
+)
 from startrack import units
 
 #: Arrays every navigation run must have, and those a campaign report reads from each run.
@@ -64,6 +71,8 @@ def run_report(run) -> bytes:
             f"The NEES of the whole error state ({summary['nees']['dof']} dof) and the NIS of each update per degree of "
             "freedom, with their two-sided 95 % chi-square bands."))
         doc.figure(figures.consistency(run), "NEES and NIS per degree of freedom (log scale) with their 95 % bands.")
+        comparison_section(doc, summary)
+        notes_section(doc, summary)
         return doc.compile()
 
 

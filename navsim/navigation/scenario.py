@@ -288,7 +288,7 @@ def _check_baro_states(checked, source):
 def _check_star_sensor(checked, source):
     """The star sensor's and the faults' rules: those of the attitude kind, faults only with a star sensor
     (but gyro bias steps), an outage no longer than the flight, a boresight above the horizon at some
-    time of the flight."""
+    time of the flight, and no shadow attitude filter (``compare_without_stacking``)."""
     sensor = checked.get("star_sensor")
     faults = checked["faults"]
     if sensor is None:
@@ -297,6 +297,10 @@ def _check_star_sensor(checked, source):
                 raise InputError(f"{source}: faults.{kind}: needs a [star_sensor] (it acts on the star sensor)")
         return
     check_star_sensor(sensor, source)
+    if sensor.get("image", {}).get("compare_without_stacking"):
+        raise InputError(f"{source}: star_sensor.image.compare_without_stacking: the shadow filter of 004 §3 is the "
+                         "attitude filter's; a navigation run compares the attitude solvers of the stacked frames only "
+                         "(set it false)")
     check_faults(faults, sensor["fidelity"], source)
     duration = checked["duration_s"]
     for k, outage in enumerate(faults["outages"]):

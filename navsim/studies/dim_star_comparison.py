@@ -136,21 +136,20 @@ class DimStarRun:
 
     def finish(self, series, steady):
         """The run's figures [arcsec, px]; the shadow filter's attitude error joins the series."""
-        shadow_error = None
-        if self._shadow is not None:
-            shadow_error = rot.attitude_error(self._shadow_q, series["q_true"])
-        if shadow_error is None and not any(self._logs.values()):
-            return None
-        extra = {} if shadow_error is None else {"attitude_error_without_stacking": shadow_error}
-        return Findings(_statistics(self._logs, series["attitude_error"], shadow_error, steady), extra)
+        if self._shadow is None:
+            return Findings(_statistics(self._logs, None, steady)) if any(self._logs.values()) else None
+        shadow_error = rot.attitude_error(self._shadow_q, series["q_true"])
+        return Findings(_statistics(self._logs, (series["attitude_error"], shadow_error), steady),
+                        {"attitude_error_without_stacking": shadow_error})
 
 
 def _rms_arcsec(values, axis=0):
     return np.sqrt(np.mean(np.square(values), axis=axis)) / ARCSEC
 
 
-def _statistics(logs, attitude_error, shadow_error, steady):
-    """Per-frame solver RMS, the bound's RMS, the stacked centroid's error and the filters' RMS."""
+def _statistics(logs, filters, steady):
+    """Per-frame solver RMS, the bound's RMS, the stacked centroid's error and, with ``filters`` (the run's
+    and the shadow's attitude errors (F, 3) [rad]), the filters' RMS."""
     out = {}
     uv_errors = np.array(logs["stacked_uv_error_px"]).reshape(-1, 2)
     if len(uv_errors):
@@ -170,8 +169,8 @@ def _statistics(logs, attitude_error, shadow_error, steady):
             out[name[:-2]] = {"frames": len(logs[name]),
                               "rms_cross_roll_arcsec": [float(np.sqrt(0.5 * (variance[0] + variance[1])) / ARCSEC),
                                                         float(np.sqrt(variance[2]) / ARCSEC)]}
-    if shadow_error is not None:
-        for name, err in (("filter_with_stacking", attitude_error), ("filter_without_stacking", shadow_error)):
+    if filters is not None:
+        for name, err in zip(("filter_with_stacking", "filter_without_stacking"), filters):
             out[name] = {"rms_xyz_arcsec": [float(v) for v in _rms_arcsec(err[steady])]}
     return out
 

@@ -63,6 +63,12 @@ def test_observers_run_on_an_ins():
     assert summary.paper_comparison and "tracking_failure_probes" in summary.timing
 
 
+def test_the_shadow_filter_comparison_is_the_attitude_kinds():
+    """004 §3's shadow filter copies the attitude filter; a navigation run keeps the solver comparison only."""
+    with pytest.raises(InputError, match="star_sensor.image.compare_without_stacking: the shadow filter of 004 §3"):
+        kinds.load_scenario(DATA / "base_sins_cns.toml", {"star_sensor.image.compare_without_stacking": True})
+
+
 def test_a_filter_configuration_is_checked_where_it_is_built():
     with pytest.raises(InputError, match="filter.scale_factor: must be one of estimate, consider, ignore"):
         AttitudeFilterConfig(np.eye(6), 1e-6, 1e-9, scale_factor="estimated")

@@ -14,6 +14,7 @@ import pytest
 import navsim
 from navsim import studies
 from navsim.kinds import load_scenario, scenario_from_dict
+from navsim.output import write_study
 from navsim.report import write_report
 from startrack.errors import InputError
 from tests.support import HANG_S
@@ -183,7 +184,7 @@ def test_cli_runs_a_study_prints_the_comparison_and_writes_a_report(tmp_path):
 
 
 def test_contest_report_has_its_figures_and_numbers(tmp_path, contest):
-    navsim.output.write_study(tmp_path / "c", contest)
+    write_study(tmp_path / "c", contest)
     pdf = write_report(tmp_path / "c", tmp_path / "c.pdf")
     text = "\n".join(page.extract_text() for page in pypdf.PdfReader(pdf).pages)
     for needle in ("001 Fig. 2.6/3.5", "001 §5.4", "maps recognised"):
