@@ -63,6 +63,17 @@ def test_observers_run_on_an_ins():
     assert summary.paper_comparison and "tracking_failure_probes" in summary.timing
 
 
+def test_the_dim_star_comparison_needs_no_attitude_series_without_its_shadow():
+    """An INS run's series has no attitude-filter error: without the shadow filter the comparison reports the
+    stacked frames alone (a navigation run with stacked frames used to end in a KeyError)."""
+    from navsim.studies.dim_star_comparison import DimStarComparison
+
+    run = DimStarComparison(shadow=False).start(None, np.random.default_rng(0), 3)
+    run._logs["stacked_uv_error_px"].append(np.array([0.1, -0.2]))  # one stacked frame's centroid error
+    found = run.finish({"t": np.arange(3.0), "error_state": np.zeros((3, 15))}, np.ones(3, bool))
+    assert found.stats["stacked_centroid"]["frames"] == 1 and "filter_with_stacking" not in found.stats
+
+
 def test_the_shadow_filter_comparison_is_the_attitude_kinds():
     """004 §3's shadow filter copies the attitude filter; a navigation run keeps the solver comparison only."""
     with pytest.raises(InputError, match="star_sensor.image.compare_without_stacking: the shadow filter of 004 §3"):
