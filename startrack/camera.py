@@ -232,6 +232,17 @@ class Camera:
         v = np.concatenate([xy_n, np.ones((len(uv), 1))], axis=1)
         return v / np.linalg.norm(v, axis=1, keepdims=True)
 
+    def unproject_covariance(self, uv, cov_uv):
+        """Covariances (N, 3, 3) in S of the unit vectors of image points ``uv`` (N, 2) [px] whose positions have
+        covariances ``cov_uv`` (N, 2, 2) [px²]: J Σ Jᵀ with J = ∂ unproject / ∂(u, v) (N, 3, 2) by central
+        differences of 0.01 px (truncation ~(0.01 px / f)² of J, rounding ~1e-16 / 0.01 of it: both far below
+        any centroid's σ)."""
+        uv = np.atleast_2d(np.asarray(uv, dtype=float))
+        step = 0.01
+        J = np.stack([(self.unproject(uv + d) - self.unproject(uv - d)) / (2.0 * step)
+                      for d in (np.array([step, 0.0]), np.array([0.0, step]))], axis=-1)
+        return J @ np.asarray(cov_uv, dtype=float) @ np.swapaxes(J, 1, 2)
+
     def center_radec_roll(self, q_IS):
         """(ra, dec, roll) [rad] of the image centre: the frame whose +z is the direction of the centre pixel
         ((W-1)/2, (H-1)/2) and whose axes follow S by the smallest rotation (what plate solvers report)."""

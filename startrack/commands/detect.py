@@ -5,6 +5,11 @@ Background and noise on a mesh of cells (or given), threshold V_th = b + a sigma
 saturation at the full scale of the file's bit depth (:mod:`startrack.image_io`); prints one line
 per star, brightest first, or JSON.  The same detection, with the same options
 (:func:`add_detection_options`), is the image front end of ``startrack solve``.
+
+With ``--psf-sigma-px`` each star's position is then fitted at the Cramér-Rao bound with its 2 x 2
+covariance (:mod:`startrack.psf_fit`: the Gaussian PSF of that radius, the smear ``--smear-px`` and the
+star's shot noise through ``--gain-e-per-dn`` when given), flagged when the model does not explain its
+pixels (outlier, edge, saturated, failed).
 """
 
 import json
@@ -59,6 +64,59 @@ def detect_frame(frame, options):
     return detect(frame.image, **options)
 
 
+def add_fit_options(parser):
+    """The options of the PSF fit (:mod:`startrack.psf_fit`)."""
+    group = parser.add_argument_group("position fit at the Cramér-Rao bound")
+    group.add_argument("--psf-sigma-px", type=float, default=None,
+                       help="Gaussian PSF radius [px]: fit every star's position and covariance (off by default)")
+    group.add_argument("--gain-e-per-dn", type=float, default=None,
+                       help="detector gain [e-/DN] for the stars' shot noise (default: left out of the noise)")
+    group.add_argument("--smear-px", default=None, metavar="DU,DV",
+                       help="the stars' trail during the exposure [px] (default: none)")
+
+
+def fit_options(args):
+    """(PSF radius, gain, smear) of the parsed fit options, checked; None without --psf-sigma-px."""
+    if args.psf_sigma_px is None:
+        if args.gain_e_per_dn is not None or args.smear_px is not None:
+            raise InputError("options --gain-e-per-dn and --smear-px go with --psf-sigma-px (the PSF fit)")
+        return None
+    check_range("--psf-sigma-px", args.psf_sigma_px, 0.05, 100.0)
+    if args.gain_e_per_dn is not None:
+        check_range("--gain-e-per-dn", args.gain_e_per_dn, 1e-6, 1e6)
+    smear = (0.0, 0.0)
+    if args.smear_px is not None:
+        try:
+            smear = tuple(float(x) for x in args.smear_px.split(","))
+        except ValueError:
+            smear = ()
+        if len(smear) != 2:
+            raise InputError(f"option --smear-px = {args.smear_px!r}: expected two numbers DU,DV [px]")
+        for value in smear:
+            check_range("--smear-px", value, -1000.0, 1000.0)
+    return args.psf_sigma_px, args.gain_e_per_dn, smear
+
+
+def fit_frame(frame, found, options):
+    """:func:`startrack.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`)."""
+    from startrack.psf_fit import PixelNoise, fit_stars
+
+    sigma, gain, smear = options
+    noise = PixelNoise(found.sigma_n, gain_e_per_dn=gain)
+    return fit_stars(frame.image, found.uv, sigma, noise, found.background, smear_px=smear,
+                     saturation_dn=frame.full_scale)
+
+
+def _fit_dict(fits, i):
+    return {"u": float(fits.uv[i, 0]), "v": float(fits.uv[i, 1]), "cov_uv_px2": fits.cov[i].tolist(),
+            "flux_dn": float(fits.flux[i]), "background_dn": float(fits.background[i]), "chi2": float(fits.chi2[i]),
+            "dof": int(fits.dof[i]), **{flag: bool(getattr(fits, flag)[i]) for flag in FIT_FLAGS}}
+
+
+#: The flags of a position fit (startrack.psf_fit).
+FIT_FLAGS = ("outlier", "edge", "saturated", "failed")
+
+
 def register(subparsers):
     parser = subparsers.add_parser(
         "detect",
@@ -67,6 +125,7 @@ def register(subparsers):
     )
     parser.add_argument("image", help="frame: .png, .tif/.tiff, .jpg/.jpeg or .npy")
     add_detection_options(parser)
+    add_fit_options(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=run)
 
@@ -74,24 +133,34 @@ def register(subparsers):
 def run(args):
     from startrack.image_io import read_frame
 
-    options = detection_options(args)
+    options, fitting = detection_options(args), fit_options(args)
     frame = read_frame(args.image)
     image = frame.image
     start = time.perf_counter()
     found = detect_frame(frame, options)
+    fits = fit_frame(frame, found, fitting) if fitting is not None and len(found) else None
     elapsed_ms = 1000.0 * (time.perf_counter() - start)
     if args.json:
         result = {"image": args.image, "height": image.shape[0], "width": image.shape[1],
                   "centroider": args.centroider, "full_scale_dn": frame.full_scale, "detect_ms": elapsed_ms,
                   **found.to_dict()}
+        if fits is not None:
+            for i, star in enumerate(result["stars"]):
+                star["psf_fit"] = _fit_dict(fits, i)
         print(json.dumps(result))
         return 0
     print(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, b = {found.background:.2f} DN, "
           f"sigma_n = {found.sigma_n:.2f} DN, V_th = {found.threshold:.2f} DN, {len(found)} stars, "
           f"{elapsed_ms:.1f} ms")
-    print(f"{'#':>4} {'u_px':>10} {'v_px':>10} {'flux_dn':>10} {'peak_dn':>8} {'npix':>5} {'snr':>7}  flags")
+    fitted = "" if fits is None else f" {'fit_u_px':>10} {'fit_v_px':>10} {'sig_u':>6} {'sig_v':>6}"
+    print(f"{'#':>4} {'u_px':>10} {'v_px':>10} {'flux_dn':>10} {'peak_dn':>8} {'npix':>5} {'snr':>7}{fitted}  flags")
     for i in range(len(found)):
-        flags = ",".join(name for name, on in (("saturated", found.saturated[i]), ("edge", found.edge[i])) if on)
+        flags = [name for name, on in (("saturated", found.saturated[i]), ("edge", found.edge[i])) if on]
+        columns = ""
+        if fits is not None:
+            sigma_u, sigma_v = fits.cov[i, 0, 0] ** 0.5, fits.cov[i, 1, 1] ** 0.5
+            columns = f" {fits.uv[i, 0]:>10.3f} {fits.uv[i, 1]:>10.3f} {sigma_u:>6.3f} {sigma_v:>6.3f}"
+            flags += [f"fit-{name}" for name in FIT_FLAGS if getattr(fits, name)[i]]
         print(f"{i:>4} {found.u[i]:>10.3f} {found.v[i]:>10.3f} {found.flux[i]:>10.1f} {found.peak[i]:>8.0f} "
-              f"{found.npix[i]:>5d} {found.snr[i]:>7.1f}  {flags}")
+              f"{found.npix[i]:>5d} {found.snr[i]:>7.1f}{columns}  {','.join(flags)}")
     return 0

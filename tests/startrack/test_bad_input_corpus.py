@@ -22,7 +22,7 @@ COMMANDS = {
                ["--ra-deg", "--dec-deg", "--roll-deg", "--fov-deg", "--width", "--height", "--mag-limit",
                 "--exposure-ms", "--rate-deg-s", "--epoch", "--seed"]),
     "detect": (["detect", "{tmp}/frame.png"], ["--a", "--background-dn", "--sigma-n-dn", "--mesh-px", "--min-pixels",
-                                               "--saturation-dn"]),
+                                               "--saturation-dn", "--psf-sigma-px", "--gain-e-per-dn"]),
     "solve": (["solve", "{tmp}/frame.png"], ["--fov-deg", "--width", "--height", "--boresight-error-deg", "--mag",
                                              "--epoch", "--centroid-sigma-px", "--time-budget-s", "--max-false-match",
                                              "--a", "--background-dn", "--sigma-n-dn", "--mesh-px", "--min-pixels",
