@@ -29,9 +29,11 @@ the current model (not of the data, which would bias it), over a window of half-
 around each start; its covariance is J⁻¹ at the estimate (u and v correlated along the smear). The χ² of
 the residuals over the window tests the model: a blend, a hot pixel or a cosmic-ray hit leaves χ² above
 the 99.9 % quantile of χ²(dof) and the star is flagged ``outlier`` with its covariance scaled by the
-measured χ²/dof (nothing is inflated by a set factor); a window cut by the border of the frame is flagged
-``edge``; pixels at saturation are left out of the fit and the star flagged ``saturated``; a fit that does
-not converge to a positive flux within 2 px (and half the smear) of its start is flagged ``failed``.
+measured χ²/dof (nothing is inflated by a set factor); a window cut by the border of the frame (or of its
+readout window) is flagged ``edge`` -- the model knows which pixels it has, so the fit stays unbiased and
+its covariance grows with the light lost; pixels at saturation are left out of the fit and the star flagged
+``saturated``; a fit that does not converge to a positive flux, within 2 px (and half the smear) of its
+start and inside its window, is flagged ``failed`` and not used.
 """
 
 import math
@@ -236,8 +238,14 @@ class StarFits:
 
     @property
     def usable(self):
-        """True for the fits whose position and covariance can be fused: converged, not cut by the border."""
-        return ~(self.failed | self.edge)
+        """True for the fits whose position and covariance can be fused: those that converged (a star cut by
+        the border keeps the information of its pixels in the image, and its covariance says so)."""
+        return ~self.failed
+
+
+def concatenate(fits):
+    """One :class:`StarFits` of the stars of several, in their order."""
+    return StarFits(*(np.concatenate([getattr(f, name) for f in fits]) for name in StarFits.__dataclass_fields__))
 
 
 def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, saturation_dn=None, origin=(0, 0)):
@@ -283,7 +291,8 @@ def _fit_one(array, start, drift, sigma, noise, background, saturation_dn, origi
                                                           sv, sigma, noise.variance_dn2, noise.inverse_gain)
             dof = n - 4
             shift = np.hypot(*(theta[:2] - start))
-            failed = not (converged and theta[2] > 0.0 and shift <= MAX_SHIFT_PX + 0.5 * np.hypot(*drift))
+            inside = top - 0.5 <= theta[1] - origin[0] <= bottom - 0.5 and left - 0.5 <= theta[0] - origin[1] <= right - 0.5
+            failed = not (converged and inside and theta[2] > 0.0 and shift <= MAX_SHIFT_PX + 0.5 * np.hypot(*drift))
             cov = np.linalg.inv(J)[:2, :2] if not failed else cov
         except np.linalg.LinAlgError:  # no star to fit (the flux collapsed to zero): nothing to estimate
             theta, failed = theta0, True

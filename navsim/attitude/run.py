@@ -33,9 +33,10 @@ from startrack.star_catalog import load_star_catalog
 #: The attitude filter's NEES is over its attitude and gyro-bias errors.
 NEES_DOF = 6
 #: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity, balanced on two cores
-#: (40-46 s each on the test machine, benchmarks/cold_start.py): the identifier's pattern searches, against
-#: the inertial sensor, the filter and tracking (which loads what the first lane compiled before it gets there).
-IMAGE_LANES = (("startrack.identify.warmup:pattern_search",),
+#: (40-46 s each on the test machine, benchmarks/cold_start.py): the identifier's pattern searches and the
+#: position fit, against the inertial sensor, the filter and tracking (which loads what the first lane
+#: compiled before it gets there).
+IMAGE_LANES = (("startrack.identify.warmup:pattern_search", "startrack.warmup:psf_fit"),
                ("navsim.sensors.warmup:inertial_sensors", "navsim.estimation.warmup:attitude_filter",
                 "startrack.identify.warmup:star_tracking"))
 #: At vector fidelity: one lane (compiling ahead then only says what is compiled, once).

@@ -182,24 +182,28 @@ class AttitudeFilter:
             self._x, self._P, np.asarray(q_IS, dtype=float), R, self.gate[3], self.model, self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
-    def update_stars(self, ref_I, obs_S, sigma):
+    def update_stars(self, ref_I, obs_S, cov_S):
         """Update with identified stars: catalog unit vectors ref_I (N, 3) in I, measured unit
-        vectors obs_S (N, 3) in S, direction σ (N,) or scalar [rad].
+        vectors obs_S (N, 3) in S and the covariance of each measured direction cov_S (N, 3, 3) [rad², S].
 
         Each star gives z_i = T_i (s_i − ŝ_i) with T_i (2x3) spanning the plane ⟂ ŝ_i,
-        H_i = T_i [R_SB [b̂_i×], 0, (0), ([ŝ_i×])], R_i = σ_i² I₂ (:func:`kernels.star_residuals`).
+        H_i = T_i [R_SB [b̂_i×], 0, (0), ([ŝ_i×])], R_i = T_i C_i T_iᵀ (:func:`kernels.star_residuals`).
         Stars whose NIS against the prior exceeds the 2-dof gate are rejected; the rest update
         together (:func:`kernels.stars_update`).
         """
         ref_I = np.ascontiguousarray(ref_I, dtype=float)
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
-        variance = self._variance(sigma, ref_I.shape[0])
         self._x, self._P, z, nis, accepted = kernels.stars_update(
-            self._x, self._P, ref_I, obs_S, variance, self.gate[2], self.model, self.estimated)
+            self._x, self._P, ref_I, obs_S, self._covariance(cov_S, ref_I.shape[0]), self.gate[2], self.model,
+            self.estimated)
         return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
 
-    def _variance(self, sigma, count):
-        return self.variance_scale * np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (count,)).copy()
+    def _covariance(self, cov_S, count):
+        """The stars' covariances (count, 3, 3) scaled by the tuning factor (``measurement_noise_scale``²)."""
+        cov = np.asarray(cov_S, dtype=float)
+        if cov.shape != (count, 3, 3):
+            raise ValueError(f"star covariances must have shape ({count}, 3, 3), got {cov.shape}")
+        return np.ascontiguousarray(self.variance_scale * cov)
 
     def reinitialise(self, q_IS):
         """Restart the attitude from a sensor fix q_IS after a lost track: q_IB = q_IS ⊗ q_BS⁻¹, the
@@ -239,7 +243,7 @@ class AttitudeFilter:
             out = kernels.run_stars(self._x, self._P, omega, ratio, dt, self.model, self.estimated,
                                     stars.offsets.astype(np.int64),
                                     np.ascontiguousarray(stars.ref_I), np.ascontiguousarray(stars.obs_S),
-                                    self._variance(record.sigma, len(stars.ref_I)), self.gate[2], available)
+                                    self._covariance(record.covariances(), len(stars.ref_I)), self.gate[2], available)
         x_log, P_log = out[0], out[1]
         self._x, self._P = x_log[-1].copy(), P_log[-1].copy()
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[2:]))

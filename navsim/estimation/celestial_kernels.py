@@ -85,20 +85,21 @@ def fix_update(nav, calib, P, acc, model, q_ie, q_IS, R_S, gate, estimated):
 
 
 @njit
-def stars_update(nav, calib, P, acc, model, q_ie, ref_I, obs_S, variance, gate, estimated):
+def stars_update(nav, calib, P, acc, model, q_ie, ref_I, obs_S, cov_S, gate, estimated):
     """Flush the covariance, then the update with identified stars: catalog directions ``ref_I`` (N, 3)
-    (already apparent: aberrated as the processing sees them), measured ``obs_S`` (N, 3), direction
-    variance (N,) [rad²]. Each star's tangent-plane residual (:func:`kernels.star_residuals`) with
+    (already apparent: aberrated as the processing sees them), measured ``obs_S`` (N, 3) with their
+    covariances ``cov_S`` (N, 3, 3) [rad², sensor axes]. Each star's tangent-plane residual
+    (:func:`kernels.star_residuals`) with
     H chained to the navigation error state is gated alone by its 2-dof NIS; the accepted stars
     update together (Joseph), then the reset. Returns (z (N, 2), nis (N,), accepted (N,))."""
     flush(nav, P, acc, model)
     layout = model.layout
-    z, H_att = star_residuals(inertial_attitude(nav, q_ie), calib[12:16], ref_I, obs_S, 6, True)
+    z, H_att, R = star_residuals(inertial_attitude(nav, q_ie), calib[12:16], ref_I, obs_S, cov_S, 6, True)
     A = attitude_jacobian(nav, layout.n)
     H = np.empty((z.shape[0], 2, layout.n))
     for k in range(z.shape[0]):
         _chain(H_att[k], A, layout.mounting, H[k])
-    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, variance, gate)
+    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, R, gate)
     if za.shape[0] > 0:
         dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
         P[:, :] = P_next

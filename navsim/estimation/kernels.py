@@ -223,19 +223,22 @@ def joseph_update_attitude(P, R, z, estimated):
 
 
 @njit
-def star_residuals(q_IB, q_BS, ref_I, obs_S, n, mounting):
-    """Tangent-plane residuals of identified stars against the estimates q_IB, q_BS and their Jacobians.
+def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mounting):
+    """Tangent-plane residuals of identified stars against the estimates q_IB, q_BS, their Jacobians and
+    their measurement covariances.
 
-    ŝ = R_SB R_IBᵀ r; T (2x3) spans the plane ⟂ ŝ; z = T (s − ŝ);
+    ŝ = R_SB R_IBᵀ r; T (2x3) spans the plane ⟂ ŝ; z = T (s − ŝ); R = T C Tᵀ of the measured direction's
+    covariance C (3x3, sensor axes: ``cov_S``, correlated along a smear trail);
     H = T [R_SB [b̂×], 0, …, ([ŝ×] in the last three columns when ``mounting``)] for the body-axes
     attitude error δθ (first three columns) and the mounting error δm (last three).
-    Returns (z (N, 2), H (N, 2, n)).
+    Returns (z (N, 2), H (N, 2, n), R (N, 2, 2)).
     """
     m = ref_I.shape[0]
     R_IB = quat_to_matrix(q_IB)
     R_SB = quat_to_matrix(q_BS).T
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
+    R = np.empty((m, 2, 2))
     for k in range(m):
         b_hat = R_IB.T @ ref_I[k]
         s_hat = R_SB @ b_hat
@@ -254,6 +257,10 @@ def star_residuals(q_IB, q_BS, ref_I, obs_S, n, mounting):
         d = obs_S[k] - s_hat
         z[k, 0] = np.sum(e1 * d)
         z[k, 1] = np.sum(e2 * d)
+        c1, c2 = cov_S[k] @ e1, cov_S[k] @ e2
+        R[k, 0, 0] = np.sum(e1 * c1)
+        R[k, 0, 1] = R[k, 1, 0] = 0.5 * (np.sum(e1 * c2) + np.sum(e2 * c1))
+        R[k, 1, 1] = np.sum(e2 * c2)
         A = R_SB @ skew(b_hat)
         for j in range(3):
             H[k, 0, j] = e1[0] * A[0, j] + e1[1] * A[1, j] + e1[2] * A[2, j]
@@ -263,18 +270,16 @@ def star_residuals(q_IB, q_BS, ref_I, obs_S, n, mounting):
             for j in range(3):
                 H[k, 0, n - 3 + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
                 H[k, 1, n - 3 + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
-    return z, H
+    return z, H, R
 
 
 @njit
-def block_nis(H, P, z, variance):
-    """NIS z_kᵀ S_k⁻¹ z_k of each 2-dim star residual, S_k = H_k P H_kᵀ + σ_k² I₂."""
+def block_nis(H, P, z, R):
+    """NIS z_kᵀ S_k⁻¹ z_k of each 2-dim star residual, S_k = H_k P H_kᵀ + R_k."""
     m = z.shape[0]
     out = np.empty(m)
     for k in range(m):
-        S = mm_t(mm(H[k], P), H[k])
-        S[0, 0] += variance[k]
-        S[1, 1] += variance[k]
+        S = mm_t(mm(H[k], P), H[k]) + R[k]
         det = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
         out[k] = (S[1, 1] * z[k, 0] ** 2 - 2.0 * S[0, 1] * z[k, 0] * z[k, 1] + S[0, 0] * z[k, 1] ** 2) / det
     return out
@@ -323,12 +328,12 @@ def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
 
 
 @njit
-def stars_update(x, P, ref_I, obs_S, variance, gate, model, estimated):
-    """Gated update with identified stars (see :func:`star_residuals`): each star's 2-dof NIS
-    against the prior is compared with ``gate``; the accepted stars update together, then the
-    reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
-    z, H = star_residuals(x[0:4], x[16:20], ref_I, obs_S, P.shape[0], model.mounting)
-    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, variance, gate)
+def stars_update(x, P, ref_I, obs_S, cov_S, gate, model, estimated):
+    """Gated update with identified stars and their covariances in S (see :func:`star_residuals`): each
+    star's 2-dof NIS against the prior is compared with ``gate``; the accepted stars update together, then
+    the reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
+    z, H, R = star_residuals(x[0:4], x[16:20], ref_I, obs_S, cov_S, P.shape[0], model.mounting)
+    nis, accepted, Ha, za, Ra = gate_stars(H, P, z, R, gate)
     if za.shape[0] == 0:
         return x, P, z, nis, accepted
     dx, P_next = joseph_update(P, Ha, Ra, za, estimated)
@@ -336,12 +341,12 @@ def stars_update(x, P, ref_I, obs_S, variance, gate, model, estimated):
 
 
 @njit
-def gate_stars(H, P, z, variance, gate):
+def gate_stars(H, P, z, R, gate):
     """Each star's 2-dof NIS against the prior (:func:`block_nis`) compared with ``gate``; the accepted
     stars stacked into one measurement. Returns (nis (N,), accepted (N,), H (2m, n), z (2m,),
-    R (2m, 2m)) for the m accepted stars."""
+    R (2m, 2m): the accepted stars' 2x2 blocks) for the m accepted stars."""
     n = P.shape[0]
-    nis = block_nis(H, P, z, variance)
+    nis = block_nis(H, P, z, R)
     accepted = nis <= gate
     m = int(np.sum(accepted))
     Ha = np.empty((2 * m, n))
@@ -351,10 +356,11 @@ def gate_stars(H, P, z, variance, gate):
     for k in range(z.shape[0]):
         if accepted[k]:
             for r in range(2):
-                Ha[row] = H[k, r]
-                za[row] = z[k, r]
-                Ra[row, row] = variance[k]
-                row += 1
+                Ha[row + r] = H[k, r]
+                za[row + r] = z[k, r]
+                for c in range(2):
+                    Ra[row + r, row + c] = R[k, r, c]
+            row += 2
     return nis, accepted, Ha, za, Ra
 
 
@@ -426,16 +432,16 @@ def run_fixes(x, P, omega, ratio, dt, model, estimated, q_meas, R_S, gate, avail
 
 
 @njit
-def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, ref_I, obs_S, variance, gate, available):
+def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, ref_I, obs_S, cov_S, gate, available):
     """:func:`run_fixes` with star vectors: frame f updates with the stars offsets[f]:offsets[f+1]
-    of ``ref_I``/``obs_S``/``variance`` (:func:`stars_update`)."""
+    of ``ref_I``/``obs_S``/``cov_S`` (:func:`stars_update`)."""
     n_frames = available.shape[0]
     x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
     for f in range(n_frames):
         x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
         lo, hi = offsets[f], offsets[f + 1]
         if available[f] and hi > lo:
-            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], variance[lo:hi], gate, model,
+            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], cov_S[lo:hi], gate, model,
                                                   estimated)
             n_meas[f] = hi - lo
             n_acc[f], nis_log[f], dof_log[f], innov_log[f] = star_statistics(z, nis, accepted)

@@ -228,19 +228,22 @@ class NavFilter:
                                                         self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
-    def update_stars(self, ref_I, obs_S, sigma):
+    def update_stars(self, ref_I, obs_S, cov_S):
         """Update with identified stars: catalog unit vectors ``ref_I`` (N, 3) in ICRS, measured unit
-        vectors ``obs_S`` (N, 3) in S, direction σ (N,) or scalar [rad]; each star a 2-dof residual gated
-        alone (:func:`celestial_kernels.stars_update`). The catalog directions are made apparent with
-        the filter's own velocity and the ephemeris when the processing corrects aberration."""
+        vectors ``obs_S`` (N, 3) in S and their covariances ``cov_S`` (N, 3, 3) [rad², S]; each star a 2-dof
+        residual gated alone (:func:`celestial_kernels.stars_update`). The catalog directions are made
+        apparent with the filter's own velocity and the ephemeris when the processing corrects aberration."""
         j = self._frame()
         ref_I = np.ascontiguousarray(ref_I, dtype=float)
         if self.star_sensor.correct_aberration:
             ref_I = np.ascontiguousarray(aberrate(ref_I, self._observer_velocity(j)))
-        variance = (self.sigma_scale**2 * np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (ref_I.shape[0],))).copy()
+        cov = np.asarray(cov_S, dtype=float)
+        if cov.shape != (ref_I.shape[0], 3, 3):
+            raise ValueError(f"star covariances must have shape ({ref_I.shape[0]}, 3, 3), got {cov.shape}")
         z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                           self.star_sensor.orientation.q_ie[j], ref_I,
-                                                          np.ascontiguousarray(obs_S, dtype=float), variance,
+                                                          np.ascontiguousarray(obs_S, dtype=float),
+                                                          np.ascontiguousarray(self.sigma_scale**2 * cov),
                                                           self.gates[2], self.estimated)
         return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
 

@@ -22,6 +22,7 @@ def attitude_filter():
     filt.predict(np.zeros((5, 3)), 0.01)
     q_IS, _ = filt.sensor_prediction(np.zeros(3))
     ref_I = rot.rotate(q_IS, np.array([[0.0, 0.0, 1.0], [0.1, 0.0, 1.0], [0.0, 0.1, 1.0]]) / np.sqrt([[1.0], [1.01], [1.01]]))
-    filt.update_stars(ref_I, rot.rotate(rot.conjugate(q_IS), ref_I), np.full(3, 1e-5)).statistics()
+    obs_S = rot.rotate(rot.conjugate(q_IS), ref_I)
+    filt.update_stars(ref_I, obs_S, np.full((3, 3, 3), 1e-10) * (np.eye(3) - obs_S[:, :, None] * obs_S[:, None, :])).statistics()
     filt.update_attitude(q_IS, np.eye(3) * 1e-10).statistics()
     nees(filt.P[None, :6, :6], np.zeros((1, 6)))

@@ -50,10 +50,11 @@ from startrack import rotation as rot
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
-#: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity: the identifier's
-#: (the INS's kernels compile at first call).
+#: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity: the identifier's and
+#: the position fit's (the INS's kernels compile at first call).
 IMAGE_LANES = (("startrack.identify.warmup:pattern_search",),
-               ("navsim.sensors.warmup:inertial_sensors", "startrack.identify.warmup:star_tracking"))
+               ("navsim.sensors.warmup:inertial_sensors", "startrack.identify.warmup:star_tracking",
+                "startrack.warmup:psf_fit"))
 #: Without a star sensor or at vector fidelity: one lane (a campaign's parent compiles it once for its workers).
 VECTOR_LANES = (("navsim.navigation.warmup:run",),)
 

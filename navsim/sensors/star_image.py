@@ -17,10 +17,11 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    stacked over the last 4 frames (shifted-window superposition, eq. 13-18 of 004), its centroid
    corrected by the sub-pixel phases the predictions give (an extension of 004: integer shifts alone
    leave ~0.25 px per axis);
-5. one unit vector per identified star with the σ its detection gives (pixel noise propagated through
-   the centroid, and the pixel grid: it grows with the smear), the stacked dim star last with its own
-   measured σ; the identification's attitude for a re-initialisation when it came from the sub-catalog
-   or full sky.
+5. one unit vector per identified star, its position fitted at the Cramér-Rao bound with the smear the
+   predicted rate gives (:mod:`startrack.psf_fit`) and its 2 x 2 covariance carried into the sensor frame
+   (correlated along the trail; an outlier's scaled by its measured χ²/dof, a star cut by the frame's
+   border or whose fit failed not fused), the stacked dim star last with its own measured σ; the
+   identification's attitude for a re-initialisation when it came from the sub-catalog or full sky.
 
 Faults acting on the sensor (outages, dropped frames, false-star storms) are applied here; the
 tracking state follows the filter's verdict (:meth:`ImageRun.after_update`).
@@ -32,10 +33,11 @@ import numpy as np
 
 from navsim import kinematics
 from navsim.earth.apparent import field_stars
-from navsim.sensors.star_sensor import MODE_CODE, StarFrame
+from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covariance
 from startrack import rotation as rot
 from startrack.detection import detect, detect_windows
 from startrack.identify.identifier import Prior
+from startrack.psf_fit import PixelNoise, concatenate, fit_stars
 from startrack.render import Windows, cosmic_ray, render_star_field
 from startrack.stacking import DimStarCache
 
@@ -147,22 +149,24 @@ class ImageRun:
                 or request.index in self._full_frames)
         image, windows, found = self._read(request, q_IS_true, uv_pred[predicted], full)
         result = s.identifier.solve(found.uv, found.flux, prior=self._prior(request, info))
-        ref_I, obs_S, detected, mode, reason = self._identified(result, found, uv_pred, predicted)
+        ref_I, _, detected, mode, reason = self._identified(result, found, uv_pred, predicted)
+        fits = self._fit(image, windows, found.uv[detected], ref_I, request)
+        ref_I, uv, cov_uv = ref_I[fits.usable], fits.uv[fits.usable], fits.cov[fits.usable]
+        obs_S, cov_S = s.camera.unproject(uv), s.camera.unproject_covariance(uv, cov_uv)
         info |= {"n_detected": len(found), "n_identified": len(ref_I), "id_ms": result.solve_ms}
-        diagnostics = {"q_IS_true": q_IS_true, "detections": found}
+        diagnostics = {"q_IS_true": q_IS_true, "detections": found, "fits": fits}
         stacked = self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I)) if self._stacks(predicted) else None
-        sigma = np.sqrt(0.5 * (found.sigma_u[detected] ** 2 + found.sigma_v[detected] ** 2)) / s.camera.focal_px
         if stacked is not None:
             stacked["uv_true"] = s.camera.project(q_IS_true, s.stars_I[stacked["index"]][None])[0][0]
             diagnostics["stacked"] = stacked
             ref_I, obs_S = np.vstack([ref_I, stacked["ref_I"]]), np.vstack([obs_S, stacked["obs_S"]])
-            sigma = np.append(sigma, stacked["sigma"])
+            cov_S = np.concatenate([cov_S, isotropic_covariance(stacked["obs_S"][None], stacked["sigma"])])
             mode, reason = "stacked", f"{len(ref_I) - 1} stars and the stacked dim star HIP {stacked['hip']}"
         if not len(ref_I):
             mode = "no_fix"
         if self.sample is None and full and (request.index >= self._sample_at or request.index == self._last):
             self.sample = _sample_frame(image, found, result)
-        return StarFrame(mode=mode, reason=reason, ref_I=ref_I, obs_S=obs_S, sigma=sigma,
+        return StarFrame(mode=mode, reason=reason, ref_I=ref_I, obs_S=obs_S, cov_S=cov_S,
                          n_stacked=int(stacked is not None),
                          fix_q_IS=result.q_IS if mode in ("subcatalog", "lost_in_space") else None,
                          info=info | {"mode": MODE_CODE[mode], "n_stacked": int(stacked is not None)},
@@ -204,6 +208,26 @@ class ImageRun:
             found = _unique(detect_windows(frame.image, windows.row0, windows.col0, b, sigma_n, a=s.detection_sigmas,
                                            saturation_dn=model.saturation_dn))
         return frame.image, windows, found
+
+    def _fit(self, image, windows, uv, ref_I, request):
+        """The PSF fits (:func:`startrack.psf_fit.fit_stars`) of the identified stars' detections ``uv`` (N, 2)
+        in the full frame or in the readout window holding each, with the smear the predicted attitude and
+        rate give each star over the exposure: positions at the Cramér-Rao bound with their covariance."""
+        s, model = self.sensor, self.sensor.model
+        half_exposure = 0.5 * model.exposure_s
+        track = s.camera.angular_velocity_track(request.q_IS_pred, request.omega_S_pred, (-half_exposure, half_exposure),
+                                                ref_I)
+        smear = np.nan_to_num(track[:, 1] - track[:, 0])
+        noise = PixelNoise(model.noise_dn, gain_e_per_dn=model.gain_e_per_dn)
+        common = {"psf_sigma_px": model.psf_sigma_px, "noise": noise, "background_dn": model.background_dn,
+                  "saturation_dn": model.saturation_dn}
+        if windows is None:
+            return fit_stars(image, uv, smear_px=smear, **common)
+        centres = np.stack([windows.col0, windows.row0], axis=1) + 0.5 * (windows.size - 1)
+        holder = np.argmin(np.abs(uv[:, None, :] - centres[None]).max(axis=2), axis=1) if len(uv) else np.zeros(0, int)
+        fits = [fit_stars(image[w], uv[k:k + 1], smear_px=smear[k], origin=(windows.row0[w], windows.col0[w]), **common)
+                for k, w in enumerate(holder)]
+        return concatenate(fits) if fits else fit_stars(image[0], np.zeros((0, 2)), **common)
 
     def _false_stars(self, t):
         """Cosmic-ray tracks of a false-star storm at t [s] (none outside a storm)."""

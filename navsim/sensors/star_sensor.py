@@ -6,7 +6,7 @@ shared by the runs of a batch. ``sensor.start(seed, ...)`` returns the run's own
 which answers three calls:
 
 - ``observe(request) -> StarFrame``: the frame's measurements (identified star vectors with their
-  σ, or an attitude fix), the mode used, counts, timings and the diagnostics observers read;
+  covariances, or an attitude fix), the mode used, counts, timings and the diagnostics observers read;
 - ``after_update(update)``: the filter's verdict on the frame (tracking continues while it accepts
   the stars), ``None`` when nothing was fused;
 - ``lose_track()``: the estimate was knocked off (attitude-jump fault), start acquiring again.
@@ -29,6 +29,14 @@ MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage
 MODE_CODE = {name: code for code, name in enumerate(MODES)}
 
 
+def isotropic_covariance(obs_S, sigma):
+    """The covariances (N, 3, 3) of unit vectors ``obs_S`` (N, 3) measured with the same σ [rad] on each axis
+    of their tangent plane: σ² (I − s sᵀ) (``sigma`` a number or one per vector)."""
+    obs_S = np.asarray(obs_S, dtype=float)
+    sigma2 = np.broadcast_to(np.asarray(sigma, dtype=float) ** 2, (len(obs_S),))
+    return sigma2[:, None, None] * (np.eye(3) - obs_S[:, :, None] * obs_S[:, None, :])
+
+
 @dataclass(frozen=True)
 class FrameRequest:
     """What the loop knows at a frame: its index and time [s], the truth record of the frame (for
@@ -45,8 +53,9 @@ class FrameRequest:
 
 @dataclass(frozen=True)
 class StarFrame:
-    """One frame's output. Measurements: ``ref_I``/``obs_S`` (N, 3) with direction σ (N,) [rad]
-    (a stacked dim star last, counted by ``n_stacked``), or an attitude fix ``q_IS`` with covariance
+    """One frame's output. Measurements: ``ref_I``/``obs_S`` (N, 3) with the covariance of each measured
+    direction ``cov_S`` (N, 3, 3) [rad², sensor axes] (a stacked dim star last, counted by ``n_stacked``),
+    or an attitude fix ``q_IS`` with covariance
     ``R_S`` in sensor axes. ``fix_q_IS``: the attitude of a sub-catalog or full-sky identification,
     from which the filter may be re-initialised when it rejects the stars (a lost track).
     ``info``: the per-frame log quantities (``log_fields``); ``diagnostics``: what observers read
@@ -57,7 +66,7 @@ class StarFrame:
     reason: str = ""
     ref_I: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     obs_S: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    cov_S: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
     n_stacked: int = 0
     q_IS: np.ndarray | None = None
     R_S: np.ndarray | None = None
@@ -72,8 +81,13 @@ class StarFrame:
         if self.q_IS is not None:
             return (("attitude", (self.q_IS, self.R_S)),)
         if len(self.ref_I):
-            return (("stars", (self.ref_I, self.obs_S, self.sigma)),)
+            return (("stars", (self.ref_I, self.obs_S, self.cov_S)),)
         return ()
+
+    @property
+    def sigma(self):
+        """Each star's direction σ [rad]: the RMS of its covariance's two tangent axes, √(tr C / 2)."""
+        return np.sqrt(0.5 * np.trace(self.cov_S, axis1=1, axis2=2))
 
     @property
     def measurements(self):

@@ -22,7 +22,7 @@ import numpy as np
 
 from navsim.earth.apparent import fix_rotation
 from navsim.sensors.recorded_run import RecordedRun
-from navsim.sensors.star_sensor import StarFrame
+from navsim.sensors.star_sensor import StarFrame, isotropic_covariance
 from startrack import rotation as rot
 from startrack.aberration import aberrate
 
@@ -151,6 +151,10 @@ class Record:
     stars: StarFrames | None = None
     sigma: float = 0.0
 
+    def covariances(self):
+        """The covariance of every star of every frame (M, 3, 3) [rad², S]: isotropic, σ on each tangent axis."""
+        return isotropic_covariance(self.stars.obs_S, self.sigma)
+
 
 class VectorRun(RecordedRun):
     """The per-run sensor of :class:`StarVectorSensor` and :class:`AttitudeFixSensor`: it reads its
@@ -165,4 +169,4 @@ class VectorRun(RecordedRun):
         ref_I, obs_S, _ = r.stars.frame(j)
         if not len(ref_I):
             return StarFrame(mode="no_fix")
-        return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, sigma=np.full(len(ref_I), r.sigma))
+        return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, cov_S=isotropic_covariance(obs_S, r.sigma))

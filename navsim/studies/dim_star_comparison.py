@@ -109,7 +109,7 @@ class DimStarRun:
                 self._compare(frame.ref_I[:2], frame.obs_S[:2], stacked, q_IS_true, frame.sigma[0])
         if self._shadow is not None:
             if bright:
-                self._shadow.update_stars(frame.ref_I[:bright], frame.obs_S[:bright], frame.sigma[:bright])
+                self._shadow.update_stars(frame.ref_I[:bright], frame.obs_S[:bright], frame.cov_S[:bright])
             self._shadow_q[request.index] = self._shadow.q
 
     def _compare(self, ref_I, obs_S, stacked, q_IS_true, sigma):

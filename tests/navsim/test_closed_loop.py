@@ -11,7 +11,7 @@ import navsim
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.estimation.updates import UpdateResult
 from navsim.sensors.faults import AttitudeJumps
-from navsim.sensors.star_sensor import MODE_CODE, StarFrame
+from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covariance
 from navsim.simulation import prepare, simulate
 from navsim.truth.profiles import TruthRecord
 from startrack import units
@@ -196,8 +196,8 @@ class _ScriptedSensor:
             return StarFrame(mode="tracking", q_IS=request.q_IS_pred, R_S=np.eye(3), info={"mode": 0})
         if request.index == 2:
             return StarFrame(mode="no_fix", info={"mode": MODE_CODE["no_fix"]})
-        return StarFrame(mode="subcatalog", ref_I=stars, obs_S=stars, sigma=np.ones(3), fix_q_IS=request.q_IS_pred,
-                         info={"mode": MODE_CODE["subcatalog"]})
+        return StarFrame(mode="subcatalog", ref_I=stars, obs_S=stars, cov_S=isotropic_covariance(stars, 1.0),
+                         fix_q_IS=request.q_IS_pred, info={"mode": MODE_CODE["subcatalog"]})
 
     def after_update(self, update):
         self.verdicts.append(None if update is None else update.n_accepted)

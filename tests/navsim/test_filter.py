@@ -13,6 +13,7 @@ import navsim
 from navsim.estimation import kernels, linalg
 from navsim.estimation.analytic import farrenkopf_steady_state
 from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
+from navsim.sensors.star_sensor import isotropic_covariance
 from startrack import rotation as rot
 from startrack import units
 
@@ -246,7 +247,7 @@ def test_one_star_update_only_shrinks_the_two_axes_across_it():
     P0 = np.diag([1e-6] * 3 + [1e-10] * 3)
     filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=1e-5, rrw=1e-8))
     star = np.array([[0.0, 0.0, 1.0]])  # along z_S = z_B
-    result = filt.update_stars(star, star, units.arcsec_to_rad(5.0))
+    result = filt.update_stars(star, star, isotropic_covariance(star, units.arcsec_to_rad(5.0)))
     assert result.n_accepted == 1
     assert filt.P[2, 2] == pytest.approx(1e-6, rel=1e-12)  # rounding level: exactly unobserved in exact arithmetic
     assert filt.P[0, 0] < 1e-8 and filt.P[1, 1] < 1e-8
@@ -259,7 +260,7 @@ def test_two_stars_make_the_attitude_fully_observable():
     sigma = units.arcsec_to_rad(5.0)
     filt = AttitudeFilter([0, 0, 0, 1.0], np.zeros(3), AttitudeFilterConfig(P0=P0, arw=1e-5, rrw=1e-8))
     stars = np.array([[0.0, 0.0, 1.0], [np.sin(0.1), 0.0, np.cos(0.1)]])
-    filt.update_stars(stars, stars, sigma)
+    filt.update_stars(stars, stars, isotropic_covariance(stars, sigma))
     assert np.sqrt(filt.P[2, 2]) == pytest.approx(np.sqrt(2.0) * sigma / np.sin(0.1), rel=0.01)
     assert np.all(np.sqrt(np.diag(filt.P)[:2]) < 1.01 * sigma)
 
@@ -272,7 +273,7 @@ def test_a_star_update_moves_the_estimate_to_the_truth():
     ref_I = np.array([[0, 0, 1.0], [0.1, 0, 1.0], [0, 0.12, 1.0], [-0.08, -0.05, 1.0]])
     ref_I /= np.linalg.norm(ref_I, axis=1, keepdims=True)
     obs_S = rot.rotate(rot.conjugate(q_true), ref_I)
-    filt.update_stars(ref_I, obs_S, units.arcsec_to_rad(0.01))
+    filt.update_stars(ref_I, obs_S, isotropic_covariance(obs_S, units.arcsec_to_rad(0.01)))
     assert units.rad_to_arcsec(np.linalg.norm(rot.attitude_error(filt.q, q_true))) < 0.1
 
 

@@ -89,9 +89,29 @@ def test_edge_saturation_and_an_empty_window_are_flagged():
     saturation = 4000.0
     fits = fit_stars(np.minimum(image, saturation), [[1.2, 12.0], [15.0, 12.0], [20.0, 3.0]], SIGMA, NOISE,
                      BIAS + SKY, saturation_dn=saturation)
-    assert fits.edge[0] and not fits.usable[0]
+    assert fits.edge[0] and fits.usable[0] and np.hypot(*(fits.uv[0] - (1.2, 12.0))) < 5.0 * np.sqrt(np.trace(fits.cov[0]))
     assert fits.saturated[1] and not fits.failed[1] and np.hypot(*(fits.uv[1] - (15.0, 12.0))) < 0.05
     assert fits.failed[2] and not fits.usable[2]  # nothing there: no position, no crash
+
+
+def test_a_star_cut_by_the_border_stays_unbiased():
+    """Centres in the first column (a third to a half of the light outside the frame), 300 draws: the model
+    knows which pixels it has, so the mean error is zero within 3σ of the mean (σ/√300) and the Mahalanobis
+    distance averages 2 within 0.4 (3σ of the mean of 300 χ²(2); measured 1.83-1.88: the covariance at
+    the estimate is slightly wider than the errors across the border)."""
+    rng = np.random.default_rng(8)
+    errors, covariances = [], []
+    for _ in range(300):
+        u, v = rng.uniform(0.0, 0.6), 12.0 + rng.uniform(-0.5, 0.5)
+        image = noisy_frame(rng, (25, 25), [(u, v, 5000.0, (0.0, 0.0))], SIGMA, SKY, READ, GAIN, BIAS)
+        fits = fit_stars(image, [[u + rng.normal(0, 0.2), v + rng.normal(0, 0.2)]], SIGMA, NOISE, BIAS + SKY)
+        assert fits.edge[0] and fits.usable[0]
+        errors.append(fits.uv[0] - (u, v))
+        covariances.append(fits.cov[0])
+    errors, covariances = np.array(errors), np.array(covariances)
+    assert np.all(np.abs(errors.mean(axis=0)) < 3.0 * np.sqrt(covariances[:, [0, 1], [0, 1]].mean(axis=0) / 300))
+    mahalanobis = np.einsum("ni,nij,nj->n", errors, np.linalg.inv(covariances), errors)
+    assert mahalanobis.mean() == pytest.approx(2.0, abs=0.4)
 
 
 def test_a_window_of_the_frame_fits_in_image_coordinates():
