@@ -13,9 +13,11 @@ barycentre x, y), and sep.extract with the known background.
 
 Accuracy against the bound (``accuracy``). 256 x 256 frames of 16 stars on a grid at random sub-pixel
 phases, rendered by :mod:`startrack.render` with a 16-bit sensor (gain 20 e-/DN, full well 2e6 e-: no star
-saturates up to SNR 1000; 0.671 px PSF, read noise 20 e-, dark 2 e- per pixel), each star's flux drawn so
-that its flux SNR N/σ_N (σ_N the bound on the flux) is log-uniform in 5-1000, its smear |Δ| 0, 2, 5 or
-10 px in a random direction. Per (SNR, smear) bin: the RMS error of each estimator over the RMS of the
+saturates up to SNR 1000; 0.671 px PSF, read noise 20 e-, dark 2 e- per pixel), each star's smear |Δ| 0, 2,
+5 or 10 px in a random direction. The charge of each star is log-uniform from SNR 5 to 1000 by either
+definition of the SNR: 004's (eq. 1: the noise-free peak above the background over σ_n, as
+:func:`startrack.detection.detect` reports it) and the flux SNR N/σ_N (the bound on the flux); both
+tables are written. Per (SNR, smear) bin: the RMS error of each estimator over the RMS of the
 bound at the true positions (both axes pooled; 1 is the bound); for the estimators that give a σ, the
 variance of the normalised errors e/σ (1 for an honest σ) and the share beyond 3σ (0.27 % for a Gaussian).
 Estimators: the fit of eq. (1)-(2) of startrack.psf_fit started from the detection where one was found,
@@ -84,6 +86,15 @@ PREDICTION_PX = 0.3
 TRACK_POINTS = 64
 
 
+def peak_snr(uv, electrons, smear, sensor=ACCURACY_SENSOR):
+    """004's SNR (eq. 1) of a star: its noise-free peak above the background over σ_n."""
+    half = int(np.ceil(5 * sensor.psf_sigma_px + 0.5 * np.hypot(*smear))) + 1
+    s = (np.arange(TRACK_POINTS) + 0.5) / TRACK_POINTS - 0.5
+    track = (half + np.asarray(uv) - np.rint(uv)) + s[:, None] * np.asarray(smear)
+    charge = expected_charge(sensor, 2 * half + 1, 2 * half + 1, [Sources(track[None], [electrons], sensor.psf_sigma_px)])
+    return float(charge.max() / sensor.gain_e_per_dn / sensor.noise_dn)
+
+
 def flux_snr(electrons, smear_px, sensor=ACCURACY_SENSOR):
     """N/σ_N of a star of ``electrons`` [e-] with a smear of ``smear_px`` (the bound on the flux, at a pixel centre)."""
     noise = PixelNoise(sensor.noise_dn, gain_e_per_dn=sensor.gain_e_per_dn)
@@ -95,17 +106,28 @@ def flux_snr(electrons, smear_px, sensor=ACCURACY_SENSOR):
     return flux / np.sqrt(np.linalg.inv(J)[2, 2])
 
 
-def _frame_stars(rng, smear_px, electrons_of_snr):
-    """(u, v, electrons, smear (2,)) of the 16 stars of one accuracy frame."""
+def _frame_stars(rng, smear_px, electrons_range):
+    """(u, v, electrons, smear (2,)) of the 16 stars of one accuracy frame, the charge log-uniform in
+    ``electrons_range``."""
     spacing = FRAME_PX / GRID
     stars = []
     for i in range(GRID):
         for j in range(GRID):
             angle = rng.uniform(0.0, np.pi)
-            snr = np.exp(rng.uniform(np.log(SNR_EDGES[0]), np.log(SNR_EDGES[-1])))
+            electrons = np.exp(rng.uniform(*np.log(electrons_range)))
             stars.append((spacing * (j + 0.5) + rng.uniform(-0.5, 0.5), spacing * (i + 0.5) + rng.uniform(-0.5, 0.5),
-                          float(electrons_of_snr(snr)), smear_px * np.array([np.cos(angle), np.sin(angle)])))
+                          float(electrons), smear_px * np.array([np.cos(angle), np.sin(angle)])))
     return stars
+
+
+def _electrons_range(smear_px):
+    """The charge [e-] from the faintest star at SNR 5 to the brightest at SNR 1000, by either definition."""
+    grid = np.logspace(1.0, 8.0, 120)
+    flux = np.array([flux_snr(e, smear_px) for e in grid])
+    peak = np.array([peak_snr((0.0, 0.0), e, (smear_px, 0.0)) for e in grid])
+    low = min(np.interp(np.log(SNR_EDGES[0]), np.log(x), grid) for x in (flux, peak))
+    high = max(np.interp(np.log(SNR_EDGES[-1]), np.log(x), grid) for x in (flux, peak))
+    return low, high
 
 
 def _nearest(uv_found, uv, gate):
@@ -123,16 +145,16 @@ def accuracy(stars_per_bin):
     sensor = ACCURACY_SENSOR
     noise = PixelNoise(sensor.noise_dn, gain_e_per_dn=sensor.gain_e_per_dn)
     sigma, gain, b = sensor.psf_sigma_px, sensor.gain_e_per_dn, sensor.background_dn
-    frames = int(np.ceil(stars_per_bin * (len(SNR_EDGES) - 1) / GRID**2))
-    out = {}
+    out = {"peak_snr": {}, "flux_snr": {}}
     for smear_px in SMEARS_PX:
-        grid = np.logspace(1.0, 7.5, 200)
-        snr_grid = np.array([flux_snr(e, smear_px) for e in grid])
-        electrons_of_snr = lambda snr: np.interp(np.log(snr), np.log(snr_grid), grid)  # noqa: E731
+        electrons_range = _electrons_range(smear_px)
+        decades = np.log10(electrons_range[1] / electrons_range[0])
+        frames = int(np.ceil(stars_per_bin * (len(SNR_EDGES) - 1) * decades / np.log10(SNR_EDGES[-1] / SNR_EDGES[0])
+                             / GRID**2))
         rng = np.random.default_rng(np.random.SeedSequence([27, int(smear_px * 10)]))
         records = []
         for _ in range(frames):
-            stars = _frame_stars(rng, smear_px, electrons_of_snr)
+            stars = _frame_stars(rng, smear_px, electrons_range)
             s = (np.arange(TRACK_POINTS) + 0.5) / TRACK_POINTS - 0.5
             tracks = np.array([[(u + t * d[0], v + t * d[1]) for t in s] for u, v, _, d in stars])
             image = render(sensor, FRAME_PX, FRAME_PX, [Sources(tracks, [e for _, _, e, _ in stars], sigma)], rng)
@@ -140,7 +162,8 @@ def accuracy(stars_per_bin):
             objects = sep.extract(image.astype(float) - b, 5.0, err=sensor.noise_dn, minarea=1) if sep else None
             for u, v, electrons, d in stars:
                 records.append(_star_record(image, found, objects, (u, v), electrons, d, sigma, noise, b, gain, rng))
-        out[f"{smear_px:g}"] = _bin_statistics(records)
+        for snr in out:
+            out[snr][f"{smear_px:g}"] = _bin_statistics(records, snr)
     return out
 
 
@@ -148,7 +171,8 @@ def _star_record(image, found, objects, uv, electrons, smear, sigma, noise, back
     """One star's errors [px] and σ (2,) per estimator, its CRB and flux SNR."""
     uv = np.asarray(uv)
     crb = centroid_bound(uv, electrons / gain, sigma, noise, smear)
-    record = {"snr": flux_snr(electrons, float(np.hypot(*smear))), "crb": np.diag(crb), "errors": {}}
+    record = {"flux_snr": flux_snr(electrons, float(np.hypot(*smear))), "peak_snr": peak_snr(uv, electrons, smear),
+              "crb": np.diag(crb), "errors": {}}
     gate = 1.5 + 0.5 * float(np.hypot(*smear))
     predicted = fit_stars(image, [uv + rng.normal(0.0, PREDICTION_PX, 2)], sigma, noise, background, smear_px=smear)
     if not predicted.failed[0]:
@@ -172,9 +196,10 @@ def _star_record(image, found, objects, uv, electrons, smear, sigma, noise, back
     return record
 
 
-def _bin_statistics(records):
-    """Per SNR bin: stars, detected share, and per estimator RMS/CRB and the normalised errors."""
-    snr = np.array([r["snr"] for r in records])
+def _bin_statistics(records, definition):
+    """Per bin of the SNR ``definition`` (peak_snr, flux_snr): stars, detected share, and per estimator RMS/CRB
+    and the normalised errors."""
+    snr = np.array([r[definition] for r in records])
     out = {}
     for lo, hi in zip(SNR_EDGES[:-1], SNR_EDGES[1:]):
         members = [r for r, x in zip(records, snr) if lo <= x < hi]
@@ -308,9 +333,14 @@ def main(stars_per_bin=300):
     return 0
 
 
-def _print_accuracy(study):
+def _print_accuracy(studies):
+    for definition, study in studies.items():
+        _print_study(definition, study)
+
+
+def _print_study(definition, study):
     names = ("fit_from_detection", "fit_from_prediction", "threshold_centroid", "sep_isophotal", "sep_winpos")
-    print("accuracy against the Cramér-Rao bound: RMS/CRB (normalised variance, share beyond 3σ) per estimator")
+    print(f"accuracy against the Cramér-Rao bound by {definition}: RMS/CRB (normalised variance, share beyond 3σ)")
     print(f"{'smear':>5} {'SNR':>9} {'stars':>5} {'det':>5}  " + "  ".join(f"{n:>24}" for n in names))
     for smear, bins in study.items():
         for snr, row in bins.items():

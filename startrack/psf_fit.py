@@ -36,6 +36,7 @@ its covariance grows with the light lost; pixels at saturation are left out of t
 start and inside its window, is flagged ``failed`` and not used.
 """
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -271,6 +272,12 @@ def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, sat
                       for name in out))
 
 
+@functools.lru_cache(maxsize=4096)
+def _outlier_chi2(dof):
+    """The χ² above which a fit of ``dof`` degrees of freedom is an ``outlier`` (its 99.9 % quantile)."""
+    return float(chi2.ppf(OUTLIER_PROBABILITY, dof))
+
+
 def _fit_one(array, start, drift, sigma, noise, background, saturation_dn, origin, out):
     """Fit one star (:func:`fit_stars`) and append its results to the lists of ``out``."""
     half = half_width(sigma, drift)
@@ -296,7 +303,7 @@ def _fit_one(array, start, drift, sigma, noise, background, saturation_dn, origi
             cov = np.linalg.inv(J)[:2, :2] if not failed else cov
         except np.linalg.LinAlgError:  # no star to fit (the flux collapsed to zero): nothing to estimate
             theta, failed = theta0, True
-    outlier = bool(dof > 0 and not failed and chi2_sum > chi2.ppf(OUTLIER_PROBABILITY, dof))
+    outlier = bool(dof > 0 and not failed and chi2_sum > _outlier_chi2(dof))
     if outlier:
         cov = cov * chi2_sum / dof
     for name, value in (("uv", theta[:2]), ("cov", cov), ("flux", theta[2]), ("background", theta[3]),
