@@ -154,7 +154,11 @@ class ImageRun:
         ref_I, uv, cov_uv = ref_I[fits.usable], fits.uv[fits.usable], fits.cov[fits.usable]
         obs_S, cov_S = s.camera.unproject(uv), s.camera.unproject_covariance(uv, cov_uv)
         info |= {"n_detected": len(found), "n_identified": len(ref_I), "id_ms": result.solve_ms}
-        diagnostics = {"q_IS_true": q_IS_true, "detections": found, "fits": fits}
+        centroided = detected[fits.usable]  # the same stars as 004 measures them: the thresholded centre of gravity
+        diagnostics = {"q_IS_true": q_IS_true, "detections": found, "fits": fits,
+                       "centroids_004": {"obs_S": s.camera.unproject(found.uv[centroided]),
+                                         "sigma": np.hypot(found.sigma_u[centroided], found.sigma_v[centroided])
+                                         / np.sqrt(2.0) / s.camera.focal_px}}
         stacked = self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I)) if self._stacks(predicted) else None
         if stacked is not None:
             stacked["uv_true"] = s.camera.project(q_IS_true, s.stars_I[stacked["index"]][None])[0][0]

@@ -2,8 +2,10 @@
 
 On every frame whose update holds two bright stars and the stacked dim star, the attitude is
 solved from the two bright stars alone (TRIAD) and with the dim star (004's three-star optimal,
-eq. 8-12, unweighted as 004; and the σ-weighted SVD), against the truth in (RA, Dec, roll) and in
-sensor axes, beside the Cramér-Rao bound of both star sets; the stacked centroid is compared with
+eq. 8-12, unweighted as 004; and the σ-weighted SVD), with every star centroided as 004 does (the
+thresholded centre of gravity: the filter itself fuses the bright stars fitted at the Cramér-Rao bound,
+against which a stacked star adds little), against the truth in (RA, Dec, roll) and in sensor axes,
+beside the Cramér-Rao bound of both star sets; the stacked centroid is compared with
 the true star position. With ``star_sensor.image.compare_without_stacking`` a shadow filter, a copy
 of the run's filter at the start, receives every update without the stacked star. The summary
 compares the third star's gain with 004's (TRIAD 11.51/10.10/153.65" against three-star
@@ -105,8 +107,9 @@ class DimStarRun:
         if frame.n_stacked:
             stacked, q_IS_true = frame.diagnostics["stacked"], frame.diagnostics["q_IS_true"]
             self._logs["stacked_uv_error_px"].append(stacked["uv"] - stacked["uv_true"])
-            if bright == 2:
-                self._compare(frame.ref_I[:2], frame.obs_S[:2], stacked, q_IS_true, frame.sigma[0])
+            if bright == 2:  # 004's experiment on 004's centroids (the filter fuses the fits at the bound)
+                centroids = frame.diagnostics["centroids_004"]
+                self._compare(frame.ref_I[:2], centroids["obs_S"][:2], stacked, q_IS_true, centroids["sigma"][0])
         if self._shadow is not None:
             if bright:
                 self._shadow.update_stars(frame.ref_I[:bright], frame.obs_S[:bright], frame.cov_S[:bright])
