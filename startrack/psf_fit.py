@@ -33,7 +33,12 @@ measured χ²/dof (nothing is inflated by a set factor); a window cut by the bor
 readout window) is flagged ``edge`` -- the model knows which pixels it has, so the fit stays unbiased and
 its covariance grows with the light lost; pixels at saturation are left out of the fit and the star flagged
 ``saturated``; a fit that does not converge to a positive flux, within 2 px (and half the smear) of its
-start and inside its window, is flagged ``failed`` and not used.
+start and inside its window, is flagged ``failed`` and not used. A χ² test cannot see every blend: two trails
+of a fast-turning camera overlap pixel for pixel, each faint per pixel, and the fit slides along the pair
+with a χ² that looks like one star's. So a caller who knows where the other sources are (a catalog's
+prediction, the other detections) passes them as ``neighbours``, and a star whose window another source's
+light reaches (its track, smeared like the star's, within 5σ -- where the PSF holds 3e-7 of the light -- of
+the window) is flagged ``blended`` and not used.
 """
 
 import functools
@@ -59,6 +64,9 @@ MAX_STEPS = 30
 MAX_STEP_PX, MAX_SHIFT_PX = 1.0, 2.0
 #: Probability of χ²(dof) below which a fit's residuals are the model's noise (above it: ``outlier``).
 OUTLIER_PROBABILITY = 0.999
+#: Reach of a neighbour's light beyond its track [PSF radii] for the ``blended`` flag (the renderer's extent:
+#: startrack.render.PSF_EXTENT_SIGMA).
+NEIGHBOUR_REACH_SIGMA = 5.0
 
 
 @njit
@@ -221,7 +229,8 @@ def centroid_bound(uv, flux_dn, psf_sigma_px, noise, smear_px=(0.0, 0.0)):
 class StarFits:
     """The fits of N stars: positions ``uv`` (N, 2) [px], their covariance ``cov`` (N, 2, 2) [px²] (J⁻¹ at
     the estimate; an ``outlier``'s scaled by its χ²/dof), ``flux`` and ``background`` [DN], the fit's ``chi2``
-    and ``dof``, and the flags of the module docstring: ``outlier``, ``edge``, ``saturated``, ``failed``."""
+    and ``dof``, and the flags of the module docstring: ``outlier``, ``edge``, ``saturated``, ``failed``,
+    ``blended``."""
 
     uv: np.ndarray
     cov: np.ndarray
@@ -233,15 +242,17 @@ class StarFits:
     edge: np.ndarray
     saturated: np.ndarray
     failed: np.ndarray
+    blended: np.ndarray
 
     def __len__(self):
         return len(self.uv)
 
     @property
     def usable(self):
-        """True for the fits whose position and covariance can be fused: those that converged (a star cut by
-        the border keeps the information of its pixels in the image, and its covariance says so)."""
-        return ~self.failed
+        """True for the fits whose position and covariance can be fused: those that converged alone in their
+        window (a star cut by the border keeps the information of its pixels in the image, and its covariance
+        says so)."""
+        return ~(self.failed | self.blended)
 
 
 def concatenate(fits):
@@ -249,14 +260,16 @@ def concatenate(fits):
     return StarFits(*(np.concatenate([getattr(f, name) for f in fits]) for name in StarFits.__dataclass_fields__))
 
 
-def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, saturation_dn=None, origin=(0, 0)):
+def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, saturation_dn=None, origin=(0, 0),
+              neighbours=None):
     """Fit eq. (1)-(2) to the stars starting at ``uv0`` (N, 2) [px, image coordinates] in ``image`` (2-D [DN],
     its top-left pixel at image row, column ``origin``: a full frame or one readout window).
 
     ``psf_sigma_px`` the PSF radius [px]; ``noise`` a :class:`PixelNoise`; ``background_dn`` the background's
     start value [DN] (fitted per star); ``smear_px`` (N, 2) or (2,) the smear of each star during the exposure
-    [px] (None: none); ``saturation_dn`` the grey level of a saturated pixel (None: none). Returns
-    :class:`StarFits`."""
+    [px] (None: none); ``saturation_dn`` the grey level of a saturated pixel (None: none); ``neighbours`` N
+    arrays (M_k, 2) [px]: the centres of the other sources known near each star, smeared like it (None: none
+    known). Returns :class:`StarFits`."""
     array = np.asarray(image, dtype=float)
     uv0 = np.atleast_2d(np.asarray(uv0, dtype=float)).reshape(-1, 2)
     if array.ndim != 2 or array.size == 0:
@@ -264,12 +277,26 @@ def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, sat
     if not (np.isfinite(psf_sigma_px) and psf_sigma_px > 0.0):
         raise InputError(f"PSF radius {psf_sigma_px!r} px must be a positive number")
     smear = np.zeros((len(uv0), 2)) if smear_px is None else np.broadcast_to(np.asarray(smear_px, float), (len(uv0), 2))
-    out = {name: [] for name in ("uv", "cov", "flux", "background", "chi2", "dof", "outlier", "edge", "saturated", "failed")}
-    for start, drift in zip(uv0, smear):
+    others = [np.zeros((0, 2))] * len(uv0) if neighbours is None else [np.asarray(n, float).reshape(-1, 2) for n in neighbours]
+    if len(others) != len(uv0):
+        raise InputError(f"fit_stars got neighbours for {len(others)} stars but {len(uv0)} stars to fit")
+    out = {name: [] for name in StarFits.__dataclass_fields__}
+    for start, drift, near in zip(uv0, smear, others):
         _fit_one(array, start, drift, float(psf_sigma_px), noise, float(background_dn), saturation_dn, origin, out)
-    return StarFits(*(np.array(out[name], dtype=bool if name in ("outlier", "edge", "saturated", "failed") else float)
+        out["blended"].append(_reached(near, drift, float(psf_sigma_px), start, half_width(psf_sigma_px, drift)))
+    flags = ("outlier", "edge", "saturated", "failed", "blended")
+    return StarFits(*(np.array(out[name], dtype=bool if name in flags else float)
                       .reshape((len(uv0),) + ((2,) if name == "uv" else (2, 2) if name == "cov" else ()))
                       for name in out))
+
+
+def _reached(centres, smear, sigma, start, half):
+    """True when the light of a source centred at one of ``centres`` (M, 2) [px], smeared by ``smear`` [px],
+    reaches within NEIGHBOUR_REACH_SIGMA σ of the fit window of half-width ``half`` around ``start``: the
+    bounding boxes of its track and of the window, grown by that reach, overlap."""
+    reach = half + 0.5 + NEIGHBOUR_REACH_SIGMA * sigma + 0.5 * np.abs(smear)
+    window = np.rint(start)
+    return bool(np.any(np.all(np.abs(centres - window) <= reach, axis=1)))
 
 
 @functools.lru_cache(maxsize=4096)

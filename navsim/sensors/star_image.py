@@ -19,8 +19,9 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    leave ~0.25 px per axis);
 5. one unit vector per identified star, its position fitted at the Cramér-Rao bound with the smear the
    predicted rate gives (:mod:`startrack.psf_fit`) and its 2 x 2 covariance carried into the sensor frame
-   (correlated along the trail; an outlier's scaled by its measured χ²/dof, a star cut by the frame's
-   border or whose fit failed not fused), the stacked dim star last with its own measured σ; the
+   (correlated along the trail; an outlier's scaled by its measured χ²/dof; a star whose fit failed, or
+   whose window another catalog star's light reaches -- a blend, which overlapping trails of a turning
+   camera hide from the χ² -- not fused), the stacked dim star last with its own measured σ; the
    identification's attitude for a re-initialisation when it came from the sub-catalog or full sky.
 
 Faults acting on the sensor (outages, dropped frames, false-star storms) are applied here; the
@@ -63,8 +64,9 @@ class ImageStarSensor:
     camera and detector model, the identifier over the navigation catalog, the stars drawn into the
     frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n,
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
-    tracked (004's set-up), the true mounting and the faults. Each star's direction σ comes from its
-    detection (the centroid σ of :class:`startrack.detection.Detections`)."""
+    tracked (004's set-up), the true mounting and the faults. Each fused star's direction and its
+    covariance come from its position fit (:mod:`startrack.psf_fit`); the drawn stars are also the catalog
+    the fit's neighbours come from."""
 
     camera: object
     model: object
@@ -222,16 +224,33 @@ class ImageRun:
         track = s.camera.angular_velocity_track(request.q_IS_pred, request.omega_S_pred, (-half_exposure, half_exposure),
                                                 ref_I)
         smear = np.nan_to_num(track[:, 1] - track[:, 0])
+        near = self._neighbours(request.q_IS_pred, ref_I, np.abs(smear).max(initial=0.0))
         noise = PixelNoise(model.noise_dn, gain_e_per_dn=model.gain_e_per_dn)
         common = {"psf_sigma_px": model.psf_sigma_px, "noise": noise, "background_dn": model.background_dn,
                   "saturation_dn": model.saturation_dn}
         if windows is None:
-            return fit_stars(image, uv, smear_px=smear, **common)
+            return fit_stars(image, uv, smear_px=smear, neighbours=near, **common)
         centres = np.stack([windows.col0, windows.row0], axis=1) + 0.5 * (windows.size - 1)
         holder = np.argmin(np.abs(uv[:, None, :] - centres[None]).max(axis=2), axis=1) if len(uv) else np.zeros(0, int)
-        fits = [fit_stars(image[w], uv[k:k + 1], smear_px=smear[k], origin=(windows.row0[w], windows.col0[w]), **common)
-                for k, w in enumerate(holder)]
+        fits = [fit_stars(image[w], uv[k:k + 1], smear_px=smear[k], origin=(windows.row0[w], windows.col0[w]),
+                          neighbours=near[k:k + 1], **common) for k, w in enumerate(holder)]
         return concatenate(fits) if fits else fit_stars(image[0], np.zeros((0, 2)), **common)
+
+    def _neighbours(self, q_IS_pred, ref_I, smear_px):
+        """For each identified star of catalog direction ``ref_I`` (N, 3), the predicted centres (M, 2) [px] of
+        the other catalog stars drawn into the frame that lie near the image (``smear_px`` the largest smear
+        [px]): what the sensor's catalog knows lies beside it, for the fit's ``blended`` flag. A catalog star
+        within 1 px of the star's own prediction is the star itself."""
+        s = self.sensor
+        margin = 8.0 * s.model.psf_sigma_px + 2.0 * smear_px + 3.0  # the fit's reach (startrack.psf_fit._reached)
+        index = s.camera.stars_in_field(q_IS_pred, s.stars_I, margin_px=margin)
+        field = s.camera.project(q_IS_pred, s.stars_I[index])[0]
+        own = s.camera.project(q_IS_pred, ref_I)[0] if len(ref_I) else np.zeros((0, 2))
+        near = []
+        for p in own:
+            d = np.hypot(*(field - p).T)
+            near.append(np.delete(field, np.argmin(d), axis=0) if d.size and d.min() < 1.0 else field)
+        return near
 
     def _false_stars(self, t):
         """Cosmic-ray tracks of a false-star storm at t [s] (none outside a storm)."""

@@ -9,7 +9,7 @@ per star, brightest first, or JSON.  The same detection, with the same options
 With ``--psf-sigma-px`` each star's position is then fitted at the Cramér-Rao bound with its 2 x 2
 covariance (:mod:`startrack.psf_fit`: the Gaussian PSF of that radius, the smear ``--smear-px`` and the
 star's shot noise through ``--gain-e-per-dn`` when given), flagged when the model does not explain its
-pixels (outlier, edge, saturated, failed).
+pixels (outlier, edge, saturated, failed) or another detection's light reaches its window (blended).
 """
 
 import json
@@ -98,13 +98,17 @@ def fit_options(args):
 
 
 def fit_frame(frame, found, options):
-    """:func:`startrack.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`)."""
+    """:func:`startrack.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`),
+    each detection's neighbours the others: a star whose window another detection's light reaches is ``blended``."""
+    import numpy as np
+
     from startrack.psf_fit import PixelNoise, fit_stars
 
     sigma, gain, smear = options
     noise = PixelNoise(found.sigma_n, gain_e_per_dn=gain)
+    others = [np.delete(found.uv, i, axis=0) for i in range(len(found))]
     return fit_stars(frame.image, found.uv, sigma, noise, found.background, smear_px=smear,
-                     saturation_dn=frame.full_scale)
+                     saturation_dn=frame.full_scale, neighbours=others)
 
 
 def _fit_dict(fits, i):
@@ -114,7 +118,7 @@ def _fit_dict(fits, i):
 
 
 #: The flags of a position fit (startrack.psf_fit).
-FIT_FLAGS = ("outlier", "edge", "saturated", "failed")
+FIT_FLAGS = ("outlier", "edge", "saturated", "failed", "blended")
 
 
 def register(subparsers):
