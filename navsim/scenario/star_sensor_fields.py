@@ -41,7 +41,7 @@ STAR_SENSOR = {
             "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
                                       doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
             "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0, maximum=100.0,
-                                       doc="centroid error the identification assumes (its gates); the filter takes each star's σ from its detection"),
+                                       doc="centroid error the identification assumes (its gates); the filter takes each star's covariance from its position fit"),
             "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
                                 doc="n_d of the navigation catalog (eq. 1-2 of 000)"),
             "catalog_max_pointing_error_deg": Value("float", default=2.0, exclusive_minimum=0.0,

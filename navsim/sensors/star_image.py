@@ -243,8 +243,9 @@ class ImageRun:
         within 1 px of the star's own prediction is the star itself."""
         s = self.sensor
         margin = 8.0 * s.model.psf_sigma_px + 2.0 * smear_px + 3.0  # the fit's reach (startrack.psf_fit._reached)
-        index = s.camera.stars_in_field(q_IS_pred, s.stars_I, margin_px=margin)
-        field = s.camera.project(q_IS_pred, s.stars_I[index])[0]
+        boresight_I = rot.rotate(q_IS_pred, np.array([0.0, 0.0, 1.0]))
+        cone = s.stars_I[s.stars_I @ boresight_I > np.cos(s.field_radius + margin / s.camera.focal_px)]
+        field = s.camera.project(q_IS_pred, cone[s.camera.stars_in_field(q_IS_pred, cone, margin_px=margin)])[0]
         own = s.camera.project(q_IS_pred, ref_I)[0] if len(ref_I) else np.zeros((0, 2))
         near = []
         for p in own:
