@@ -283,20 +283,21 @@ def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, sat
     out = {name: [] for name in StarFits.__dataclass_fields__}
     for start, drift, near in zip(uv0, smear, others):
         _fit_one(array, start, drift, float(psf_sigma_px), noise, float(background_dn), saturation_dn, origin, out)
-        out["blended"].append(_reached(near, drift, float(psf_sigma_px), start, half_width(psf_sigma_px, drift)))
+        out["blended"].append(bool(np.any(np.all(np.abs(near - np.rint(start)) <= neighbour_reach(psf_sigma_px, drift),
+                                                 axis=1))))
     flags = ("outlier", "edge", "saturated", "failed", "blended")
     return StarFits(*(np.array(out[name], dtype=bool if name in flags else float)
                       .reshape((len(uv0),) + ((2,) if name == "uv" else (2, 2) if name == "cov" else ()))
                       for name in out))
 
 
-def _reached(centres, smear, sigma, start, half):
-    """True when the light of a source centred at one of ``centres`` (M, 2) [px], smeared by ``smear`` [px],
-    reaches within NEIGHBOUR_REACH_SIGMA σ of the fit window of half-width ``half`` around ``start``: the
-    bounding boxes of its track and of the window, grown by that reach, overlap."""
-    reach = half + 0.5 + NEIGHBOUR_REACH_SIGMA * sigma + 0.5 * np.abs(smear)
-    window = np.rint(start)
-    return bool(np.any(np.all(np.abs(centres - window) <= reach, axis=1)))
+def neighbour_reach(psf_sigma_px, smear_px):
+    """(2,) [px]: how far from the centre of a star's fit window, per axis, the centre of another source smeared
+    like it (``smear_px`` (Δu, Δv)) may lie and still send light into the window -- its track within
+    NEIGHBOUR_REACH_SIGMA σ of the window: the bounding boxes of the track and of the window, grown by that
+    reach, overlap (the ``blended`` flag)."""
+    smear = np.asarray(smear_px, dtype=float)
+    return half_width(psf_sigma_px, smear) + 0.5 + NEIGHBOUR_REACH_SIGMA * psf_sigma_px + 0.5 * np.abs(smear)
 
 
 @functools.lru_cache(maxsize=4096)

@@ -38,7 +38,7 @@ from navsim.estimation import kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
 from navsim.estimation.treatments import TREATMENTS
-from navsim.estimation.updates import UpdateResult
+from navsim.estimation.updates import UpdateResult, star_covariances
 from startrack import rotation as rot
 from startrack.errors import InputError
 
@@ -194,16 +194,9 @@ class AttitudeFilter:
         ref_I = np.ascontiguousarray(ref_I, dtype=float)
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
         self._x, self._P, z, nis, accepted = kernels.stars_update(
-            self._x, self._P, ref_I, obs_S, self._covariance(cov_S, ref_I.shape[0]), self.gate[2], self.model,
+            self._x, self._P, ref_I, obs_S, star_covariances(cov_S, ref_I.shape[0], self.variance_scale), self.gate[2], self.model,
             self.estimated)
         return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
-
-    def _covariance(self, cov_S, count):
-        """The stars' covariances (count, 3, 3) scaled by the tuning factor (``measurement_noise_scale``²)."""
-        cov = np.asarray(cov_S, dtype=float)
-        if cov.shape != (count, 3, 3):
-            raise ValueError(f"star covariances must have shape ({count}, 3, 3), got {cov.shape}")
-        return np.ascontiguousarray(self.variance_scale * cov)
 
     def reinitialise(self, q_IS):
         """Restart the attitude from a sensor fix q_IS after a lost track: q_IB = q_IS ⊗ q_BS⁻¹, the
@@ -243,7 +236,7 @@ class AttitudeFilter:
             out = kernels.run_stars(self._x, self._P, omega, ratio, dt, self.model, self.estimated,
                                     stars.offsets.astype(np.int64),
                                     np.ascontiguousarray(stars.ref_I), np.ascontiguousarray(stars.obs_S),
-                                    self._covariance(record.covariances(), len(stars.ref_I)), self.gate[2], available)
+                                    star_covariances(record.covariances(), len(stars.ref_I), self.variance_scale), self.gate[2], available)
         x_log, P_log = out[0], out[1]
         self._x, self._P = x_log[-1].copy(), P_log[-1].copy()
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[2:]))

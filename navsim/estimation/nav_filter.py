@@ -33,7 +33,7 @@ from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
 from navsim.estimation.treatments import TREATMENTS
-from navsim.estimation.updates import UpdateResult
+from navsim.estimation.updates import UpdateResult, star_covariances
 from navsim.ins import strapdown
 from startrack import rotation as rot
 from startrack.aberration import aberrate
@@ -237,13 +237,10 @@ class NavFilter:
         ref_I = np.ascontiguousarray(ref_I, dtype=float)
         if self.star_sensor.correct_aberration:
             ref_I = np.ascontiguousarray(aberrate(ref_I, self._observer_velocity(j)))
-        cov = np.asarray(cov_S, dtype=float)
-        if cov.shape != (ref_I.shape[0], 3, 3):
-            raise ValueError(f"star covariances must have shape ({ref_I.shape[0]}, 3, 3), got {cov.shape}")
         z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                           self.star_sensor.orientation.q_ie[j], ref_I,
                                                           np.ascontiguousarray(obs_S, dtype=float),
-                                                          np.ascontiguousarray(self.sigma_scale**2 * cov),
+                                                          star_covariances(cov_S, ref_I.shape[0], self.sigma_scale**2),
                                                           self.gates[2], self.estimated)
         return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
 

@@ -13,6 +13,15 @@ import numpy as np
 from navsim.estimation import kernels
 
 
+def star_covariances(cov_S, count, scale=1.0):
+    """The covariances (count, 3, 3) [rad², S] of a star update's measured directions, checked and times
+    ``scale`` (a filter's tuning factor, ``measurement_noise_scale``²), contiguous for the kernels."""
+    cov = np.asarray(cov_S, dtype=float)
+    if cov.shape != (count, 3, 3):
+        raise ValueError(f"star covariances must have shape ({count}, 3, 3), got {cov.shape}")
+    return np.ascontiguousarray(scale * cov)
+
+
 @dataclass(frozen=True)
 class UpdateResult:
     """Outcome of one measurement update: innovations z (one row per measurement), NIS per

@@ -9,6 +9,7 @@ import numpy as np
 
 from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
 from navsim.estimation.consistency import nees
+from navsim.sensors.star_sensor import isotropic_covariance
 from startrack import rotation as rot
 
 
@@ -23,6 +24,6 @@ def attitude_filter():
     q_IS, _ = filt.sensor_prediction(np.zeros(3))
     ref_I = rot.rotate(q_IS, np.array([[0.0, 0.0, 1.0], [0.1, 0.0, 1.0], [0.0, 0.1, 1.0]]) / np.sqrt([[1.0], [1.01], [1.01]]))
     obs_S = rot.rotate(rot.conjugate(q_IS), ref_I)
-    filt.update_stars(ref_I, obs_S, np.full((3, 3, 3), 1e-10) * (np.eye(3) - obs_S[:, :, None] * obs_S[:, None, :])).statistics()
+    filt.update_stars(ref_I, obs_S, isotropic_covariance(obs_S, 1e-5)).statistics()
     filt.update_attitude(q_IS, np.eye(3) * 1e-10).statistics()
     nees(filt.P[None, :6, :6], np.zeros((1, 6)))

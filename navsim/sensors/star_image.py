@@ -38,7 +38,7 @@ from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covarianc
 from startrack import rotation as rot
 from startrack.detection import detect, detect_windows
 from startrack.identify.identifier import Prior
-from startrack.psf_fit import PixelNoise, concatenate, fit_stars
+from startrack.psf_fit import PixelNoise, concatenate, fit_stars, neighbour_reach
 from startrack.render import Windows, cosmic_ray, render_star_field
 from startrack.stacking import DimStarCache
 
@@ -242,7 +242,7 @@ class ImageRun:
         [px]): what the sensor's catalog knows lies beside it, for the fit's ``blended`` flag. A catalog star
         within 1 px of the star's own prediction is the star itself."""
         s = self.sensor
-        margin = 8.0 * s.model.psf_sigma_px + 2.0 * smear_px + 3.0  # the fit's reach (startrack.psf_fit._reached)
+        margin = float(neighbour_reach(s.model.psf_sigma_px, (smear_px, smear_px)).max())
         boresight_I = rot.rotate(q_IS_pred, np.array([0.0, 0.0, 1.0]))
         cone = s.stars_I[s.stars_I @ boresight_I > np.cos(s.field_radius + margin / s.camera.focal_px)]
         field = s.camera.project(q_IS_pred, cone[s.camera.stars_in_field(q_IS_pred, cone, margin_px=margin)])[0]

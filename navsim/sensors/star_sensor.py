@@ -85,11 +85,6 @@ class StarFrame:
         return ()
 
     @property
-    def sigma(self):
-        """Each star's direction σ [rad]: the RMS of its covariance's two tangent axes, √(tr C / 2)."""
-        return np.sqrt(0.5 * np.trace(self.cov_S, axis1=1, axis2=2))
-
-    @property
     def measurements(self):
         """((kind, arguments of the filter's update), ...) of the frame: the star sensor's, then ``aiding``."""
         return self.star_measurements + self.aiding

@@ -28,7 +28,7 @@ def test_run_writes_summary_and_timeseries(tmp_path):
     for key in ("scenario", "seed", "duration_s", "attitude_error_rms_arcsec", "cross_boresight_rms_arcsec",
                 "roll_rms_arcsec", "bias_error_final_deg_per_h", "nees", "updates", "timing"):
         assert key in summary
-    assert summary["timing"]["wall_seconds"] > 0
+    assert "wall_seconds" in summary["timing"]  # a wall-clock figure, reported not asserted (speed: benchmarks/)
     assert summary["seed"] == 3 and summary["duration_s"] == 5.0
     assert set(summary["nees"]) >= {"mean", "fraction_in_band", "band_95"}
     with np.load(out / "timeseries.npz", allow_pickle=False) as data:
