@@ -5,6 +5,7 @@
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
     navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
     navsim budget SCENARIO.toml --out DIR [--runs N] [--workers W]
+    navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -162,6 +163,44 @@ def _budget(args):
     return 1 if any(row["status"] == "failed" for row in [*budget["parts"], budget["total"]]) else 0
 
 
+def _covariance(args):
+    from navsim.kinds import resolve_scenario, run_kind
+    from navsim.output import write_covariance
+    from navsim.simulation import covariance
+
+    scenario = resolve_scenario(args.scenario, args.set or ())
+    kind = run_kind(scenario, "a covariance analysis")
+    check_output(args.out, "covariance")
+    runs = _campaign_series(args.compare, scenario) if args.compare else None
+    analysis = covariance(scenario, split=args.budget)
+    comparison = analysis.compare(runs) if runs else None
+    out = publish(args.out, "covariance", lambda directory: write_covariance(directory, scenario, analysis, comparison))
+    print("\n".join(kind.covariance_lines(analysis.summary(scenario))))
+    if comparison is not None:
+        print(f"Monte Carlo         {comparison['runs']} runs: {comparison['inside']} of {comparison['checks']} RMS values inside "
+              f"their 95 % band, {comparison['inside_family']} inside the family-wise band")
+    print(f"wall time           {analysis.wall_seconds:.2f} s")
+    print(f"written to          {out}")
+    return 0
+
+
+def _campaign_series(directory, scenario):
+    """The finished runs' series of the campaign ``directory``; an InputError unless it is a campaign of the
+    same scenario with finished runs."""
+    from navsim.campaign.montecarlo import load_runs
+    from navsim.places import output_kind
+
+    if not Path(directory).is_dir() or output_kind(directory) != "campaign":
+        raise InputError(f"--compare {directory}: not a campaign directory (navsim montecarlo --out)")
+    request, finished, _ = load_runs(directory)
+    if request["scenario_data"] != scenario.data:
+        raise InputError(f"--compare {directory}: a campaign of another scenario (or other --set values) than "
+                         f"{scenario.source}")
+    if not finished:
+        raise InputError(f"--compare {directory}: no finished runs")
+    return [series for _, _, series in finished]
+
+
 def build_parser():
     parser = ArgumentParser(prog="navsim", description="INS / star-sensor navigation simulator.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -212,6 +251,16 @@ def build_parser():
     p.add_argument("--seed", type=int, default=None, help="base seed (default: the scenario's)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_budget)
+
+    p = sub.add_parser("covariance", help="linear covariance analysis: the true RMS of every error along the scenario's "
+                                          "nominal trajectory in one pass, the filter's own sigma beside it")
+    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("--out", required=True, help="output directory (summary.json, timeseries.npz)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.add_argument("--budget", action="store_true", help="also split the errors by source (the error budget)")
+    p.add_argument("--compare", metavar="CAMPAIGN_DIR", default=None,
+                   help="check the analysis against a Monte Carlo campaign of the same scenario (comparison.json)")
+    p.set_defaults(func=_covariance)
     return parser
 
 

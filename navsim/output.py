@@ -71,3 +71,16 @@ def write_study(directory, result):
     write_json(directory / "summary.json", result.summary)
     write_npz(directory / "study.npz", result.arrays)
     return directory
+
+
+def write_covariance(directory, scenario, analysis, comparison=None):
+    """Write a covariance analysis into ``directory``: ``scenario.json``, ``summary.json`` (its kind's
+    ``summary``), ``timeseries.npz`` (its ``series``) and, when compared with a Monte Carlo campaign,
+    ``comparison.json``."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    write_json(directory / "scenario.json", scenario.data)
+    write_json(directory / "summary.json", analysis.summary(scenario))
+    write_npz(directory / "timeseries.npz", analysis.series())
+    if comparison is not None:
+        write_json(directory / "comparison.json", comparison)

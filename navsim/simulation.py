@@ -46,6 +46,14 @@ def run(scenario, seed=None, overrides=(), star_catalog=None):
     return dataclasses.replace(result, summary=summary)
 
 
+def covariance(scenario, overrides=(), split=False, star_catalog=None):
+    """The linear covariance analysis of ``scenario`` (a path, a dictionary or a Scenario, with ``overrides``)
+    by its kind: the true RMS of its errors, the filter's σ beside it and, when ``split``, each error source's
+    share (:mod:`navsim.estimation.lincov`)."""
+    scenario = resolve_scenario(scenario, overrides)
+    return run_kind(scenario, "a covariance analysis").covariance_analysis(scenario, split, star_catalog)
+
+
 def run_study(scenario, seed=None, overrides=(), progress=False):
     """Run a static study (a scenario with a ``[study]`` table, :mod:`navsim.studies`); ``seed``
     overrides the scenario's. Returns a :class:`~navsim.studies.StudyResult`."""

@@ -66,13 +66,11 @@ def _chain(H_att, A, mounting, out):
 
 
 @njit
-def fix_update(nav, calib, P, acc, model, q_ie, q_IS, R_S, gate, estimated):
-    """Flush the covariance, then the gated update with a star-sensor attitude fix q_IS (covariance
-    R_S in sensor axes): z = δθ(q_IB, q_IS ⊗ q̂_BS⁻¹) in body axes (:func:`kernels.fix_residual`),
-    H = A (+ R_BS in the mounting columns), R = R_BS R_S R_BSᵀ. Returns (z (3,) [rad], nis, accepted)."""
-    flush(nav, P, acc, model)
-    layout = model.layout
-    z, R_BS, R = fix_residual(inertial_attitude(nav, q_ie), calib[12:16], q_IS, R_S)
+def fix_terms(nav, q_BS, q_ie, q_IS, R_S, layout):
+    """(z (3,) [rad], H (3, n), R (3, 3)) of a star-sensor attitude fix q_IS (covariance R_S in sensor axes)
+    against the navigation state ``nav`` and the mounting estimate q_BS: z = δθ(q_IB, q_IS ⊗ q̂_BS⁻¹) in
+    body axes (:func:`kernels.fix_residual`), H = A (+ R_BS in the mounting columns), R = R_BS R_S R_BSᵀ."""
+    z, R_BS, R = fix_residual(inertial_attitude(nav, q_ie), q_BS, q_IS, R_S)
     H_att = np.zeros((3, 6))
     for i in range(3):
         H_att[i, i] = 1.0
@@ -80,25 +78,42 @@ def fix_update(nav, calib, P, acc, model, q_ie, q_IS, R_S, gate, estimated):
             H_att[i, 3 + j] = R_BS[i, j]
     H = np.empty((3, layout.n))
     _chain(H_att, attitude_jacobian(nav, layout.n), layout.mounting, H)
-    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, layout)
+    return z, H, R
+
+
+@njit
+def fix_update(nav, calib, P, acc, model, q_ie, q_IS, R_S, gate, estimated):
+    """Flush the covariance, then the gated update with a star-sensor attitude fix q_IS (covariance
+    R_S in sensor axes) of :func:`fix_terms`. Returns (z (3,) [rad], nis, accepted)."""
+    flush(nav, P, acc, model)
+    z, H, R = fix_terms(nav, calib[12:16], q_ie, q_IS, R_S, model.layout)
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return z, nis, accepted
 
 
 @njit
-def stars_update(nav, calib, P, acc, model, q_ie, ref_I, obs_S, cov_S, gate, estimated):
-    """Flush the covariance, then the update with identified stars: catalog directions ``ref_I`` (N, 3)
-    (already apparent: aberrated as the processing sees them), measured ``obs_S`` (N, 3) with their
-    covariances ``cov_S`` (N, 3, 3) [rad², sensor axes]. Each star's tangent-plane residual
-    (:func:`kernels.star_residuals`) with
-    H chained to the navigation error state is gated alone by its 2-dof NIS; the accepted stars
-    update together (Joseph), then the reset. Returns (z (N, 2), nis (N,), accepted (N,))."""
-    flush(nav, P, acc, model)
-    layout = model.layout
-    z, H_att, R = star_residuals(inertial_attitude(nav, q_ie), calib[12:16], ref_I, obs_S, cov_S, 6, True)
+def star_terms(nav, q_BS, q_ie, ref_I, obs_S, cov_S, layout):
+    """(z (N, 2) [rad], H (N, 2, n), R (N, 2, 2)) of identified stars against the navigation state ``nav``
+    and the mounting estimate q_BS: each star's tangent-plane residual (:func:`kernels.star_residuals`)
+    with its H chained to the navigation error state; catalog directions ``ref_I`` (N, 3) (already
+    apparent: aberrated as the processing sees them), measured ``obs_S`` (N, 3), covariances ``cov_S``
+    (N, 3, 3) [rad², sensor axes]."""
+    z, H_att, R = star_residuals(inertial_attitude(nav, q_ie), q_BS, ref_I, obs_S, cov_S, 6, True)
     A = attitude_jacobian(nav, layout.n)
     H = np.empty((z.shape[0], 2, layout.n))
     for k in range(z.shape[0]):
         _chain(H_att[k], A, layout.mounting, H[k])
+    return z, H, R
+
+
+@njit
+def stars_update(nav, calib, P, acc, model, q_ie, ref_I, obs_S, cov_S, gate, estimated):
+    """Flush the covariance, then the update with identified stars (:func:`star_terms`): each star gated
+    alone by its 2-dof NIS; the accepted stars update together (Joseph), then the reset.
+    Returns (z (N, 2), nis (N,), accepted (N,))."""
+    flush(nav, P, acc, model)
+    layout = model.layout
+    z, H, R = star_terms(nav, calib[12:16], q_ie, ref_I, obs_S, cov_S, layout)
     nis, accepted, Ha, za, Ra = gate_stars(H, P, z, R, gate)
     if za.shape[0] > 0:
         dx, P_next = joseph_update(P, Ha, Ra, za, estimated)

@@ -39,3 +39,15 @@ def nees_statistics(values, dof, runs=1):
     lo, hi = chi2_band(dof, runs)
     return {"dof": int(dof), "runs": int(runs), "band_95": [float(lo), float(hi)], "mean": float(np.mean(values)),
             "fraction_in_band": float(np.mean((values >= lo) & (values <= hi)))}
+
+
+def mean_square_band(expected, variance, runs, probability=BAND_PROBABILITY):
+    """Two-sided ``probability`` interval of the mean over ``runs`` independent draws of a squared error
+    whose expectation is ``expected`` and variance ``variance`` (arrays alike): the draw taken as a scaled
+    χ² of ν = 2 E²/Var dof (exact for a central Gaussian error of equal variances; Satterthwaite's
+    approximation otherwise, e.g. for |y|² of y ~ N(m, C): E = tr C + |m|², Var = 2 tr C² + 4 mᵀ C m), so
+    the mean is E χ²(runs ν)/(runs ν)."""
+    expected, variance = np.asarray(expected, dtype=float), np.asarray(variance, dtype=float)
+    dof = runs * 2.0 * expected**2 / np.maximum(variance, np.finfo(float).tiny)
+    tail = (1.0 - probability) / 2.0
+    return expected * chi2_quantile(tail, dof) / dof, expected * chi2_quantile(1.0 - tail, dof) / dof

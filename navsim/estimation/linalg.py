@@ -87,6 +87,19 @@ def solve3(A, d):
 
 
 @njit
+def schmidt_gain(P, H, R, estimated):
+    """(K, H P): the Kalman gain K = P Hᵀ (H P Hᵀ + R)⁻¹ with the rows of consider states (not
+    ``estimated``) zero (Schmidt 1966)."""
+    HP = mm(H, P)
+    S = mm_t(HP, H) + R
+    K = mm(HP.T.copy(), inverse_small(S))
+    for i in range(K.shape[0]):
+        if not estimated[i]:
+            K[i, :] = 0.0
+    return K, HP
+
+
+@njit
 def joseph_update(P, H, R, z, estimated):
     """Kalman update of a zero error state: returns (dx, P⁺) with the Joseph form
     P⁺ = (I − KH) P (I − KH)ᵀ + K R Kᵀ, K = P Hᵀ S⁻¹, S = H P Hᵀ + R, symmetrised; the rows of K of
@@ -94,12 +107,7 @@ def joseph_update(P, H, R, z, estimated):
 
     Formed as M = P − K (H P), P⁺ = M − (M Hᵀ) Kᵀ + K R Kᵀ: O(n² m) for m measurements.
     """
-    HP = mm(H, P)
-    S = mm_t(HP, H) + R
-    K = mm(HP.T.copy(), inverse_small(S))
-    for i in range(K.shape[0]):
-        if not estimated[i]:
-            K[i, :] = 0.0
+    K, HP = schmidt_gain(P, H, R, estimated)
     dx = np.zeros(K.shape[0])
     for i in range(K.shape[0]):
         for j in range(z.shape[0]):
@@ -136,3 +144,47 @@ def quadratic_forms(P, e):
             total += y[r] * y[r]
         out[i] = total
     return out
+
+
+@njit
+def _sparse_times(rows, cols, values, B, out):
+    """out = S B for S given by its non-zero triplets (rows, cols, values)."""
+    out[:, :] = 0.0
+    for k in range(values.shape[0]):
+        i, p, a = rows[k], cols[k], values[k]
+        for j in range(B.shape[1]):
+            out[i, j] += a * B[p, j]
+
+
+@njit
+def van_loan(F, q_c, dt):
+    """(Φ, Q_d (S, n, n)) over dt [s] for F and S diagonal continuous noises ``q_c`` (S, n) (one per error
+    source: Q_d is linear in q_c) by their Taylor series to fifth order: Φ = Σ (FΔt)^k/k! and Van Loan's
+    integral Q_d = ∫₀^Δt e^(Fs) Q e^(Fᵀs) ds = Σ L_k Δt^(k+1)/(k+1)!, L_0 = Q, L_k = F L_(k−1) + L_(k−1) Fᵀ
+    (Van Loan 1978). F is sparse: each product runs over its non-zeros only."""
+    n, sources = F.shape[0], q_c.shape[0]
+    rows, cols = np.nonzero(F)
+    values = np.empty(rows.shape[0])
+    for k in range(rows.shape[0]):
+        values[k] = F[rows[k], cols[k]]
+    Phi, term, product = np.eye(n), np.eye(n), np.empty((n, n))
+    for k in range(1, 6):
+        _sparse_times(rows, cols, values * (dt / k), term, product)
+        term[:, :] = product
+        Phi += term
+    Q = np.zeros((sources, n, n))
+    L = np.zeros((n, n))
+    for s in range(sources):
+        L[:, :] = 0.0
+        for i in range(n):
+            L[i, i] = q_c[s, i]
+            Q[s, i, i] = q_c[s, i] * dt
+        coefficient = dt
+        for k in range(1, 6):
+            _sparse_times(rows, cols, values, L, product)
+            coefficient *= dt / (k + 1)
+            for i in range(n):
+                for j in range(n):
+                    L[i, j] = product[i, j] + product[j, i]
+                    Q[s, i, j] += coefficient * L[i, j]
+    return Phi, Q

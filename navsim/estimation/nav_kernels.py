@@ -26,7 +26,7 @@ import numpy as np
 from navsim.earth.frames import earth_rate_n, transport_rate_n
 from navsim.earth.gravity import normal_gravity_height_gradient, normal_gravity_latitude_gradient
 from navsim.earth.wgs84 import E2, radii
-from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t
+from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t, van_loan
 from navsim.ins.strapdown import step
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, skew
@@ -125,44 +125,11 @@ def continuous_f(lat, h, v, f_n, C, C_w, C_f, layout, inv_length):
 
 
 @njit
-def _sparse_times(rows, cols, values, B, out):
-    """out = S B for S given by its non-zero triplets (rows, cols, values)."""
-    out[:, :] = 0.0
-    for k in range(values.shape[0]):
-        i, p, a = rows[k], cols[k], values[k]
-        for j in range(B.shape[1]):
-            out[i, j] += a * B[p, j]
-
-
-@njit
 def discretize(F, q_c, dt):
-    """(Φ, Q_d) over dt [s] for F and the diagonal continuous noise ``q_c`` (n,) by their Taylor
-    series to fifth order: Φ = Σ (FΔt)^k/k! and Van Loan's integral
-    Q_d = ∫₀^Δt e^(Fs) Q e^(Fᵀs) ds = Σ L_k Δt^(k+1)/(k+1)!, L_0 = Q, L_k = F L_(k−1) + L_(k−1) Fᵀ
-    (Van Loan 1978). F is sparse: each product runs over its non-zeros only."""
-    n = F.shape[0]
-    rows, cols = np.nonzero(F)
-    values = np.empty(rows.shape[0])
-    for k in range(rows.shape[0]):
-        values[k] = F[rows[k], cols[k]]
-    Phi, term, product = np.eye(n), np.eye(n), np.empty((n, n))
-    L = np.zeros((n, n))
-    Q = np.zeros((n, n))
-    for i in range(n):
-        L[i, i] = q_c[i]
-        Q[i, i] = q_c[i] * dt
-    coefficient = dt
-    for k in range(1, 6):
-        _sparse_times(rows, cols, values * (dt / k), term, product)
-        term[:, :] = product
-        Phi += term
-        _sparse_times(rows, cols, values, L, product)
-        coefficient *= dt / (k + 1)
-        for i in range(n):
-            for j in range(n):
-                L[i, j] = product[i, j] + product[j, i]
-                Q[i, j] += coefficient * L[i, j]
-    return Phi, Q
+    """(Φ, Q_d) over dt [s] for F and the diagonal continuous noise ``q_c`` (n,): the fifth-order series
+    of :func:`navsim.estimation.linalg.van_loan`."""
+    Phi, Q = van_loan(F, q_c.reshape(1, q_c.shape[0]), dt)
+    return Phi, Q[0]
 
 
 @njit

@@ -5,7 +5,7 @@ sensor (SINS/CNS).
 Its modules: ``scenario`` (schema and rules), ``build`` (its tables to SI models), ``run`` (prepare,
 simulate), ``summary`` and ``celestial`` (its series and summary), ``records`` (its run and campaign
 summaries), ``campaign`` (what a campaign pools), ``console`` (what the command line prints),
-``budget`` (the error budget's sources and parts), ``report``, ``figures`` and ``report_statistics``
+``budget`` (the error budget's sources and parts), ``covariance`` (its linear covariance analysis), ``report``, ``figures`` and ``report_statistics``
 (its PDF sections), ``warmup`` (its compile-ahead task). The names below are the run-kind interface of
 :mod:`navsim.kinds`, each loaded on first use.
 """
@@ -19,6 +19,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.navigation.scenario": ("validate", "check_tuning"),
     "navsim.navigation.run": ("prepare", "simulate", "lanes", "check_truth_off", "TRUTH_SOURCES"),
     "navsim.navigation.budget": ("budget_parts", "summarize_budget", "budget_text"),
+    "navsim.navigation.covariance": ("covariance_analysis", "covariance_lines"),
     "navsim.navigation.records": ("RunSummary", "CampaignSummary"),
     "navsim.navigation.campaign": ("pool",),
     "navsim.navigation.console": ("run_lines", "campaign_lines"),

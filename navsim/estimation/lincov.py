@@ -1,0 +1,79 @@
+"""Linear covariance analysis of a closed-loop error-state filter whose model differs from the truth
+(compiled primitives; each run kind builds its truth model and drives them).
+
+The truth's error state x (n_t: the filter's states and the ones it ignores — a Gauss-Markov bias part,
+axis misalignments, a baro bias...) and the filter's error state (n_f), related by ``W`` (n_t x n_f):
+column j of W is where the filter's state j sits in the truth (its correction goes there), and
+``T`` (n_f x n_t) the filter's states as the truth's combinations (x_f = T x; T W = I). The filter
+resets its estimate into the nominal state after every update, so between updates its estimate is zero
+and the navigation error *is* the estimation error; its gains come from its own P_f along the nominal
+trajectory. With each error source s driving x alone (its share of the initial covariance, of the
+process noise Q_s and of the measurement noise R_s) the truth's covariance is the sum of the sources'
+P_s, each propagated by the same linear recursion (Gelb, *Applied Optimal Estimation*, 1974, §7.1-7.2,
+error budgets and the sensitivity of suboptimal filters; Maybeck vol. 1, 1979, §6.8; Geller 2006):
+
+    propagation      P_s ← Φ P_s Φᵀ + Q_s,                      m ← Φ m                         (1)
+    the filter       K = P_f H_fᵀ (H_f P_f H_fᵀ + R_f)⁻¹, H_f = H_t W, rows of consider states 0,
+                     P_f ← (I − K H_f) P_f (I − K H_f)ᵀ + K R_f Kᵀ (Joseph)                        (2)
+    update           A = I − W K H_t,  B = W K:  P_s ← A P_s Aᵀ + B R_s Bᵀ,  m ← A m − B d          (3)
+
+for a measurement z = H_t x + d + v, v ~ N(0, Σ_s R_s), d a deterministic offset (a baro's lag, an
+uncorrected aberration); m is the mean error of the fixed (not drawn) truth errors. When the filter's
+model is the truth's (W = T = I, the same Φ, Q, H, R) eq. (3) is eq. (2) and Σ_s P_s = P_f.
+"""
+
+import numpy as np
+
+from navsim.estimation.linalg import schmidt_gain
+from startrack.jit import njit
+
+
+@njit
+def propagate(P, mean, Phi, Q):
+    """Eq. (1) in place for each source of the stacks P (S, n, n) and ``mean`` (S, n) with its Q (S, n, n)."""
+    for s in range(P.shape[0]):
+        P_next = Phi @ P[s] @ Phi.T + Q[s]
+        P[s] = 0.5 * (P_next + P_next.T)
+        mean[s] = Phi @ mean[s]
+
+
+@njit
+def filter_update(P_f, H_f, R_f, estimated):
+    """Eq. (2) in place: the filter's Schmidt-Joseph update of P_f (n_f, n_f) with H_f (m, n_f) and its R_f
+    (m, m); returns its gain K (n_f, m)."""
+    K, HP = schmidt_gain(P_f, H_f, R_f, estimated)
+    M = P_f - K @ HP
+    P_next = M - (M @ H_f.T) @ K.T + K @ R_f @ K.T
+    P_f[:, :] = 0.5 * (P_next + P_next.T)
+    return K
+
+
+@njit
+def true_update(P, mean, W, K, H_t, R_t, d, source, offset_source):
+    """Eq. (3) in place for the stacks P (S, n_t, n_t) and ``mean`` (S, n_t) of the sources: the filter's gain K
+    applied to the truth's measurement H_t (m, n_t) whose noise R_t (m, m) is source ``source``'s and whose
+    deterministic offset d (m,) is source ``offset_source``'s (the other sources see only A)."""
+    B = W @ K
+    A = np.eye(W.shape[0]) - B @ H_t
+    for s in range(P.shape[0]):
+        P_next = A @ P[s] @ A.T
+        if s == source:
+            P_next += B @ R_t @ B.T
+        P[s] = 0.5 * (P_next + P_next.T)
+        mean[s] = A @ mean[s]
+        if s == offset_source:
+            mean[s] -= B @ d
+
+
+@njit
+def update(P, mean, P_f, W, H_t, R_t, R_f, d, estimated, source, offset_source):
+    """One measurement through the filter (eq. 2) and the truth (eq. 3); H_f = H_t W."""
+    H_f = np.ascontiguousarray(H_t @ W)
+    K = filter_update(P_f, H_f, R_f, estimated)
+    true_update(P, mean, W, K, H_t, R_t, d, source, offset_source)
+
+
+@njit
+def expected_nees(P_f, C):
+    """E[NEES] = tr(P_f⁻¹ C) of an error of second moment C (n_f, n_f) (covariance plus m mᵀ)."""
+    return np.trace(np.linalg.solve(P_f, C))

@@ -1,0 +1,237 @@
+"""Compiled linear covariance analysis of the navigation filter (numba): the truth's error dynamics
+(the filter's states plus the errors it ignores) and the pass along a nominal trajectory that drives
+the primitives of :mod:`navsim.estimation.lincov` with the filter's own model beside the truth's.
+
+The truth's error state is the navigation error state of :mod:`navsim.estimation.nav_kernels` with every
+group the truth has (scale factors, mounting, gravity disturbance: its ``base`` layout), then the
+truth-only groups of :data:`TruthLayout`: the Gauss-Markov parts g of the gyro and accelerometer
+biases (the filter's ε is ε_t + g_g, its ∇ is ∇_t + g_a: it carries them as random walks), the six
+axis misalignments of each sensor (ω̃ = (I + S)(I + M) ω: M's off-diagonal terms, :data:`MISALIGNMENT_PAIRS`)
+and the baro's bias (a white-noise height to the filter).
+"""
+
+from collections import namedtuple
+
+import numpy as np
+
+from navsim.earth.wgs84 import radii
+from navsim.estimation.celestial_kernels import fix_terms, star_terms
+from navsim.estimation.linalg import van_loan
+from navsim.estimation.lincov import expected_nees, propagate, update
+from navsim.estimation.nav_kernels import DP, continuous_f, discretize, noise_densities
+from startrack.jit import njit
+from startrack.rotation_jit import quat_to_matrix
+
+#: Where the truth's groups start (−1: absent): ``base`` the :class:`nav_kernels.Layout` of the states the
+#: filter may carry; the Gauss-Markov bias parts (3 each), the misalignments (6 each), the baro bias (1);
+#: ``n`` the truth's state count.
+TruthLayout = namedtuple("TruthLayout", "base gyro_gm accel_gm gyro_mis accel_mis baro n")
+#: The measurements of a pass, per frame f of F: identified stars (rows ``star_offsets[f]:star_offsets[f+1]``
+#: of the filter's catalog directions ``star_ref`` (M, 3) in I, the noise-free measured directions
+#: ``star_obs`` (M, 3) in S through the nominal mounting and their covariances ``star_cov`` (M, 3, 3)
+#: [rad²]); attitude fixes (``fix_mask`` (F,), noise-free ``fix_q`` (F, 4) as the filter's processing
+#: sees them, ``fix_R`` (3, 3) [rad²]); position fixes (``position_mask`` (F,), NED σ ``position_sigma``
+#: (3,) [m]); baro heights (``baro_mask`` (F,), the truth's white-noise variance ``baro_var`` and the
+#: filter's ``baro_filter_var`` [m²], the deterministic offset ``baro_offset`` (F,) [m] of its lag);
+#: ``r_scale2`` the filter's measurement_noise_scale²; the stack's sources of the star sensor's noise
+#: (``star_source``) and of the aiding sensors' (``aiding_source``), and of the stars' deterministic offset
+#: (an uncorrected aberration: ``offset_source``).
+Measurements = namedtuple("Measurements", "star_offsets star_ref star_obs star_cov fix_mask fix_q fix_R position_mask "
+                                          "position_sigma baro_mask baro_var baro_filter_var baro_offset r_scale2 "
+                                          "star_source aiding_source offset_source")
+#: The off-diagonal terms (i, j) of a misalignment matrix M, in the order of its six states.
+MISALIGNMENT_PAIRS = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
+#: The leading block kept in full at every output frame: φ, δv, δL, δλ, δh.
+BLOCK = 9
+
+
+@njit
+def truth_f(lat, h, v, f_n, C, G_w, G_f, tl, inv_length, inv_tau):
+    """The truth's continuous error dynamics (n_t, n_t): :func:`nav_kernels.continuous_f` of its ``base``
+    layout (1/D ``inv_length`` of its gravity disturbance), then φ̇ −= C_nb g_g, δv̇ += C_nb g_a with
+    ġ = −g/τ (``inv_tau`` = (1/τ_g, 1/τ_a)), and the misalignment columns φ̇ −= C_nb M_g ω_b,
+    δv̇ += C_nb M_a f_b: column (i, j) is −G_w[:, i, j] (G_w[a, i, j] the interval mean of C_nb[a, i] ω_j,
+    [rad/s]) and G_f[:, i, j] [m/s²]."""
+    C_w, C_f = np.empty((3, 3)), np.empty((3, 3))
+    for a in range(3):
+        for i in range(3):
+            C_w[a, i], C_f[a, i] = G_w[a, i, i], G_f[a, i, i]
+    F = np.zeros((tl.n, tl.n))
+    F[:tl.base.n, :tl.base.n] = continuous_f(lat, h, v, f_n, C, C_w, C_f, tl.base, inv_length)
+    if tl.gyro_gm >= 0:
+        F[0:3, tl.gyro_gm:tl.gyro_gm + 3] = -C
+        for i in range(3):
+            F[tl.gyro_gm + i, tl.gyro_gm + i] = -inv_tau[0]
+    if tl.accel_gm >= 0:
+        F[3:6, tl.accel_gm:tl.accel_gm + 3] = C
+        for i in range(3):
+            F[tl.accel_gm + i, tl.accel_gm + i] = -inv_tau[1]
+    for p in range(6):
+        i, j = MISALIGNMENT_PAIRS[p]
+        if tl.gyro_mis >= 0:
+            F[0:3, tl.gyro_mis + p] = -G_w[:, i, j]
+        if tl.accel_mis >= 0:
+            F[3:6, tl.accel_mis + p] = G_f[:, i, j]
+    return F
+
+
+@njit
+def _interval_means(q_nb, dtheta, dv, k0, k1, dt):
+    """(C, f_n, G_w, G_f) over IMU intervals k0..k1−1 with C_nb at the start of each interval, as the
+    filter's accumulator has them: the mean C_nb, the mean specific force in n [m/s²], and
+    G_w[a, i, j] = mean C_nb[a, i] ω_j [rad/s], G_f likewise with f_b [m/s²]."""
+    C, f_n = np.zeros((3, 3)), np.zeros(3)
+    G_w, G_f = np.zeros((3, 3, 3)), np.zeros((3, 3, 3))
+    for k in range(k0, k1):
+        Ck = quat_to_matrix(q_nb[k])
+        for a in range(3):
+            for i in range(3):
+                C[a, i] += Ck[a, i]
+                f_n[a] += Ck[a, i] * dv[k, i]
+                for j in range(3):
+                    G_w[a, i, j] += Ck[a, i] * dtheta[k, j]
+                    G_f[a, i, j] += Ck[a, i] * dv[k, j]
+    span = (k1 - k0) * dt
+    return C / (k1 - k0), f_n / span, G_w / span, G_f / span
+
+
+@njit
+def _nav(lat, lon, h, v_n, q_nb, k):
+    """The strapdown state's first ten entries (L, λ, h, v_n, q_nb) of the nominal at sample k."""
+    nav = np.empty(10)
+    nav[0], nav[1], nav[2] = lat[k], lon[k], h[k]
+    nav[3:6] = v_n[k]
+    nav[6:10] = q_nb[k]
+    return nav
+
+
+@njit
+def _embed(H, n_t):
+    """H (m, n) of the truth's base layout padded with zero columns to (m, n_t)."""
+    out = np.zeros((H.shape[0], n_t))
+    out[:, :H.shape[1]] = H
+    return out
+
+
+@njit
+def _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, span, tl, truth_q, inv_length, inv_tau, gravity_drive,
+                        gravity_source, model):
+    """Eq. (1) of :mod:`navsim.estimation.lincov` for the truth and the filter over ``span`` [s]; the
+    truth's gravity disturbance driven by 2σ² V/D at the current speed (``gravity_drive`` = 2σ²/D)."""
+    speed = np.hypot(nav[3], nav[4])
+    q = truth_q.copy()
+    if tl.base.gravity >= 0:
+        for i in range(3):
+            q[gravity_source, tl.base.gravity + i] += gravity_drive[i] * speed
+    F_t = truth_f(nav[0], nav[2], nav[3:6], f_n, C, G_w, G_f, tl, inv_length, inv_tau)
+    Phi, Q = van_loan(F_t, q, span)
+    propagate(P, mean, Phi, Q)
+    C_w, C_f = np.empty((3, 3)), np.empty((3, 3))
+    for a in range(3):
+        for i in range(3):
+            C_w[a, i], C_f[a, i] = G_w[a, i, i], G_f[a, i, i]
+    F_f = continuous_f(nav[0], nav[2], nav[3:6], f_n, C, C_w, C_f, model.layout, model.gm[3])
+    Phi_f, Q_f = discretize(F_f, noise_densities(nav, model), span)
+    P_next = Phi_f @ P_f @ Phi_f.T + Q_f
+    P_f[:, :] = 0.5 * (P_next + P_next.T)
+
+
+@njit
+def _update_stars(P, mean, P_f, nav, q_ie, q_BS, rows, meas, tl, W, estimated):
+    """All stars of a frame as one measurement (the filter fuses the accepted stars together)."""
+    z, H, R = star_terms(nav, q_BS, q_ie, meas.star_ref[rows[0]:rows[1]], meas.star_obs[rows[0]:rows[1]],
+                         meas.star_cov[rows[0]:rows[1]], tl.base)
+    m = z.shape[0]
+    H_t, R_t, d = np.zeros((2 * m, tl.n)), np.zeros((2 * m, 2 * m)), np.empty(2 * m)
+    for k in range(m):
+        for r in range(2):
+            H_t[2 * k + r, :tl.base.n] = H[k, r]
+            d[2 * k + r] = z[k, r]
+            for c in range(2):
+                R_t[2 * k + r, 2 * k + c] = R[k, r, c]
+    update(P, mean, P_f, W, H_t, R_t, meas.r_scale2 * R_t, d, estimated, meas.star_source, meas.offset_source)
+
+
+@njit
+def _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated):
+    """The frame's position fix (H = [0 0 I …], R in radians of L, λ and metres of h) and baro height
+    (H = e_δh − e_baro bias, R the white noise; the filter's R its σ with the bias), in that order."""
+    if meas.position_mask[f]:
+        r_m, r_n = radii(nav[0])
+        scale = np.array([r_m + nav[2], (r_n + nav[2]) * np.cos(nav[0]), 1.0])
+        H_t, R_t = np.zeros((3, tl.n)), np.zeros((3, 3))
+        for i in range(3):
+            H_t[i, DP + i] = 1.0
+            R_t[i, i] = (meas.position_sigma[i] / scale[i]) ** 2
+        update(P, mean, P_f, W, H_t, R_t, meas.r_scale2 * R_t, np.zeros(3), estimated, meas.aiding_source,
+               meas.aiding_source)
+    if meas.baro_mask[f]:
+        H_t = np.zeros((1, tl.n))
+        H_t[0, DP + 2] = 1.0
+        if tl.baro >= 0:
+            H_t[0, tl.baro] = -1.0
+        R_t = np.full((1, 1), meas.baro_var)
+        R_f = np.full((1, 1), meas.r_scale2 * meas.baro_filter_var)
+        update(P, mean, P_f, W, H_t, R_t, R_f, np.array([meas.baro_offset[f]]), baro_estimated, meas.aiding_source,
+               meas.aiding_source)
+
+
+@njit
+def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_q, inv_length, inv_tau, gravity_drive,
+        gravity_source, model, W, T, estimated, baro_estimated, P, mean, P_f, q_ie, q_BS, meas, step_frames, step_values,
+        step_source):
+    """The pass along the nominal (samples of L, λ, h, v_n, q_nb (N+1, ·); increments Δθ, Δv (N, 3) on IMU
+    intervals of ``dt`` [s]): per frame of ``ratio`` intervals, the truth's stacks P (S, n_t, n_t) and
+    ``mean`` (S, n_t) (one per error source) and the filter's P_f propagated every ``every`` intervals and at the frame's end
+    (:func:`_propagate_interval`; the truth's noise densities ``truth_q`` (S, n_t)), the gyro bias steps of
+    the frame added to source ``step_source``'s mean (``step_frames`` (J,), ``step_values`` (J, 3) [rad/s]), then the frame's
+    measurements (``meas``: stars or a fix, then the position fix and the baro). Every ``stride`` frames
+    (and at the last) it keeps: the time, the mean, the diagonal of each source's P in the truth's and
+    (T P Tᵀ) the filter's coordinates, each source's leading :data:`BLOCK` x BLOCK, the filter's own
+    diagonal and block, and the filter's expected NEES tr(P_f⁻¹ (T (Σ P + m mᵀ) Tᵀ))."""
+    frames = (q_nb.shape[0] - 1) // ratio
+    S, n_t, n_f = P.shape[0], tl.n, P_f.shape[0]
+    kept = (frames + stride - 1) // stride
+    t_out, mean_out = np.empty(kept), np.empty((S, kept, n_t))
+    diag_t, diag_f = np.empty((S, kept, n_t)), np.empty((S, kept, n_f))
+    block, filter_diag, filter_block = np.empty((S, kept, BLOCK, BLOCK)), np.empty((kept, n_f)), np.empty((kept, BLOCK, BLOCK))
+    nees_out = np.empty(kept)
+    out = 0
+    for f in range(frames):
+        for s in range(step_frames.shape[0]):
+            if step_frames[s] == f:
+                mean[step_source, 9:12] += step_values[s]
+        k0, end = f * ratio, (f + 1) * ratio
+        while k0 < end:
+            k1 = min(k0 + every, end)
+            C, f_n, G_w, G_f = _interval_means(q_nb, dtheta, dv, k0, k1, dt)
+            nav = _nav(lat, lon, h, v_n, q_nb, k1)
+            _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, (k1 - k0) * dt, tl, truth_q, inv_length, inv_tau,
+                                gravity_drive, gravity_source, model)
+            k0 = k1
+        nav = _nav(lat, lon, h, v_n, q_nb, end)
+        rows = (meas.star_offsets[f], meas.star_offsets[f + 1])
+        if rows[1] > rows[0]:
+            _update_stars(P, mean, P_f, nav, q_ie[f], q_BS, rows, meas, tl, W, estimated)
+        if meas.fix_mask[f]:
+            z, H, R = fix_terms(nav, q_BS, q_ie[f], meas.fix_q[f], meas.fix_R, tl.base)
+            H_t = _embed(H, n_t)
+            update(P, mean, P_f, W, H_t, R, meas.r_scale2 * R, z, estimated, meas.star_source, meas.offset_source)
+        _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
+        if (f + 1) % stride == 0 or f == frames - 1:
+            t_out[out] = end * dt
+            total = np.zeros(n_t)
+            second = np.zeros((n_t, n_t))
+            for s in range(S):
+                mean_out[s, out] = mean[s]
+                total += mean[s]
+                second += P[s]
+                diag_t[s, out] = np.diag(P[s])
+                diag_f[s, out] = np.diag(T @ P[s] @ T.T)
+                block[s, out] = P[s, :BLOCK, :BLOCK]
+            second += np.outer(total, total)
+            filter_diag[out], filter_block[out] = np.diag(P_f), P_f[:BLOCK, :BLOCK]
+            nees_out[out] = expected_nees(P_f, np.ascontiguousarray(T @ second @ T.T))
+            out += 1
+    return t_out[:out], mean_out[:, :out], diag_t[:, :out], diag_f[:, :out], block[:, :out], filter_diag[:out], \
+        filter_block[:out], nees_out[:out]

@@ -1,0 +1,72 @@
+"""Linear covariance analysis of navigation scenarios (navsim.navigation.covariance): a filter whose model is
+the truth's gets its own P back, the sources' shares add up to the total, and a mismodelled filter's true
+RMS departs from its σ as Monte Carlo runs of the same scenario do."""
+
+import numpy as np
+import pytest
+
+from navsim.kinds import resolve_scenario
+from navsim.navigation.covariance import covariance_analysis
+from navsim.simulation import run_batch
+
+SCENARIO = "scenarios/sins_cns_aircraft_vector.toml"
+#: Ten minutes of straight flight at a 50 Hz IMU (one covariance interval per 1 Hz frame).
+SHORT = ("duration_s=600", "imu.rate_hz=50", "filter.covariance_interval=50")
+#: Equal to the filter's model: no mounting error (the filter ignores the mounting) and no other truth-only term.
+MATCHED = (*SHORT, "filter.mounting=ignore", "star_sensor.misalignment_arcsec=[0, 0, 0]")
+#: Monte Carlo runs of the mismodelled-filter checks.
+RUNS = 60
+
+
+def test_a_filter_whose_model_is_the_truth_gets_its_own_covariance():
+    analysis = covariance_analysis(resolve_scenario(SCENARIO, MATCHED))
+    # every truth state is the filter's but the mounting (zero, never excited): the same recursion on the same
+    # numbers, so the true covariance is the filter's to rounding
+    assert np.allclose(analysis.diag_f[0], analysis.filter_diag, rtol=1e-9, atol=0.0)
+    scale = np.sqrt(np.einsum("kii,kjj->kij", analysis.filter_block, analysis.filter_block))
+    assert np.max(np.abs(analysis.block[0] - analysis.filter_block) / scale) < 1e-9
+    assert np.allclose(analysis.nees, len(analysis.filter_names), rtol=1e-9)
+
+
+def test_the_sources_shares_add_up_to_the_total():
+    scenario = resolve_scenario(SCENARIO, SHORT)
+    total, split = covariance_analysis(scenario), covariance_analysis(scenario, split=True)
+    assert split.sources == ("initial", "inertial", "accel_bias", "gravity", "mounting", "star_noise", "aiding")
+    # one linear recursion driven by each source alone: the parts add up to rounding
+    assert np.allclose(split.diag_f.sum(axis=0), total.diag_f[0], rtol=1e-9)
+    assert np.allclose(split.mean.sum(axis=0), total.mean[0], rtol=1e-9, atol=1e-15)
+    for name, share in split.mean_square().items():
+        assert np.allclose(share.sum(axis=0), total.mean_square()[name][0], rtol=1e-9), name
+    # the mounting's error is the scenario's given value: a mean, no variance
+    mounting = split.sources.index("mounting")
+    assert np.all(split.diag_t[mounting] == 0.0) and np.any(split.mean[mounting] != 0.0)
+
+
+def _runs(overrides):
+    return [result.series for result in run_batch(SCENARIO, range(RUNS), overrides, threads=2)]
+
+
+@pytest.mark.parametrize("mismodel, departs", [
+    # an uncalibrated mounting the filter ignores: the star sensor's 30", -45", 90" misalignment tilts and turns
+    # the attitude far beyond the filter's σ
+    (("filter.mounting=ignore",), ("tilt", "heading")),
+    # a filter that trusts its measurements four times too much (every σ halved): the baro's error, taken for
+    # half of what it is, leaves the vertical channel's true error well above the filter's σ (the attitude, held
+    # by the mounting's and the level's uncertainty in straight flight, hardly moves)
+    (("filter.measurement_noise_scale=0.5",), ("vertical_position", "vertical_velocity")),
+])
+def test_a_mismodelled_filter_departs_from_its_sigma_as_monte_carlo_does(mismodel, departs):
+    # the gate at its widest: the analysis fuses every star, as a run does once its filter has converged (with the
+    # default gate the first frames' stars are rejected while an ignored mounting's error exceeds the prior σ:
+    # the runs then converge late, which no linear analysis follows)
+    overrides = (*SHORT, *mismodel, "filter.gate_probability=0.999999999")
+    analysis = covariance_analysis(resolve_scenario(SCENARIO, overrides))
+    comparison = analysis.compare(_runs(overrides))
+    # every RMS of the runs inside the family-wise 95 % band of a 60-run RMS around the analysis's
+    assert comparison["inside_family"] == comparison["checks"]
+    summary = analysis.summary(resolve_scenario(SCENARIO, overrides))
+    for name in departs:
+        assert summary["quantities"][name]["true_over_filter_final"] > 1.3, name
+        final = comparison["quantities"][name]["rows"][-1]
+        sigma = summary["quantities"][name]["filter_sigma_final"]
+        assert final["montecarlo"] / sigma > 1.3, name
