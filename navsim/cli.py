@@ -4,7 +4,7 @@
     navsim report DIR -o FILE.pdf
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
     navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
-    navsim budget SCENARIO.toml --out DIR [--runs N] [--workers W]
+    navsim budget SCENARIO.toml --out DIR [--method covariance | --method montecarlo [--runs N] [--workers W]]
     navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
@@ -156,10 +156,14 @@ def _budget(args):
 
     _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
-    budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed)
+    budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed, method=args.method)
     write_report(args.out, Path(args.out) / "budget.pdf")
-    print("\n".join(run_kind(scenario, "an error budget").budget_text(budget)))
+    kind = run_kind(scenario, "an error budget")
+    text = kind.covariance_budget_text if args.method == "covariance" else kind.budget_text
+    print("\n".join(text(budget)))
     print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
+    if args.method == "covariance":
+        return 0
     return 1 if any(row["status"] == "failed" for row in [*budget["parts"], budget["total"]]) else 0
 
 
@@ -241,14 +245,15 @@ def build_parser():
     p.add_argument("--json", action="store_true", help="print the iterations as JSON")
     p.set_defaults(func=_tune)
 
-    p = sub.add_parser("budget", help="the error budget of a star-aided navigation scenario: the horizontal error each "
-                                      "source leaves, from runs with one source at a time")
-    p.add_argument("scenario", help="scenario TOML file (a navigation scenario with a [star_sensor])")
-    p.add_argument("--out", required=True, help="budget directory (budget.json, budget.pdf, parts/; finished runs "
-                                                "there are kept)")
-    p.add_argument("--runs", type=int, default=5, help="runs per source (default 5)")
-    p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
-    p.add_argument("--seed", type=int, default=None, help="base seed (default: the scenario's)")
+    p = sub.add_parser("budget", help="the error budget of a navigation scenario: what each error source leaves, by "
+                                      "linear covariance analysis (default) or by runs with one source at a time")
+    p.add_argument("scenario", help="scenario TOML file (a navigation scenario; --method montecarlo: with a [star_sensor])")
+    p.add_argument("--out", required=True, help="budget directory (budget.json, budget.pdf; Monte Carlo: parts/, finished "
+                                                "runs there are kept)")
+    p.add_argument("--method", default="covariance", help="covariance (default: one pass, no draws) or montecarlo")
+    p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs per source (default 5)")
+    p.add_argument("--workers", type=int, default=None, help="Monte Carlo local processes (default: all cores)")
+    p.add_argument("--seed", type=int, default=None, help="Monte Carlo base seed (default: the scenario's)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_budget)
 

@@ -1,9 +1,14 @@
-"""The error budget of a scenario: one Monte Carlo campaign per part (each error source alone in the
-truth under the scenario's own filter, then the whole scenario), resumable, and the budget the kind
-draws from them (:func:`navsim.navigation.budget.budget_parts`, ``summarize_budget``: the star-aided navigation
-kind's sources, metres and predictions).
+"""The error budget of a scenario, by linear covariance analysis (the default: one pass with each error
+source apart, :mod:`navsim.estimation.lincov`; the kind's ``covariance_analysis`` and ``covariance_budget``) or by
+Monte Carlo: one campaign per part (each error source alone in the truth under the scenario's own filter, then
+the whole scenario), resumable, and the budget the kind draws from them
+(:func:`navsim.navigation.budget.budget_parts`, ``summarize_budget``: the star-aided navigation kind's sources,
+metres and predictions).
 
-    navsim budget SCENARIO.toml --out DIR [--runs N] [--workers W]
+    navsim budget SCENARIO.toml --out DIR [--method covariance | --method montecarlo [--runs N] [--workers W]]
+
+A covariance budget writes ``DIR/budget.json`` (its format says the method) and ``DIR/timeseries.npz`` (each
+quantity's shares over time).
 
 Each part is a campaign of N runs with the same seeds in ``DIR/parts/<key>/`` (a second call runs only
 what is missing; its campaign.json records what the truth leaves out); ``DIR/budget.json`` holds the
@@ -12,20 +17,31 @@ budget, and ``navsim report DIR`` (:mod:`navsim.report.budget`) typesets it.
 
 from navsim.campaign.montecarlo import run_campaign
 from navsim.kinds import resolve_scenario, run_kind
-from navsim.output import write_json
+from navsim.output import write_json, write_npz
 from navsim.places import check_output, mark
 from startrack.errors import InputError
 
 #: Runs per source by default.
 DEFAULT_RUNS = 5
 MAX_RUNS = 10_000
+#: How a budget is computed.
+METHODS = ("covariance", "montecarlo")
 
 
-def run_budget(scenario, out, runs=DEFAULT_RUNS, workers=None, base_seed=None, overrides=(), progress=True):
-    """Run (or resume) the budget of ``scenario`` into ``out``; returns the budget (also ``out/budget.json``).
-    Bad input (runs, workers, a scenario whose kind or tables have no budget) is an InputError before
-    anything is written."""
+def run_budget(scenario, out, runs=None, workers=None, base_seed=None, overrides=(), progress=True, method="covariance"):
+    """Run (or resume) the budget of ``scenario`` into ``out`` by ``method`` (:data:`METHODS`); returns the budget
+    (also ``out/budget.json``). Bad input (runs, workers or a seed with the covariance method, a scenario whose
+    kind or tables have no budget) is an InputError before anything is written."""
     scenario = resolve_scenario(scenario, overrides)
+    if method not in METHODS:
+        raise InputError(f"--method {method}: must be one of {', '.join(METHODS)}")
+    if method == "covariance":
+        given = [name for name, value in (("--runs", runs), ("--workers", workers), ("--seed", base_seed)) if value is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: Monte Carlo options; the covariance method draws nothing "
+                             "(add --method montecarlo)")
+        return _covariance_budget(scenario, out)
+    runs = DEFAULT_RUNS if runs is None else runs
     if not 1 <= runs <= MAX_RUNS:
         raise InputError(f"--runs must be from 1 to {MAX_RUNS:,}, got {runs}")
     if workers is not None and workers < 1:
@@ -40,5 +56,17 @@ def run_budget(scenario, out, runs=DEFAULT_RUNS, workers=None, base_seed=None, o
             run_campaign(part.scenario, runs, directory / "parts" / part.key, base_seed=seed, workers=workers,
                          progress=progress, truth_off=part.truth_off)
     budget = kind.summarize_budget(scenario, directory, parts, runs, seed)
+    write_json(directory / "budget.json", budget)
+    return budget
+
+
+def _covariance_budget(scenario, out):
+    """The budget by linear covariance analysis: ``out/budget.json`` and ``out/timeseries.npz``."""
+    kind = run_kind(scenario, "an error budget")
+    analysis = kind.covariance_analysis(scenario, split=True)  # seconds: bad input found before --out is made
+    budget = kind.covariance_budget(scenario, analysis)
+    directory = check_output(out, "budget")
+    mark(directory, "budget")
+    write_npz(directory / "timeseries.npz", analysis.series())
     write_json(directory / "budget.json", budget)
     return budget

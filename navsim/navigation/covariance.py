@@ -360,6 +360,15 @@ class Analysis:
         """The analysis against Monte Carlo run series (:func:`compare`)."""
         return compare(self, runs)
 
+    def alone_mean_square(self):
+        """{quantity: (S, K)} the true mean square each source leaves alone, tr(J P_s Jᵀ) + |J m_s|² [SI²]: what a
+        run with only that source in its truth averages to (``navsim budget --method montecarlo``'s parts)."""
+        out = {}
+        for name, sel in self.selectors().items():
+            projected = np.einsum("kri,ski->skr", sel, self.mean[:, :, :BLOCK])
+            out[name] = np.einsum("kri,skij,krj->sk", sel, self.block, sel) + np.sum(projected**2, axis=2)
+        return out
+
     def filter_variance(self):
         """{quantity: (K,)} the filter's own variance of each summary quantity [SI²]."""
         return {name: np.einsum("kri,kij,krj->k", sel, self.filter_block, sel) for name, sel in self.selectors().items()}
@@ -583,4 +592,50 @@ def covariance_lines(summary):
     nees = summary["nees_expected"]
     lines.append(f"expected NEES       {nees['mean']:.2f} after settling for {nees['dof']} dof (consistent: = dof)")
     lines += [f"note                {note}" for note in summary["notes"]]
+    return lines
+
+
+#: The format of a covariance budget's ``budget.json``.
+BUDGET_FORMAT = "navsim.covariance-budget/1"
+
+
+def covariance_budget(scenario, analysis):
+    """The error budget of ``scenario`` from its analysis with the sources apart (the content of ``budget.json``,
+    :data:`BUDGET_FORMAT`): per summary quantity and source, the RMS the source leaves alone (what a run with
+    only that source averages to) and its share of the total mean square (tr(J P_s Jᵀ) + (J m_s)·(J m): the
+    shares add up to the total's square exactly), at the end and over the frames after ``settle_s``."""
+    from navsim.navigation.budget import SOURCES as LABELLED  # noqa: PLC0415  (the labels of the same sources)
+
+    labels = {source.key: source.label for source in LABELLED}
+    t = analysis.t
+    steady = t >= scenario["settle_s"]
+    steady = steady if steady.any() else np.ones_like(steady)
+    share, alone = analysis.mean_square(), analysis.alone_mean_square()
+    quantities = {}
+    for name, (unit, size) in QUANTITIES.items():
+        total = share[name].sum(axis=0)
+        rows = {key: {"label": labels[key], "alone_final": float(np.sqrt(alone[name][i, -1])) / size,
+                      "alone_rms": float(np.sqrt(np.mean(alone[name][i, steady]))) / size,
+                      "share_final": float(share[name][i, -1]) / size**2,
+                      "share_steady": float(np.mean(share[name][i, steady])) / size**2}
+                for i, key in enumerate(analysis.sources)}
+        quantities[name] = {"unit": unit, "total_final": float(np.sqrt(total[-1])) / size,
+                            "total_rms": float(np.sqrt(np.mean(total[steady]))) / size, "sources": rows}
+    return {"format": BUDGET_FORMAT, "method": "covariance", "scenario": scenario.name, "source": scenario.source,
+            "settle_s": float(scenario["settle_s"]), "duration_s": float(t[-1]), "sources": list(analysis.sources),
+            "quantities": quantities, "notes": list(analysis.notes)}
+
+
+def covariance_budget_text(budget):
+    """The covariance budget as lines of text: per source the horizontal position error it leaves alone and
+    its share of the total's mean square, at the end."""
+    q = budget["quantities"]["horizontal_position"]
+    lines = [f"error budget        {budget['scenario']}: linear covariance analysis, horizontal position at the end "
+             f"({budget['duration_s']:.0f} s)",
+             f"{'source':<36} {'alone [m]':>11} {'share [m²]':>12} {'share %':>8}"]
+    total2 = q["total_final"] ** 2
+    for key, row in q["sources"].items():
+        lines.append(f"{row['label']:<36} {row['alone_final']:11.2f} {row['share_final']:12.4g} "
+                     f"{100 * row['share_final'] / total2 if total2 else 0.0:8.1f}")
+    lines.append(f"{'total (√ of the summed shares)':<36} {q['total_final']:11.2f} {total2:12.4g} {100.0:8.1f}")
     return lines

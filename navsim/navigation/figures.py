@@ -202,3 +202,18 @@ def budget_bars(labels, values, predictions):
     ax.set(ylabel="horizontal error [m]")
     ax.legend(loc="upper left")
     return fig
+
+
+def budget_shares(t, shares, labels):
+    """The covariance budget over time: each source's share of the horizontal position error's mean square
+    [m²] (``shares`` (S, K)) stacked against time ``t`` [s] in hours (negative shares drawn below zero)."""
+    fig, axes = new_figure(3.0)
+    ax = axes[0, 0]
+    hours = np.asarray(t) / 3600.0
+    positive, negative = np.clip(shares, 0.0, None), np.clip(shares, None, 0.0)
+    ax.stackplot(hours, positive, labels=labels, alpha=0.85)
+    if np.any(negative < 0.0):
+        ax.stackplot(hours, negative, alpha=0.4)
+    ax.set(xlabel="time [h]", ylabel="share of mean square [m²]")
+    ax.legend(loc="upper left", ncol=2)
+    return fig

@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 
 from navsim.kinds import of
+from navsim.output import read_npz
 from navsim.report.budget import budget_report
 from navsim.report.study import load_study, study_report
 from navsim.typeset.inputs import campaign_runs, directory_kind, load_campaign, load_run, read_json
@@ -43,7 +44,8 @@ def _typeset(directory, output):
     if output == "study":
         return study_report(load_study(directory))
     if output == "budget":
-        return budget_report(read_json(directory / "budget.json"))
+        series = directory / "timeseries.npz"
+        return budget_report(read_json(directory / "budget.json"), read_npz(series) if series.is_file() else None)
     if output == "campaign":
         campaign = read_json(directory / "campaign.json")
         finished, failed = campaign_runs(directory)

@@ -1,6 +1,8 @@
-"""The PDF of an error budget (``budget.json``: :mod:`navsim.campaign.budget`, the star-aided navigation
-kind's :mod:`navsim.navigation.budget`): which source leaves how many metres of horizontal position
-error, as a table and a bar chart, with the total and the root-sum-square of the parts."""
+"""The PDF of an error budget (``budget.json``: :mod:`navsim.campaign.budget`): by Monte Carlo (the star-aided
+navigation kind's :mod:`navsim.navigation.budget`) which source leaves how many metres of horizontal position
+error, as a table and a bar chart, with the total and the root-sum-square of the parts; by covariance analysis
+(:func:`navsim.navigation.covariance.covariance_budget`) each source's share of every summary quantity, as a
+table and its horizontal position error's shares stacked over time."""
 
 import tempfile
 from pathlib import Path
@@ -14,8 +16,11 @@ from navsim.typeset.document import Document, markup, number, table
 METRIC_LABELS = {"schuler_mean_m": "Schuler mean", "final_m": "final", "rms_m": "RMS"}
 
 
-def budget_report(budget) -> bytes:
-    """The PDF (bytes) of a budget (the dictionary of budget.json)."""
+def budget_report(budget, series=None) -> bytes:
+    """The PDF (bytes) of a budget (the dictionary of budget.json; a covariance budget's ``series`` its
+    timeseries.npz)."""
+    if budget.get("method") == "covariance":
+        return covariance_budget_report(budget, series)
     name = budget["scenario"]
     rows = [*budget["parts"], budget["total"]]
     run = [r for r in rows if r["status"] == "run"]
@@ -68,3 +73,33 @@ def budget_report(budget) -> bytes:
 
 def _ratio(value):
     return "–" if value is None else f"{value:.3f}"
+
+
+def covariance_budget_report(budget, series) -> bytes:
+    """The PDF (bytes) of a covariance budget: its table per quantity and the stacked shares over time."""
+    name = budget["scenario"]
+    with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
+        doc = Document(Path(tmp), f"navsim error budget: {name}", f"navsim error budget · {name}")
+        doc.title(f"Error budget: {name}", budget["source"])
+        doc.paragraph(markup(
+            "Linear covariance analysis along the scenario's nominal trajectory (one pass, nothing drawn): the truth's "
+            "errors driven by each source alone under the scenario's own filter, whose gains come from its own model. "
+            "For each source, the error it leaves alone (what runs with only that source in the truth average to) and "
+            "its share of the total mean square, tr(J P_s Jᵀ) + (J m_s)·(J m): the variances of the sources add up, and "
+            "the fixed errors (a given mounting, a constant deflection) add as vectors, so a share can be negative when "
+            f"two fixed errors cancel. The shares add up to the total's square exactly. Steady: after {number(budget['settle_s'])} s."
+            + "".join(f" {note}." for note in budget["notes"])))
+        for quantity, q in budget["quantities"].items():
+            rows = [(row["label"], number(row["alone_final"]), number(row["share_final"]), number(row["alone_rms"]),
+                     number(row["share_steady"])) for row in q["sources"].values()]
+            rows.append(("total", number(q["total_final"]), number(q["total_final"] ** 2), number(q["total_rms"]),
+                         number(q["total_rms"] ** 2)))
+            unit = q["unit"]
+            doc.paragraph(markup(f"{quantity.replace('_', ' ').capitalize()} [{unit}]"))
+            doc.add(table(("Source", f"Alone, end [{unit}]", f"Share, end [{unit}²]", f"Alone, steady RMS [{unit}]",
+                           f"Share, steady [{unit}²]"), rows, ("left", "right", "right", "right", "right")))
+        if series is not None:
+            labels = [budget["quantities"]["horizontal_position"]["sources"][key]["label"] for key in budget["sources"]]
+            doc.figure(nav_figures.budget_shares(series["t"], series["horizontal_position_share"], labels),
+                       "Shares of the horizontal position error's mean square over time, stacked; the top is the total.")
+        return doc.compile()

@@ -121,7 +121,8 @@ def test_budget_parts_add_up_and_follow_eq_1(level, tmp_path, capsys):
     accelerometer-bias part's Schuler-mean error is R·∇/g, the gravity part's R times the deflection
     (measured: 1 % and 0.5 %; asserted within 15 %). A second call resumes (runs nothing again)."""
     out = tmp_path / "budget"
-    argv = ["budget", level, "--out", out, "--runs", "2", "--workers", "1", "--set", 'filter.mounting="ignore"',
+    argv = ["budget", level, "--out", out, "--method", "montecarlo", "--runs", "2", "--workers", "1", "--set",
+            'filter.mounting="ignore"',
             "--set", "star_sensor.misalignment_arcsec=[0.0, 0.0, 0.0]"]
     status, err = run_cli(cli.main, argv, capsys)
     assert status == 0, err
@@ -151,11 +152,16 @@ def test_budget_parts_add_up_and_follow_eq_1(level, tmp_path, capsys):
     assert (out / "parts" / "total" / "runs" / "run_00000" / "summary.json").stat().st_mtime_ns == mtime
 
 
+MONTE_CARLO = ["--method", "montecarlo"]
+
+
 @pytest.mark.parametrize("scenario, extra, message", [
-    ("base_constant.toml", [], "not a navigation scenario"),
-    ("base_navigation.toml", [], "no [star_sensor] table"),
-    ("base_sins_cns.toml", ["--runs", "0"], "--runs must be from 1"),
-    ("base_sins_cns.toml", ["--workers", "0"], "--workers must be at least 1"),
+    ("base_constant.toml", MONTE_CARLO, "not a navigation scenario"),
+    ("base_navigation.toml", MONTE_CARLO, "no [star_sensor] table"),
+    ("base_sins_cns.toml", [*MONTE_CARLO, "--runs", "0"], "--runs must be from 1"),
+    ("base_sins_cns.toml", [*MONTE_CARLO, "--workers", "0"], "--workers must be at least 1"),
+    ("base_sins_cns.toml", ["--runs", "5"], "--runs: Monte Carlo options"),
+    ("base_sins_cns.toml", ["--method", "guess"], "--method guess: must be one of covariance, montecarlo"),
 ])
 def test_budget_bad_input(scenario, extra, message, tmp_path, capsys):
     out = tmp_path / "budget"
