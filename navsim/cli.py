@@ -5,7 +5,9 @@
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
     navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
     navsim budget SCENARIO.toml --out DIR [--method covariance | --method montecarlo [--runs N] [--workers W]]
-    navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR]
+    navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR] [--report [FILE.pdf]]
+    navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
+                 [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -171,10 +173,13 @@ def _covariance(args):
     from navsim.kinds import resolve_scenario, run_kind
     from navsim.output import write_covariance
     from navsim.simulation import covariance
+    from startrack.paths import check_file
 
     scenario = resolve_scenario(args.scenario, args.set or ())
     kind = run_kind(scenario, "a covariance analysis")
     check_output(args.out, "covariance")
+    if args.report:
+        check_file(args.report, "--report", (".pdf",))
     runs = _campaign_series(args.compare, scenario) if args.compare else None
     analysis = covariance(scenario, split=args.budget)
     comparison = analysis.compare(runs) if runs else None
@@ -185,6 +190,30 @@ def _covariance(args):
               f"their 95 % band, {comparison['inside_family']} inside the family-wise band")
     print(f"wall time           {analysis.wall_seconds:.2f} s")
     print(f"written to          {out}")
+    if args.report is not None:
+        from navsim.report import write_report
+
+        print(f"report              {write_report(out, args.report or Path(out) / 'report.pdf')}")
+    return 0
+
+
+def _sweep(args):
+    from navsim.campaign.sweep import parse_vary, run_sweep
+    from navsim.report import write_report
+
+    if args.workers is not None and args.scheduler is not None:
+        raise InputError("give either --workers or --scheduler, not both")
+    result = run_sweep(args.scenario, [parse_vary(v) for v in args.vary], args.metric, args.out, method=args.method,
+                       runs=args.runs, requirement=args.requirement, workers=args.workers, scheduler=args.scheduler,
+                       overrides=args.set or ())
+    pdf = write_report(args.out, Path(args.out) / "sweep.pdf")
+    unit, requirement = result["unit"], result["requirement"]
+    keys = [key for key, _ in result["vary"]]
+    print(" ".join(f"{key:>24}" for key in keys) + f" {result['metric'] + ' [' + unit + ']':>28}")
+    for point in result["points"]:
+        meets = "" if requirement is None else ("  meets" if point["value"] <= requirement else "  fails")
+        print(" ".join(f"{str(v):>24}" for v in point["values"]) + f" {point['value']:28.4g}{meets}")
+    print(f"written to          {Path(args.out) / 'sweep.json'}, {Path(args.out) / 'sweep.csv'}, {pdf}")
     return 0
 
 
@@ -265,7 +294,26 @@ def build_parser():
     p.add_argument("--budget", action="store_true", help="also split the errors by source (the error budget)")
     p.add_argument("--compare", metavar="CAMPAIGN_DIR", default=None,
                    help="check the analysis against a Monte Carlo campaign of the same scenario (comparison.json)")
+    p.add_argument("--report", nargs="?", const="", default=None, metavar="FILE.pdf",
+                   help="also write a PDF report (default file: DIR/report.pdf)")
     p.set_defaults(func=_covariance)
+
+    p = sub.add_parser("sweep", help="a trade sweep: one metric over a grid of scenario keys, by covariance analysis "
+                                     "(default) or Monte Carlo, with its requirement chart")
+    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("--vary", action="append", required=True, metavar="KEY=V1,V2,...",
+                   help="a scenario key and its values (repeatable: the grid is every combination)")
+    p.add_argument("--metric", required=True, metavar="NAME[@TIME]",
+                   help="a summary quantity (e.g. horizontal_position), at a time (e.g. @4h, @1800 s; default: the end)")
+    p.add_argument("--out", required=True, help="sweep directory (sweep.json, sweep.csv, sweep.pdf, points/; finished "
+                                                "points there are kept)")
+    p.add_argument("--requirement", type=float, default=None, help="the metric's requirement, drawn on the chart")
+    p.add_argument("--method", default="covariance", help="covariance (default) or montecarlo")
+    p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs per point")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask distributed scheduler")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.set_defaults(func=_sweep)
     return parser
 
 

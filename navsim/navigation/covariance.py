@@ -46,6 +46,7 @@ from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
 from startrack import units
 from startrack.aberration import aberrate
+from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
 #: The error sources of the budget, in order (the keys of :data:`navsim.navigation.budget.SOURCES`).
@@ -230,7 +231,7 @@ def vector_star_sensor(scenario, star_catalog):
     if table["fidelity"] != "image":
         sensor = build.star_sensor(scenario, star_catalog)
         return dataclasses.replace(sensor, q_BS_true=mounting(table)[0]), None
-    from startrack.camera import Camera  # noqa: PLC0415  (image fidelity only)
+    from startrack.camera import Camera  # image fidelity only
 
     image, fov = table["image"], units.deg_to_rad(table["fov_deg"])
     camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
@@ -491,7 +492,7 @@ def summary(analysis, scenario):
     steady = s["t"] >= scenario["settle_s"]
     steady = steady if steady.any() else np.ones_like(steady)
     quantities = {}
-    for name, (unit, _) in QUANTITIES.items():
+    for name, (unit, _size) in QUANTITIES.items():
         rms, sigma = s[f"{name}_rms"], s[f"{name}_sigma_filter"]
         quantities[name] = {"unit": unit, "final": float(rms[-1]), "rms": float(np.sqrt(np.mean(rms[steady] ** 2))),
                             "max": float(rms[steady].max()), "mean_final": float(s[f"{name}_mean"][-1]),
@@ -604,7 +605,7 @@ def covariance_budget(scenario, analysis):
     :data:`BUDGET_FORMAT`): per summary quantity and source, the RMS the source leaves alone (what a run with
     only that source averages to) and its share of the total mean square (tr(J P_s Jᵀ) + (J m_s)·(J m): the
     shares add up to the total's square exactly), at the end and over the frames after ``settle_s``."""
-    from navsim.navigation.budget import SOURCES as LABELLED  # noqa: PLC0415  (the labels of the same sources)
+    from navsim.navigation.budget import SOURCES as LABELLED  # the labels of the same sources
 
     labels = {source.key: source.label for source in LABELLED}
     t = analysis.t
@@ -634,8 +635,42 @@ def covariance_budget_text(budget):
              f"({budget['duration_s']:.0f} s)",
              f"{'source':<36} {'alone [m]':>11} {'share [m²]':>12} {'share %':>8}"]
     total2 = q["total_final"] ** 2
-    for key, row in q["sources"].items():
+    for row in q["sources"].values():
         lines.append(f"{row['label']:<36} {row['alone_final']:11.2f} {row['share_final']:12.4g} "
                      f"{100 * row['share_final'] / total2 if total2 else 0.0:8.1f}")
     lines.append(f"{'total (√ of the summed shares)':<36} {q['total_final']:11.2f} {total2:12.4g} {100.0:8.1f}")
     return lines
+
+
+def metric_unit(name):
+    """The edge unit of the sweep metric ``name`` (a summary quantity)."""
+    return QUANTITIES[name][0]
+
+
+def check_metric(scenario, name, time_s):
+    """An InputError unless ``name`` is a summary quantity and ``time_s`` [s] (None: the end) lies in the run."""
+    if name not in QUANTITIES:
+        raise InputError(f"--metric {name}: unknown; choose one of {', '.join(QUANTITIES)}")
+    if time_s is not None and not 0.0 < time_s <= scenario["duration_s"]:
+        raise InputError(f"--metric {name}@{time_s:g}s: the time must be inside the run (0, {scenario['duration_s']:g}] s")
+
+
+def _row(t, time_s):
+    return t.size - 1 if time_s is None else int(np.argmin(np.abs(t - time_s)))
+
+
+def covariance_metric(analysis, name, time_s):
+    """{value, filter_sigma, t}: the summary quantity ``name``'s true RMS and the filter's σ at the kept frame
+    nearest ``time_s`` [s] (None: the end), in its edge unit."""
+    s = analysis.series()
+    r = _row(s["t"], time_s)
+    return {"value": float(s[f"{name}_rms"][r]), "filter_sigma": float(s[f"{name}_sigma_filter"][r]), "t": float(s["t"][r])}
+
+
+def montecarlo_metric(runs, name, time_s):
+    """{value, t, runs}: the RMS over the run series ``runs`` of the summary quantity ``name`` at the frame nearest
+    ``time_s`` [s] (None: the end), in its edge unit."""
+    t = runs[0]["t"]
+    f = _row(t, time_s)
+    squares = [np.sum(quantity_errors(run)[name][f] ** 2) for run in runs]
+    return {"value": float(np.sqrt(np.mean(squares))) / QUANTITIES[name][1], "t": float(t[f]), "runs": len(runs)}

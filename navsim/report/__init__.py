@@ -17,6 +17,7 @@ from pathlib import Path
 from navsim.kinds import of
 from navsim.output import read_npz
 from navsim.report.budget import budget_report
+from navsim.report.covariance import covariance_report, sweep_report
 from navsim.report.study import load_study, study_report
 from navsim.typeset.inputs import campaign_runs, directory_kind, load_campaign, load_run, read_json
 from startrack.errors import InputError
@@ -43,6 +44,10 @@ def _typeset(directory, output):
     """The PDF (bytes) of ``directory`` holding an output of kind ``output`` (:func:`directory_kind`)."""
     if output == "study":
         return study_report(load_study(directory))
+    if output == "covariance":
+        return covariance_report(read_json(directory / "summary.json"), read_npz(directory / "timeseries.npz"))
+    if output == "sweep":
+        return sweep_report(read_json(directory / "sweep.json"))
     if output == "budget":
         series = directory / "timeseries.npz"
         return budget_report(read_json(directory / "budget.json"), read_npz(series) if series.is_file() else None)

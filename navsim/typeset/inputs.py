@@ -138,7 +138,7 @@ def read_series(path: Path, required, names=None) -> dict:
 
 
 def directory_kind(directory: Path) -> str:
-    """'run', 'study', 'campaign' or 'budget'; anything else is an InputError."""
+    """'run', 'study', 'campaign', 'budget', 'covariance' or 'sweep'; anything else is an InputError."""
     if not directory.exists():
         raise InputError(f"{directory}: no such directory.")
     if not directory.is_dir():
@@ -147,13 +147,18 @@ def directory_kind(directory: Path) -> str:
         return "campaign"
     if (directory / "budget.json").is_file():
         return "budget"
+    if (directory / "sweep.json").is_file():
+        return "sweep"
+    if (directory / "summary.json").is_file() and '"navsim.covariance-summary/' in (directory / "summary.json").read_text(
+            encoding="utf-8", errors="replace"):
+        return "covariance"
     if (directory / "timeseries.npz").is_file() and (directory / "summary.json").is_file():
         return "run"
     if (directory / "study.npz").is_file() and (directory / "summary.json").is_file():
         return "study"
     raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz), a static-study "
-                     "directory (summary.json and study.npz), a campaign directory (campaign.json) nor an error "
-                     "budget's (budget.json).")
+                     "directory (summary.json and study.npz), a campaign directory (campaign.json), an error "
+                     "budget's (budget.json), a covariance analysis's nor a sweep's (sweep.json).")
 
 
 def load_run(directory: Path, kind) -> RunData:
