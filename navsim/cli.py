@@ -177,10 +177,10 @@ def _covariance(args):
 
     scenario = resolve_scenario(args.scenario, args.set or ())
     kind = run_kind(scenario, "a covariance analysis")
-    check_output(args.out, "covariance")
+    runs = _campaign_series(args.compare, scenario) if args.compare else None
     if args.report:
         check_file(args.report, "--report", (".pdf",))
-    runs = _campaign_series(args.compare, scenario) if args.compare else None
+    check_output(args.out, "covariance")
     analysis = covariance(scenario, split=args.budget)
     comparison = analysis.compare(runs) if runs else None
     out = publish(args.out, "covariance", lambda directory: write_covariance(directory, scenario, analysis, comparison))

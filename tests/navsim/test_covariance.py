@@ -2,12 +2,20 @@
 the truth's gets its own P back, the sources' shares add up to the total, and a mismodelled filter's true
 RMS departs from its σ as Monte Carlo runs of the same scenario do."""
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+from navsim import cli
 from navsim.kinds import resolve_scenario
 from navsim.navigation.covariance import covariance_analysis
+from navsim.output import read_npz
 from navsim.simulation import run_batch
+from tests.support import pdf_text, run_cli
+
+ROOT = Path(__file__).resolve().parents[2]
 
 SCENARIO = "scenarios/sins_cns_aircraft_vector.toml"
 #: Ten minutes of straight flight at a 50 Hz IMU (one covariance interval per 1 Hz frame).
@@ -70,3 +78,66 @@ def test_a_mismodelled_filter_departs_from_its_sigma_as_monte_carlo_does(mismode
         final = comparison["quantities"][name]["rows"][-1]
         sigma = summary["quantities"][name]["filter_sigma_final"]
         assert final["montecarlo"] / sigma > 1.3, name
+
+
+LEVEL = Path(__file__).resolve().parent / "data" / "sins_cns_level.toml"
+SHORT_LEVEL = ("--set", "duration_s=600", "--set", "settle_s=60", "--set", 'filter.mounting="ignore"')
+
+
+def test_covariance_command_writes_the_analysis_and_its_report(tmp_path, capsys):
+    out = tmp_path / "cov"
+    status, err = run_cli(cli.main, ["covariance", LEVEL, "--out", out, *SHORT_LEVEL, "--report"], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["format"] == "navsim.covariance-summary/1" and summary["kind"] == "navigation"
+    assert set(summary["quantities"]) == {"horizontal_position", "vertical_position", "horizontal_velocity",
+                                          "vertical_velocity", "tilt", "heading"}
+    series = read_npz(out / "timeseries.npz")
+    assert series["t"][-1] == 600.0 and series["state_rms"].shape == (600, len(summary["filter_states"]))
+    text, _ = pdf_text(out / "report.pdf")
+    assert "Covariance analysis: sins_cns_level" in text
+    status, err = run_cli(cli.main, ["report", out, "-o", tmp_path / "again.pdf"], capsys)
+    assert status == 0, err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["covariance", ROOT / "scenarios" / "paper003_precision.toml"], "a static study"),
+    (["covariance", LEVEL, *SHORT_LEVEL, "--compare", LEVEL.parent], "not a campaign directory"),
+    (["sweep", LEVEL, "--vary", "star_sensor.no_such_key=1,2", "--metric", "horizontal_position"], "no_such_key"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=16,wide", "--metric", "horizontal_position"], "fov_deg"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=", "--metric", "horizontal_position"], "no values (an empty grid)"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=8,16", "--metric", "speed"], "--metric speed: unknown"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=8,16", "--metric", "tilt@5h"], "inside the run"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=8,16", "--metric", "tilt@soon"], "a number of s, min or h"),
+    (["sweep", LEVEL, "--vary", "star_sensor.fov_deg=8,16", "--metric", "tilt", "--runs", "5"], "--runs: a Monte Carlo"),
+])
+def test_covariance_and_sweep_bad_input(argv, message, tmp_path, capsys):
+    out = tmp_path / "out"
+    if argv[0] == "sweep":
+        argv = [*argv, *SHORT_LEVEL]
+    status, err = run_cli(cli.main, [*argv, "--out", out], capsys)
+    assert status == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
+def test_an_interrupted_sweep_resumes_without_recomputing_finished_points(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", LEVEL, "--vary", "star_sensor.attitude_sigma_cross_arcsec=2,10", "--metric", "tilt@300",
+            "--requirement", "5", "--out", out, "--workers", "1", *SHORT_LEVEL]
+    status, err = run_cli(cli.main, argv, capsys)
+    assert status == 0, err
+    result = json.loads((out / "sweep.json").read_text())
+    assert [p["values"] for p in result["points"]] == [[2], [10]] and result["points"][0]["t"] == 300.0
+    assert result["points"][0]["value"] < result["points"][1]["value"]  # a noisier star sensor, a larger tilt
+    first = out / "points" / "point_00000.json"
+    mtime = first.stat().st_mtime_ns
+    (out / "points" / "point_00001.json").unlink()  # as if stopped before the second point
+    status, err = run_cli(cli.main, argv, capsys)
+    assert status == 0, err
+    assert first.stat().st_mtime_ns == mtime
+    assert json.loads((out / "sweep.json").read_text())["points"] == result["points"]
+    assert (out / "sweep.csv").read_text().splitlines()[0] == "star_sensor.attitude_sigma_cross_arcsec,tilt [arcsec],filter sigma [arcsec]"
+    text, _ = pdf_text(out / "sweep.pdf")
+    assert "Trade sweep: sins_cns_level" in text
+    status, err = run_cli(cli.main, [*argv[:4], "--metric", "heading", *argv[6:]], capsys)
+    assert status == 2 and "holds a sweep of another request" in err
