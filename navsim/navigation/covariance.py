@@ -27,12 +27,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navsim import analysis
+from navsim.analysis import Analysis, Quantity
 from navsim.build.faults import bias_steps, sensor_faults
 from navsim.earth.apparent import fix_rotation
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.orientation import EarthOrientation
 from navsim.earth.wgs84 import radii
-from navsim.estimation.consistency import mean_square_band
 from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
@@ -46,7 +47,6 @@ from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
 from startrack import units
 from startrack.aberration import aberrate
-from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
 #: The error sources of the budget, in order (the keys of :data:`navsim.navigation.budget.SOURCES`).
@@ -300,81 +300,6 @@ def measurements(scenario, nom, filt, star_catalog, src):
     return meas, note
 
 
-@dataclass(frozen=True)
-class Analysis:
-    """The result of a pass: at the kept frames ``t`` (K,) [s] (the nominal's ``lat``, ``h`` there), per
-    source of ``sources`` (one, "total", unless split) the mean error ``mean`` (S, K, n_t), the diagonal of
-    its covariance in the truth's (``diag_t``) and the filter's coordinates (``diag_f`` (S, K, n_f)) and its
-    leading 9 x 9 block (φ, δv, δp: the same in both); the filter's own ``filter_diag`` (K, n_f) and
-    ``filter_block``; the filter's expected NEES (K,); the truth's and the filter's state names; ``notes``."""
-
-    t: np.ndarray
-    lat: np.ndarray
-    h: np.ndarray
-    sources: tuple
-    truth_names: tuple
-    filter_names: tuple
-    mean: np.ndarray
-    diag_t: np.ndarray
-    diag_f: np.ndarray
-    block: np.ndarray
-    filter_diag: np.ndarray
-    filter_block: np.ndarray
-    nees: np.ndarray
-    T: np.ndarray
-    notes: tuple
-    wall_seconds: float
-
-    def selectors(self):
-        """{quantity: (K, r, 9)} the rows that take the leading block to each summary quantity (SI)."""
-        K = self.t.size
-        r_m, r_n = radii(self.lat)
-        out = {}
-        for name, rows in (("horizontal_position", ((6, r_m + self.h), (7, (r_n + self.h) * np.cos(self.lat)))),
-                           ("vertical_position", ((8, -np.ones(K)),)), ("horizontal_velocity", ((3, 1.0), (4, 1.0))),
-                           ("vertical_velocity", ((5, 1.0),)), ("tilt", ((0, 1.0), (1, 1.0))), ("heading", ((2, 1.0),))):
-            sel = np.zeros((K, len(rows), BLOCK))
-            for r, (column, scale) in enumerate(rows):
-                sel[:, r, column] = scale
-            out[name] = sel
-        return out
-
-    def mean_square(self):
-        """{quantity: (S, K)} each source's share of the true mean square [SI²]: tr(J P_s Jᵀ) + (J m_s)·(J m),
-        m the total mean; the shares add up to the total exactly."""
-        total = self.mean.sum(axis=0)[:, :BLOCK]
-        out = {}
-        for name, sel in self.selectors().items():
-            var = np.einsum("kri,skij,krj->sk", sel, self.block, sel)
-            out[name] = var + np.einsum("kri,ski,krj,kj->sk", sel, self.mean[:, :, :BLOCK], sel, total)
-        return out
-
-    def series(self):
-        """The arrays of ``timeseries.npz`` (:func:`series`)."""
-        return series(self)
-
-    def summary(self, scenario):
-        """The content of ``summary.json`` (:func:`summary`)."""
-        return summary(self, scenario)
-
-    def compare(self, runs):
-        """The analysis against Monte Carlo run series (:func:`compare`)."""
-        return compare(self, runs)
-
-    def alone_mean_square(self):
-        """{quantity: (S, K)} the true mean square each source leaves alone, tr(J P_s Jᵀ) + |J m_s|² [SI²]: what a
-        run with only that source in its truth averages to (``navsim budget --method montecarlo``'s parts)."""
-        out = {}
-        for name, sel in self.selectors().items():
-            projected = np.einsum("kri,ski->skr", sel, self.mean[:, :, :BLOCK])
-            out[name] = np.einsum("kri,skij,krj->sk", sel, self.block, sel) + np.sum(projected**2, axis=2)
-        return out
-
-    def filter_variance(self):
-        """{quantity: (K,)} the filter's own variance of each summary quantity [SI²]."""
-        return {name: np.einsum("kri,kij,krj->k", sel, self.filter_block, sel) for name, sel in self.selectors().items()}
-
-
 def covariance_analysis(scenario, split=False, star_catalog=None):
     """The linear covariance analysis of a validated navigation scenario: an :class:`Analysis`, each error
     source apart when ``split`` (the budget), else their sum ("total")."""
@@ -413,10 +338,14 @@ def covariance_analysis(scenario, split=False, star_catalog=None):
               np.asarray(q_BS, dtype=float), meas, step_frames, step_values, max(src("inertial"), 0))
     t, mean_out, diag_t, diag_f, block, filter_diag, filter_block, nees = out
     k = np.rint(t / nom.dt).astype(int)
-    return Analysis(t=t, lat=path.lat[k], h=path.h[k], sources=sources, truth_names=mod.names,
-                    filter_names=tuple(state_names(filt.layout)), mean=mean_out, diag_t=diag_t, diag_f=diag_f, block=block,
-                    filter_diag=filter_diag, filter_block=filter_block, nees=nees, T=mod.T,
-                    notes=() if note is None else (note,), wall_seconds=time.perf_counter() - started)
+    lat, h = path.lat[k], path.h[k]
+    names_f = tuple(state_names(filt.layout))
+    return Analysis(t=t, sources=sources, truth_names=mod.names, filter_names=names_f, mean=mean_out, diag_t=diag_t,
+                    diag_f=diag_f, block=block, filter_diag=filter_diag, filter_block=filter_block, nees=nees,
+                    nees_dof=len(names_f), T=mod.T, quantities=quantities(lat, h),
+                    units_t=tuple(state_unit(n)[0] for n in mod.names), scale_t=edge_scale(mod.names, lat, h),
+                    units_f=tuple(state_unit(n)[0] for n in names_f), scale_f=edge_scale(names_f, lat, h),
+                    run_errors=run_errors, notes=() if note is None else (note,), wall_seconds=time.perf_counter() - started)
 
 
 def _present(mod, i, scenario, name):
@@ -432,214 +361,62 @@ def _present(mod, i, scenario, name):
 
 
 def state_unit(name):
-    """(unit, SI size) of an error state at the edge; position states by their name (metres at the nominal)."""
+    """(unit, SI size) of an error state at the edge (δL, δλ in metres: their size depends on the position)."""
     for prefix, unit, size in STATE_UNITS:
         if name.startswith(prefix):
             return unit, size
     raise KeyError(name)
 
 
-def edge_scale(analysis, names):
-    """(K, len(names)) SI size of each state's edge unit at each kept frame (δL, δλ in metres there)."""
-    r_m, r_n = radii(analysis.lat)
-    out = np.empty((analysis.t.size, len(names)))
+def edge_scale(names, lat, h):
+    """(K, len(names)) SI size of each state's edge unit at the positions (L, h) (K,) (δL, δλ in metres there)."""
+    r_m, r_n = radii(lat)
+    out = np.empty((np.size(lat), len(names)))
     for j, name in enumerate(names):
-        unit, size = state_unit(name)
-        if name == "dlat":
-            out[:, j] = 1.0 / (r_m + analysis.h)
-        elif name == "dlon":
-            out[:, j] = 1.0 / ((r_n + analysis.h) * np.cos(analysis.lat))
-        else:
-            out[:, j] = size
+        out[:, j] = {"dlat": 1.0 / (r_m + h), "dlon": 1.0 / ((r_n + h) * np.cos(lat))}.get(name, state_unit(name)[1])
     return out
 
 
-def series(analysis):
-    """The arrays of ``timeseries.npz`` (edge units: :data:`QUANTITIES`, :data:`STATE_UNITS`): ``t``; per
-    summary quantity its true RMS ``<q>_rms``, mean-error size ``<q>_mean`` and the filter's σ ``<q>_sigma_filter``;
-    the filter's states (``state_names``): true RMS ``state_rms``, mean ``state_mean``, filter σ ``state_sigma``;
-    the truth's (``truth_state_names``): ``truth_state_rms``, ``truth_state_mean``; ``nees_expected``; with the
-    sources apart, ``sources`` and each quantity's share of the mean square ``<q>_share`` (S, K) [unit²]."""
-    a = analysis
-    total_mean = a.mean.sum(axis=0)
-    ms, fv = a.mean_square(), a.filter_variance()
-    out = {"t": a.t, "nees_expected": a.nees, "state_names": np.array(a.filter_names),
-           "truth_state_names": np.array(a.truth_names), "sources": np.array(a.sources)}
-    sel = a.selectors()
-    for name, (unit, size) in QUANTITIES.items():
-        out[f"{name}_rms"] = np.sqrt(np.maximum(ms[name].sum(axis=0), 0.0)) / size
-        out[f"{name}_mean"] = np.linalg.norm(np.einsum("kri,ki->kr", sel[name], total_mean[:, :BLOCK]), axis=1) / size
-        out[f"{name}_sigma_filter"] = np.sqrt(fv[name]) / size
-        if len(a.sources) > 1:
-            out[f"{name}_share"] = ms[name] / size**2
-    f_scale, t_scale = edge_scale(a, a.filter_names), edge_scale(a, a.truth_names)
-    mean_f = total_mean @ a.T.T
-    out["state_rms"] = np.sqrt(a.diag_f.sum(axis=0) + mean_f**2) / f_scale
-    out["state_mean"] = mean_f / f_scale
-    out["state_sigma"] = np.sqrt(a.filter_diag) / f_scale
-    out["truth_state_rms"] = np.sqrt(a.diag_t.sum(axis=0) + total_mean**2) / t_scale
-    out["truth_state_mean"] = total_mean / t_scale
+def quantities(lat, h):
+    """{name: :class:`~navsim.analysis.Quantity`} of the summary quantities at the positions (L, h) (K,): the NED
+    position (δL (R_M + h), δλ (R_N + h) cos L, −δh), velocity and φ components of the leading block."""
+    K = np.size(lat)
+    r_m, r_n = radii(lat)
+    rows = {"horizontal_position": ((6, r_m + h), (7, (r_n + h) * np.cos(lat))), "vertical_position": ((8, -np.ones(K)),),
+            "horizontal_velocity": ((3, 1.0), (4, 1.0)), "vertical_velocity": ((5, 1.0),),
+            "tilt": ((0, 1.0), (1, 1.0)), "heading": ((2, 1.0),)}
+    out = {}
+    for name, components in rows.items():
+        sel = np.zeros((K, len(components), BLOCK))
+        for r, (column, scale) in enumerate(components):
+            sel[:, r, column] = scale
+        out[name] = Quantity(unit=QUANTITIES[name][0], size=QUANTITIES[name][1], rows=sel)
     return out
 
 
-def summary(analysis, scenario):
-    """The analysis's ``summary.json`` (``navsim.covariance-summary/1``): per summary quantity its true RMS at
-    the end (``final``), over the frames after ``settle_s`` (``rms``, √ of the mean square) and its largest
-    (``max``), the mean error's size at the end and the filter's own σ at the end beside its ratio; per filter
-    state at the end its true RMS, mean and the filter's σ; the filter's expected NEES after ``settle_s``
-    against its dof; with the sources apart the budget's shares at the end and over the steady frames."""
-    s = series(analysis)
-    steady = s["t"] >= scenario["settle_s"]
-    steady = steady if steady.any() else np.ones_like(steady)
-    quantities = {}
-    for name, (unit, _size) in QUANTITIES.items():
-        rms, sigma = s[f"{name}_rms"], s[f"{name}_sigma_filter"]
-        quantities[name] = {"unit": unit, "final": float(rms[-1]), "rms": float(np.sqrt(np.mean(rms[steady] ** 2))),
-                            "max": float(rms[steady].max()), "mean_final": float(s[f"{name}_mean"][-1]),
-                            "filter_sigma_final": float(sigma[-1]),
-                            "true_over_filter_final": float(rms[-1] / sigma[-1]) if sigma[-1] > 0 else None}
-    states = {name: {"unit": state_unit(name)[0], "rms_final": float(s["state_rms"][-1, j]),
-                     "mean_final": float(s["state_mean"][-1, j]), "filter_sigma_final": float(s["state_sigma"][-1, j])}
-              for j, name in enumerate(analysis.filter_names)}
-    out = {"format": "navsim.covariance-summary/1", "scenario": scenario.name, "kind": scenario.kind,
-           "method": "linear covariance analysis", "duration_s": float(s["t"][-1]), "rows": int(s["t"].size),
-           "settle_s": float(scenario["settle_s"]), "quantities": quantities, "states": states,
-           "truth_states": list(analysis.truth_names), "filter_states": list(analysis.filter_names),
-           "nees_expected": {"dof": len(analysis.filter_names), "mean": float(np.mean(s["nees_expected"][steady])),
-                             "final": float(s["nees_expected"][-1])},
-           "notes": list(analysis.notes), "timing": {"wall_seconds": round(analysis.wall_seconds, 4)}}
-    if len(analysis.sources) > 1:
-        out["budget"] = {name: {source: {"final": float(s[f"{name}_share"][i, -1]),
-                                         "steady": float(np.mean(s[f"{name}_share"][i, steady]))}
-                                for i, source in enumerate(analysis.sources)} for name in QUANTITIES}
-    return out
-
-
-#: How many times along the run a comparison with Monte Carlo checks.
-COMPARE_TIMES = 10
-
-
-def quantity_errors(series_arrays):
-    """{quantity: (F, r)} the errors of a run's series (``error_state``, ``position_error_m``) that make each
-    summary quantity (SI): the NED position, velocity and φ components."""
+def run_errors(series_arrays):
+    """({quantity: (F, r)}, the error state (F, n_f)) of a navigation run's series [SI]: the NED position
+    errors, the velocity and φ components (:func:`quantities`'s rows)."""
     e, p = series_arrays["error_state"], series_arrays["position_error_m"]
-    return {"horizontal_position": p[:, 0:2], "vertical_position": p[:, 2:3], "horizontal_velocity": e[:, 3:5],
-            "vertical_velocity": e[:, 5:6], "tilt": e[:, 0:2], "heading": e[:, 2:3]}
-
-
-def compare(analysis, runs, times=COMPARE_TIMES, probability=0.95):
-    """The analysis against Monte Carlo runs (a list of run series: ``t``, ``error_state``,
-    ``position_error_m``): at ``times`` instants evenly along the run, each summary quantity's and filter
-    state's RMS over the runs beside the analysis's and the ``probability`` sampling band of an N-run RMS
-    (:func:`navsim.estimation.consistency.mean_square_band`); the family-wise band holds all checks at once
-    at ``probability`` (Šidák). Returns a JSON-able dict."""
-    a, N = analysis, len(runs)
-    t_run = runs[0]["t"]
-    wanted = a.t[-1] * (np.arange(times) + 1) / times
-    frames = [int(np.argmin(np.abs(t_run - w))) for w in wanted]
-    rows = [int(np.argmin(np.abs(a.t - t_run[f]))) for f in frames]
-    block = a.block.sum(axis=0)
-    total = a.mean.sum(axis=0)
-    sel = a.selectors()
-    checks = len(QUANTITIES) * times + len(a.filter_names) * times
-    family = probability ** (1.0 / checks)
-    out = {"runs": N, "probability": probability, "family_probability": probability, "checks": checks,
-           "quantities": {}, "states": {}}
-
-    def entry(expected, variance, samples, size):
-        lo, hi = mean_square_band(expected, variance, N, probability)
-        flo, fhi = mean_square_band(expected, variance, N, family)
-        mc = float(np.mean(samples))
-        return {"analysis": float(np.sqrt(expected)) / size, "montecarlo": float(np.sqrt(mc)) / size,
-                "band": [float(np.sqrt(lo)) / size, float(np.sqrt(hi)) / size], "inside": bool(lo <= mc <= hi),
-                "family_band": [float(np.sqrt(flo)) / size, float(np.sqrt(fhi)) / size],
-                "inside_family": bool(flo <= mc <= fhi)}
-
-    errors = [quantity_errors(run) for run in runs]
-    for name, (unit, size) in QUANTITIES.items():
-        rows_out = []
-        for r, f in zip(rows, frames):
-            J = sel[name][r]
-            C, m = J @ block[r] @ J.T, J @ total[r, :BLOCK]
-            expected = np.trace(C) + m @ m
-            variance = 2.0 * np.trace(C @ C) + 4.0 * m @ C @ m
-            samples = [np.sum(err[name][f] ** 2) for err in errors]
-            rows_out.append({"t": float(a.t[r]), **entry(expected, variance, samples, size)})
-        out["quantities"][name] = {"unit": unit, "rows": rows_out}
-    mean_f = total @ a.T.T
-    var_f = a.diag_f.sum(axis=0)
-    scale = edge_scale(a, a.filter_names)
-    for j, name in enumerate(a.filter_names):
-        rows_out = []
-        for r, f in zip(rows, frames):
-            expected = var_f[r, j] + mean_f[r, j] ** 2
-            variance = 2.0 * var_f[r, j] ** 2 + 4.0 * mean_f[r, j] ** 2 * var_f[r, j]
-            samples = [run["error_state"][f, j] ** 2 for run in runs]
-            rows_out.append({"t": float(a.t[r]), **entry(expected, variance, samples, scale[r, j])})
-        out["states"][name] = {"unit": state_unit(name)[0], "rows": rows_out}
-    every = [row for group in ("quantities", "states") for item in out[group].values() for row in item["rows"]]
-    out["inside"] = sum(row["inside"] for row in every)
-    out["inside_family"] = sum(row["inside_family"] for row in every)
-    return out
+    return ({"horizontal_position": p[:, 0:2], "vertical_position": p[:, 2:3], "horizontal_velocity": e[:, 3:5],
+             "vertical_velocity": e[:, 5:6], "tilt": e[:, 0:2], "heading": e[:, 2:3]}, e)
 
 
 def covariance_lines(summary):
-    """What the command line prints of a covariance analysis's summary."""
-    lines = [f"{'quantity':<20}{'true RMS end':>14}{'filter σ end':>14}{'true/filter':>12}{'RMS steady':>12}  unit"]
-    for name, q in summary["quantities"].items():
-        ratio = "-" if q["true_over_filter_final"] is None else f"{q['true_over_filter_final']:.3f}"
-        lines.append(f"{name.replace('_', ' '):<20}{q['final']:>14.4g}{q['filter_sigma_final']:>14.4g}{ratio:>12}"
-                     f"{q['rms']:>12.4g}  {q['unit']}")
-    nees = summary["nees_expected"]
-    lines.append(f"expected NEES       {nees['mean']:.2f} after settling for {nees['dof']} dof (consistent: = dof)")
-    lines += [f"note                {note}" for note in summary["notes"]]
-    return lines
+    """What the command line prints of the analysis's summary."""
+    return analysis.lines(summary)
 
 
-#: The format of a covariance budget's ``budget.json``.
-BUDGET_FORMAT = "navsim.covariance-budget/1"
-
-
-def covariance_budget(scenario, analysis):
-    """The error budget of ``scenario`` from its analysis with the sources apart (the content of ``budget.json``,
-    :data:`BUDGET_FORMAT`): per summary quantity and source, the RMS the source leaves alone (what a run with
-    only that source averages to) and its share of the total mean square (tr(J P_s Jᵀ) + (J m_s)·(J m): the
-    shares add up to the total's square exactly), at the end and over the frames after ``settle_s``."""
+def covariance_budget(scenario, result):
+    """The budget of the analysis ``result`` with its sources apart (:func:`navsim.analysis.budget`), labelled
+    as :data:`navsim.navigation.budget.SOURCES`."""
     from navsim.navigation.budget import SOURCES as LABELLED  # the labels of the same sources
 
-    labels = {source.key: source.label for source in LABELLED}
-    t = analysis.t
-    steady = t >= scenario["settle_s"]
-    steady = steady if steady.any() else np.ones_like(steady)
-    share, alone = analysis.mean_square(), analysis.alone_mean_square()
-    quantities = {}
-    for name, (unit, size) in QUANTITIES.items():
-        total = share[name].sum(axis=0)
-        rows = {key: {"label": labels[key], "alone_final": float(np.sqrt(alone[name][i, -1])) / size,
-                      "alone_rms": float(np.sqrt(np.mean(alone[name][i, steady]))) / size,
-                      "share_final": float(share[name][i, -1]) / size**2,
-                      "share_steady": float(np.mean(share[name][i, steady])) / size**2}
-                for i, key in enumerate(analysis.sources)}
-        quantities[name] = {"unit": unit, "total_final": float(np.sqrt(total[-1])) / size,
-                            "total_rms": float(np.sqrt(np.mean(total[steady]))) / size, "sources": rows}
-    return {"format": BUDGET_FORMAT, "method": "covariance", "scenario": scenario.name, "source": scenario.source,
-            "settle_s": float(scenario["settle_s"]), "duration_s": float(t[-1]), "sources": list(analysis.sources),
-            "quantities": quantities, "notes": list(analysis.notes)}
+    return analysis.budget(scenario, result, {source.key: source.label for source in LABELLED})
 
 
 def covariance_budget_text(budget):
-    """The covariance budget as lines of text: per source the horizontal position error it leaves alone and
-    its share of the total's mean square, at the end."""
-    q = budget["quantities"]["horizontal_position"]
-    lines = [f"error budget        {budget['scenario']}: linear covariance analysis, horizontal position at the end "
-             f"({budget['duration_s']:.0f} s)",
-             f"{'source':<36} {'alone [m]':>11} {'share [m²]':>12} {'share %':>8}"]
-    total2 = q["total_final"] ** 2
-    for row in q["sources"].values():
-        lines.append(f"{row['label']:<36} {row['alone_final']:11.2f} {row['share_final']:12.4g} "
-                     f"{100 * row['share_final'] / total2 if total2 else 0.0:8.1f}")
-    lines.append(f"{'total (√ of the summed shares)':<36} {q['total_final']:11.2f} {total2:12.4g} {100.0:8.1f}")
-    return lines
+    return analysis.budget_text(budget)
 
 
 def metric_unit(name):
@@ -649,28 +426,12 @@ def metric_unit(name):
 
 def check_metric(scenario, name, time_s):
     """An InputError unless ``name`` is a summary quantity and ``time_s`` [s] (None: the end) lies in the run."""
-    if name not in QUANTITIES:
-        raise InputError(f"--metric {name}: unknown; choose one of {', '.join(QUANTITIES)}")
-    if time_s is not None and not 0.0 < time_s <= scenario["duration_s"]:
-        raise InputError(f"--metric {name}@{time_s:g}s: the time must be inside the run (0, {scenario['duration_s']:g}] s")
+    analysis.check_metric(scenario, name, time_s, {k: unit for k, (unit, _) in QUANTITIES.items()})
 
 
-def _row(t, time_s):
-    return t.size - 1 if time_s is None else int(np.argmin(np.abs(t - time_s)))
-
-
-def covariance_metric(analysis, name, time_s):
-    """{value, filter_sigma, t}: the summary quantity ``name``'s true RMS and the filter's σ at the kept frame
-    nearest ``time_s`` [s] (None: the end), in its edge unit."""
-    s = analysis.series()
-    r = _row(s["t"], time_s)
-    return {"value": float(s[f"{name}_rms"][r]), "filter_sigma": float(s[f"{name}_sigma_filter"][r]), "t": float(s["t"][r])}
+def covariance_metric(result, name, time_s):
+    return analysis.covariance_metric(result, name, time_s)
 
 
 def montecarlo_metric(runs, name, time_s):
-    """{value, t, runs}: the RMS over the run series ``runs`` of the summary quantity ``name`` at the frame nearest
-    ``time_s`` [s] (None: the end), in its edge unit."""
-    t = runs[0]["t"]
-    f = _row(t, time_s)
-    squares = [np.sum(quantity_errors(run)[name][f] ** 2) for run in runs]
-    return {"value": float(np.sqrt(np.mean(squares))) / QUANTITIES[name][1], "t": float(t[f]), "runs": len(runs)}
+    return analysis.montecarlo_metric(runs, name, time_s, run_errors, QUANTITIES[name][1])

@@ -15,7 +15,7 @@ FLOORS = (
     {"kinematics", "kinematics_jit", "earth", "scenario"},   # geometry, numerics, the scenario files' machinery
     {"truth", "sensors", "ins"},                             # the truth, the sensor models, the strapdown INS
     {"estimation"},                                          # the filters
-    {"closed_loop", "records", "output", "places", "pooling"},
+    {"closed_loop", "records", "output", "places", "pooling", "analysis"},
     {"studies"},                                             # the source documents' experiments
     {"build", "typeset", "star_run"},                        # what the run kinds share
     {"attitude", "navigation"},                              # the run kinds
