@@ -16,6 +16,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.attitude.scenario": ("validate", "check_tuning"),
     "navsim.attitude.run": ("prepare", "simulate", "lanes", "check_truth_off", "budget_parts", "TRUTH_SOURCES"),
     "navsim.attitude.records": ("RunSummary", "CampaignSummary"),
+    "navsim.attitude.covariance": ("covariance_analysis", "covariance_lines", "covariance_budget", "covariance_budget_text",
+                                   "metric_unit", "check_metric", "covariance_metric", "montecarlo_metric"),
     "navsim.attitude.campaign": ("pool",),
     "navsim.attitude.console": ("run_lines", "campaign_lines"),
     "navsim.attitude.report": ("run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES"),

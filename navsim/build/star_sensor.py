@@ -49,6 +49,30 @@ def star_sensor(scenario, star_catalog, frame_interval, epoch, lanes=()):
     )
 
 
+def vector_equivalent(scenario, star_catalog, frame_interval, epoch):
+    """(the vector-fidelity sensor a covariance analysis sees, with the nominal mounting (its error is a state of
+    the analysis); a note when it stands for an image-fidelity sensor, else None): at image fidelity the stars of
+    the magnitude limit in the field, at most ``max_identified_stars``, each of σ = centroid σ / focal length."""
+    table = scenario["star_sensor"]
+    q_BS, _ = mounting(table)
+    if table["fidelity"] != "image":
+        return dataclasses.replace(star_sensor(scenario, star_catalog, frame_interval, epoch), q_BS_true=q_BS), None
+    image, fov = table["image"], float(units.deg_to_rad(table["fov_deg"]))
+    camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
+    if image["camera_file"] is not None:
+        camera = Camera.from_file(image["camera_file"])
+    stars = star_catalog.brighter_than(table["mag_limit"])
+    sigma = image["centroid_sigma_px"] / camera.focal_px
+    sensor = StarVectorSensor(star_vectors=np.asarray(stars.vectors), star_ids=np.asarray(stars.hip),
+                              star_mags=np.asarray(stars.v_mag), fov=fov, sigma=float(sigma),
+                              max_stars=image["max_identified_stars"], q_BS_true=q_BS,
+                              faults=sensor_faults(scenario["faults"], frame_interval))
+    note = (f"image fidelity modelled by its vector-fidelity equivalent: the V <= {table['mag_limit']:g} stars in the "
+            f"{table['fov_deg']:g} deg field, at most {image['max_identified_stars']}, each "
+            f"{units.rad_to_arcsec(sigma):.2f}\" per axis (centroid {image['centroid_sigma_px']:g} px)")
+    return sensor, note
+
+
 def image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes=()):
     """The image-fidelity sensor of ``scenario['star_sensor']`` and its ``image`` table: camera,
     detector, navigation catalog (eq. 1-8 of 000, at ``epoch`` [Julian year]) and identifier, the stars

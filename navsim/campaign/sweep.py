@@ -195,7 +195,7 @@ def _montecarlo_point(kind, directory, k, point, name, time_s, runs, workers, sc
     _, finished, _ = load_runs(campaign)
     if not finished:
         raise InputError(f"sweep point {k} ({values}): no run finished ({campaign}/runs/*/error.json)")
-    _write_point(directory, k, [(k, point)], kind.montecarlo_metric([series for _, _, series in finished], name, time_s))
+    _write_point(directory, k, [(k, point)], kind.montecarlo_metric(scenario, [series for _, _, series in finished], name, time_s))
 
 
 def _write_point(directory, k, todo, metric):

@@ -14,7 +14,7 @@ consider states, Q, R, noise scales). Left out, as the runs have them: quantisat
 accumulated LSB, bounded), NIS gating (every measurement is taken) and the second-order terms of large
 errors. At image fidelity the star sensor is its vector-fidelity equivalent: the catalog's stars of its
 magnitude limit in its field, at most ``max_identified_stars``, each with the centroid σ of the image
-table through the camera's focal length (``summary['star_sensor_model']`` says so).
+table through the camera's focal length (the summary's notes say so).
 
 A fixed truth error (the mounting, a constant gravity disturbance, a given turn-on bias, a bias step, the
 baro's lag) is carried as the mean error m beside the covariance; an RMS is √(σ² + m²).
@@ -29,7 +29,8 @@ import numpy as np
 
 from navsim import analysis
 from navsim.analysis import Analysis, Quantity
-from navsim.build.faults import bias_steps, sensor_faults
+from navsim.build.faults import bias_steps
+from navsim.build.star_sensor import vector_equivalent
 from navsim.earth.apparent import fix_rotation
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.orientation import EarthOrientation
@@ -41,7 +42,7 @@ from navsim.navigation import build
 from navsim.navigation.scenario import frame_rate
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.star_sensor import isotropic_covariance
-from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
+from navsim.sensors.star_vector import AttitudeFixSensor
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
@@ -223,32 +224,6 @@ def _coarsening(imu_hz, ratio, every):
     return max(d for d in range(1, common + 1) if common % d == 0 and imu_hz / d >= min(MIN_RATE_HZ, imu_hz))
 
 
-def vector_star_sensor(scenario, star_catalog):
-    """(the vector-fidelity star sensor the analysis sees, with its nominal mounting; a note when it stands
-    for an image-fidelity sensor): at image fidelity the stars of the magnitude limit in the field, at most
-    ``max_identified_stars``, each of σ = centroid σ / focal length."""
-    table = scenario["star_sensor"]
-    if table["fidelity"] != "image":
-        sensor = build.star_sensor(scenario, star_catalog)
-        return dataclasses.replace(sensor, q_BS_true=mounting(table)[0]), None
-    from startrack.camera import Camera  # image fidelity only
-
-    image, fov = table["image"], units.deg_to_rad(table["fov_deg"])
-    camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
-    if image["camera_file"] is not None:
-        camera = Camera.from_file(image["camera_file"])
-    stars = star_catalog.brighter_than(table["mag_limit"])
-    sigma = image["centroid_sigma_px"] / camera.focal_px
-    sensor = StarVectorSensor(star_vectors=np.asarray(stars.vectors), star_ids=np.asarray(stars.hip),
-                              star_mags=np.asarray(stars.v_mag), fov=float(fov), sigma=float(sigma),
-                              max_stars=image["max_identified_stars"], q_BS_true=mounting(table)[0],
-                              faults=sensor_faults(scenario["faults"], 1.0 / table["rate_hz"]))
-    note = (f"image fidelity modelled by its vector-fidelity equivalent: the V <= {table['mag_limit']:g} stars in the "
-            f"{table['fov_deg']:g} deg field, at most {image['max_identified_stars']}, each "
-            f"{units.rad_to_arcsec(sigma):.2f}\" per axis (centroid {image['centroid_sigma_px']:g} px)")
-    return sensor, note
-
-
 def measurements(scenario, nom, filt, star_catalog, src):
     """(the pass's :class:`~navsim.estimation.nav_lincov.Measurements`, a note on the star sensor's model or
     None) of the scenario's sensors along the nominal; ``src`` the stack index of each source."""
@@ -257,7 +232,8 @@ def measurements(scenario, nom, filt, star_catalog, src):
     offsets, ref, obs, cov = np.zeros(F + 1, np.int64), empty3, empty3, np.zeros((0, 3, 3))
     fix_mask, fix_q, fix_R = np.zeros(F, np.bool_), np.zeros((F, 4)), np.zeros((3, 3))
     if nom.sky is not None:
-        sensor, note = vector_star_sensor(scenario, star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario)))
+        catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
+        sensor, note = vector_equivalent(scenario, catalog, 1.0 / scenario["star_sensor"]["rate_hz"], build.catalog_epoch(scenario))
         available = sensor.faults.available(nom.frame_k * dt)
         correct = scenario["star_sensor"]["aberration_correction"]
         if isinstance(sensor, AttitudeFixSensor):
@@ -433,5 +409,5 @@ def covariance_metric(result, name, time_s):
     return analysis.covariance_metric(result, name, time_s)
 
 
-def montecarlo_metric(runs, name, time_s):
+def montecarlo_metric(scenario, runs, name, time_s):
     return analysis.montecarlo_metric(runs, name, time_s, run_errors, QUANTITIES[name][1])
