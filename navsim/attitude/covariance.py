@@ -87,7 +87,11 @@ def _initial(scenario, gyro, filt, tm, names, dt):
     S, n = len(SOURCES), len(names)
     src = {key: i for i, key in enumerate(SOURCES)}
     P0, m0 = np.zeros((S, n, n)), np.zeros((S, n))
-    P0[src["initial"], 0:3, 0:3] = filt.config.P0[0:3, 0:3]
+    fixed = scenario["filter"]["initial_attitude_error_arcsec"]
+    if fixed is None:
+        P0[src["initial"], 0:3, 0:3] = filt.config.P0[0:3, 0:3]
+    else:
+        m0[src["initial"], 0:3] = units.arcsec_to_rad(np.asarray(fixed, dtype=float))
     b = src["gyro_bias"]
     if gyro.bias_turn_on is not None:
         m0[b, 3:6] = gyro.bias_turn_on

@@ -103,6 +103,8 @@ def simulate(prepared, seed, compiled=True):
     omega, bias_true = apply_bias_steps(record.omega, record.bias, p.truth.t[1:], p.bias_steps)
     config = build.filter_config(scenario, p.gyro)
     dtheta0 = np.sqrt(np.diag(config.P0)[0:3]) * np.random.default_rng(init_ss).standard_normal(3)
+    if scenario["filter"]["initial_attitude_error_arcsec"] is not None:  # the error δθ: q_est = q_true ⊗ δq(−δθ)
+        dtheta0 = -units.arcsec_to_rad(np.asarray(scenario["filter"]["initial_attitude_error_arcsec"], dtype=float))
     filt = AttitudeFilter(rot.multiply(p.truth.q_IB[0], rot.from_rotation_vector(dtheta0)), np.zeros(3), config)
     frame_k = grid.frame_k
     if scenario["star_sensor"]["fidelity"] == "image":

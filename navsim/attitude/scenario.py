@@ -77,6 +77,9 @@ SCHEMA = Table(
         "filter": Table(
             {
                 "initial_attitude_sigma_deg": Value("float", default=0.1, exclusive_minimum=0.0, maximum=180.0),
+                "initial_attitude_error_arcsec": Value("vector", default=None, minimum=-36000.0, maximum=36000.0,
+                                                       doc="the filter's initial attitude error δθ (body axes: q_true = "
+                                                           "q_est ⊗ δq(δθ)), fixed instead of drawn from its σ"),
                 "initial_bias_sigma_deg_per_h": Value("float", default=None, exclusive_minimum=0.0, maximum=MAX_BIAS),
                 "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW,
                                             doc="ARW the filter assumes (default: the gyro's)"),

@@ -15,6 +15,7 @@ def gyro_model(table, rate_hz):
         "arw_deg_per_sqrt_h": ("arw", units.arw_to_si),
         "rrw_deg_per_h_per_sqrt_h": ("rrw", units.rrw_to_si),
         "bias_turn_on_deg_per_h": ("bias_turn_on_sigma", units.deg_per_h_to_rad_per_s),
+        "bias_fixed_deg_per_h": ("bias_turn_on", lambda v: tuple(float(x) for x in units.deg_per_h_to_rad_per_s(v))),
         "bias_instability_deg_per_h": ("bias_instability_sigma", _bias_instability),
         "bias_correlation_s": ("bias_correlation_time", float),
         "scale_factor_ppm": ("scale_factor_sigma", lambda v: v * 1e-6),
@@ -22,8 +23,7 @@ def gyro_model(table, rate_hz):
         "quantization_arcsec": ("quantization", units.arcsec_to_rad),
         "saturation_deg_per_s": ("saturation", units.deg_to_rad),
     }
-    changes = {name: float(convert(table[key])) for key, (name, convert) in fields.items() if table.get(key) is not None}
-    return GyroModel(**{**base.__dict__, **changes})
+    return GyroModel(**{**base.__dict__, **_changes(table, fields)})
 
 
 def accelerometer_model(table, rate_hz):
@@ -34,6 +34,7 @@ def accelerometer_model(table, rate_hz):
         "vrw_m_per_s_per_sqrt_h": ("vrw", units.vrw_to_si),
         "bias_rw_micro_g_per_sqrt_h": ("bias_rw", units.micro_g_per_sqrt_h_to_si),
         "bias_turn_on_micro_g": ("bias_turn_on_sigma", units.micro_g_to_si),
+        "bias_fixed_micro_g": ("bias_turn_on", lambda v: tuple(float(x) for x in units.micro_g_to_si(v))),
         "bias_instability_micro_g": ("bias_instability_sigma", lambda v: bias_instability_to_sigma(units.micro_g_to_si(v))),
         "bias_correlation_s": ("bias_correlation_time", float),
         "scale_factor_ppm": ("scale_factor_sigma", lambda v: v * units.PPM),
@@ -41,8 +42,17 @@ def accelerometer_model(table, rate_hz):
         "quantization_m_per_s": ("quantization", float),
         "saturation_m_per_s2": ("saturation", float),
     }
-    changes = {name: float(convert(table[key])) for key, (name, convert) in fields.items() if table.get(key) is not None}
-    return AccelerometerModel(**{**base.__dict__, **changes})
+    return AccelerometerModel(**{**base.__dict__, **_changes(table, fields)})
+
+
+def _changes(table, fields):
+    """{model field: SI value} of the datasheet keys ``table`` gives (``fields``: key -> (model field, conversion))."""
+    out = {}
+    for key, (name, convert) in fields.items():
+        if table.get(key) is not None:
+            value = convert(table[key])
+            out[name] = value if isinstance(value, tuple) else float(value)
+    return out
 
 
 def _bias_instability(deg_per_h):

@@ -39,6 +39,7 @@ from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
 from navsim.navigation import build
+from navsim.navigation.run import fixed_initial_error
 from navsim.navigation.scenario import frame_rate
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.star_sensor import isotropic_covariance
@@ -133,6 +134,12 @@ def model(scenario, nominal, filt, gyro, accel, baro):
     P0, m0, q = np.zeros((S, n, n)), np.zeros((S, n)), np.zeros((S, n))
     src = {name: i for i, name in enumerate(SOURCES)}
     P0[src["initial"], :9, :9] = filt.config.P0[:9, :9]
+    fixed = fixed_initial_error(scenario, nominal.lat[0], nominal.h[0])
+    given = np.zeros(n, dtype=bool)
+    given[:9] = ~np.isnan(fixed)
+    P0[src["initial"]][given, :] = 0.0
+    P0[src["initial"]][:, given] = 0.0
+    m0[src["initial"], :9] = np.where(given[:9], fixed, 0.0)
 
     def var(source, start, values, size=3):
         P0[src[source], start + np.arange(size), start + np.arange(size)] = np.square(values)

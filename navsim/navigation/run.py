@@ -34,6 +34,7 @@ from navsim.build.star_sensor import observers
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
+from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter
 from navsim.navigation import build, celestial
 from navsim.navigation.scenario import frame_rate
@@ -47,6 +48,7 @@ from navsim.sensors.star_vector import AttitudeFixSensor, VectorRun
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
+from startrack import units
 from startrack.errors import InputError
 from startrack.star_catalog import load_star_catalog
 
@@ -171,7 +173,8 @@ def simulate(prepared, seed, compiled=True):
         gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
     accel = accel_truth.measure(truth.dv[:n] / grid.dt, accel_ss)
     config = build.filter_config(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0], grid.dt, p.orientation)
-    filt = NavFilter(*_start(truth, config.P0, init_ss, zero="initial" in p.truth_off), config)
+    fixed = fixed_initial_error(scenario, truth.lat[0], truth.h[0])
+    filt = NavFilter(*_start(truth, config.P0, init_ss, zero="initial" in p.truth_off, fixed=fixed), config)
     record = _aiding_record(p, truth, position_ss, baro_ss)
     sensor_run, loop_truth, jumps, sky, observer_runs = AidingRun(record), truth, None, None, []
     if p.star_sensor is not None:
@@ -239,9 +242,28 @@ def _star_run(prepared, sky, seed, filt):
     return VectorRun(dataclasses.replace(record, **kept)), [], None
 
 
-def _start(truth, P0, seed, zero=False):
+def _start(truth, P0, seed, zero=False, fixed=None):
     """(L, λ, h, v_n, q_nb) of the filter: the truth at t = 0 with an error x0 ~ N(0, P0) in attitude
-    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position (``zero``: x0 = 0)."""
+    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position, each part the scenario fixes
+    (``fixed``: :func:`fixed_initial_error`, NaN where drawn) taken instead of its draw (``zero``: x0 = 0)."""
     x0 = np.linalg.cholesky(P0[:9, :9]) @ np.random.default_rng(seed).standard_normal(9) * (0.0 if zero else 1.0)
+    if fixed is not None and not zero:
+        x0 = np.where(np.isnan(fixed), x0, fixed)
     q0 = rot.multiply(rot.from_rotation_vector(-x0[0:3]), truth.q_nb[0])
     return truth.lat[0] + x0[6], truth.lon[0] + x0[7], truth.h[0] + x0[8], truth.v_n[0] + x0[3:6], q0
+
+
+def fixed_initial_error(scenario, lat, h):
+    """The filter's initial error x0[0:9] (φ, δv, δL, δλ, δh) the scenario fixes at (L, h), NaN where it is drawn
+    (``filter.initial_attitude_error_arcsec``, ``initial_velocity_error_m_per_s``, ``initial_position_error_m``)."""
+    f = scenario["filter"]
+    x0 = np.full(9, np.nan)
+    if f["initial_attitude_error_arcsec"] is not None:
+        x0[0:3] = units.arcsec_to_rad(np.asarray(f["initial_attitude_error_arcsec"], dtype=float))
+    if f["initial_velocity_error_m_per_s"] is not None:
+        x0[3:6] = f["initial_velocity_error_m_per_s"]
+    if f["initial_position_error_m"] is not None:
+        r_m, r_n = radii(lat)
+        north, east, down = f["initial_position_error_m"]
+        x0[6:9] = north / (r_m + h), east / ((r_n + h) * np.cos(lat)), -down
+    return x0

@@ -156,6 +156,14 @@ SCHEMA = Table(
                                                    "at most 10 deg"),
             "initial_velocity_sigma_m_per_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=1e3),
             "initial_position_sigma_m": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e5),
+            "initial_attitude_error_arcsec": Value("vector", default=None, minimum=-36000.0, maximum=36000.0,
+                                                   doc="the filter's initial attitude error φ (NED: the tilts and −heading "
+                                                       "error), fixed instead of drawn from its σ (PSINS avperrset's "
+                                                       "phi, in arcsec)"),
+            "initial_velocity_error_m_per_s": Value("vector", default=None, minimum=-1e3, maximum=1e3,
+                                                    doc="the filter's initial velocity error (NED), fixed instead of drawn"),
+            "initial_position_error_m": Value("vector", default=None, minimum=-1e5, maximum=1e5,
+                                              doc="the filter's initial position error (NED), fixed instead of drawn"),
             "scale_factors": Value("str", default=None, choices=("estimate", "ignore"),
                                    doc="six scale-factor states (gyro and accelerometer); default: estimate when "
                                        "either sensor has a scale-factor error"),

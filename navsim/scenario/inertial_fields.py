@@ -14,6 +14,9 @@ GYRO_ERRORS = {
     "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW),
     "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_RRW),
     "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
+    "bias_fixed_deg_per_h": Value("vector", default=None, minimum=-MAX_BIAS, maximum=MAX_BIAS,
+                                  doc="the turn-on bias per axis, fixed instead of drawn with bias_turn_on_deg_per_h "
+                                      "(PSINS imuerrset's eb)"),
     "bias_instability_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
     "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
     "scale_factor_ppm": Value("float", default=None, minimum=0.0, maximum=1e5),
@@ -28,6 +31,9 @@ ACCELEROMETER_ERRORS = {
     "vrw_m_per_s_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_VRW),
     "bias_rw_micro_g_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_MICRO_G_PER_SQRT_H),
     "bias_turn_on_micro_g": Value("float", default=None, minimum=0.0, maximum=MAX_MICRO_G),
+    "bias_fixed_micro_g": Value("vector", default=None, minimum=-MAX_MICRO_G, maximum=MAX_MICRO_G,
+                                doc="the turn-on bias per axis, fixed instead of drawn with bias_turn_on_micro_g "
+                                    "(PSINS imuerrset's db)"),
     "bias_instability_micro_g": Value("float", default=None, minimum=0.0, maximum=MAX_MICRO_G),
     "bias_correlation_s": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
     "scale_factor_ppm": Value("float", default=None, minimum=0.0, maximum=1e5),

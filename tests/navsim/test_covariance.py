@@ -149,3 +149,22 @@ def test_an_interrupted_sweep_resumes_without_recomputing_finished_points(tmp_pa
     assert "Trade sweep: sins_cns_level" in text
     status, err = run_cli(cli.main, [*argv[:4], "--metric", "heading", *argv[6:]], capsys)
     assert status == 2 and "holds a sweep of another request" in err
+
+
+def test_fixed_truth_errors_are_the_mean_error_the_runs_share():
+    """A turn-on bias and initial errors given as values (PSINS's imuerrset/avperrset) instead of σ: every run has
+    them, and the analysis carries them as its mean error; the runs' mean error and RMS agree with it."""
+    overrides = ("duration_s=1200", "settle_s=60", 'filter.mounting="ignore"', "imu.accelerometer.bias_fixed_micro_g=[100.0, -50.0, 0.0]",
+                 "imu.gyro.bias_fixed_deg_per_h=[0.03, 0.0, -0.03]", "filter.initial_attitude_error_arcsec=[20.0, -10.0, 60.0]",
+                 "filter.initial_position_error_m=[30.0, 0.0, 5.0]")
+    analysis = covariance(LEVEL, overrides)
+    runs = [result.series for result in run_batch(LEVEL, range(RUNS), overrides, threads=2)]
+    comparison = analysis.compare(runs)
+    assert comparison["inside_family"] == comparison["checks"]
+    mean, sigma = analysis.mean.sum(axis=0)[-1, :9], np.sqrt(analysis.block[0, -1].diagonal())
+    J = analysis.quantities["horizontal_position"].rows[-1]  # (δL, δλ) -> (north, east) metres at the end
+    expected = J @ mean
+    spread = np.abs(J @ sigma) / np.sqrt(RUNS)  # the σ of a RUNS-run mean of each component
+    position = np.mean([run["position_error_m"][-1, 0:2] for run in runs], axis=0)
+    assert np.all(np.abs(expected) > 10 * spread)  # the fixed errors dominate the runs' spread
+    assert np.all(np.abs(position - expected) < 4 * spread)
