@@ -221,12 +221,13 @@ def _campaign_series(directory, scenario):
     """The finished runs' series of the campaign ``directory``; an InputError unless it is a campaign of the
     same scenario with finished runs."""
     from navsim.campaign.montecarlo import load_runs
+    from navsim.kinds import validate
     from navsim.places import output_kind
 
     if not Path(directory).is_dir() or output_kind(directory) != "campaign":
         raise InputError(f"--compare {directory}: not a campaign directory (navsim montecarlo --out)")
     request, finished, _ = load_runs(directory)
-    if request["scenario_data"] != scenario.data:
+    if validate(request["scenario_data"], scenario.source).data != scenario.data:  # validated now: today's defaults
         raise InputError(f"--compare {directory}: a campaign of another scenario (or other --set values) than "
                          f"{scenario.source}")
     if not finished:

@@ -10,7 +10,7 @@ misalignments, gyro bias steps (a mean), the gravity disturbance (a Gauss-Markov
 distance, or a constant one: a mean), the star sensor's mounting error (the scenario gives its value:
 a mean) and direction noise, the baro's white noise, bias and lag (a mean offset) and the position
 fixes' noise. The filter is the scenario's (:func:`navsim.navigation.build.filter_config`: its states,
-consider states, Q, R, noise scales). Left out, as the runs have them: quantisation (the increments'
+consider states, Q, R, noise scales). Left out (the runs have them): quantisation (the increments'
 accumulated LSB, bounded), NIS gating (every measurement is taken) and the second-order terms of large
 errors. At image fidelity the star sensor is its vector-fidelity equivalent: the catalog's stars of its
 magnitude limit in its field, at most ``max_identified_stars``, each with the centroid σ of the image
