@@ -21,8 +21,7 @@ def _kernels_compiled_ahead(_isolated_cache):
     from navsim.navigation.run import VECTOR_LANES
     from startrack.precompile import compile_ahead
 
-    compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES,
-                   ("navsim.navigation.warmup:covariance", "navsim.attitude.warmup:covariance")))
+    compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES))
     yield
 
 

@@ -28,11 +28,3 @@ def run():
     navigation_run.simulate(prepared, 0)
     navigation_run.simulate(prepared, 0, compiled=False)
 
-
-def covariance():
-    """Task: the covariance analysis of the same flight, its sources together and apart."""
-    from navsim.navigation.covariance import covariance_analysis
-
-    scenario = Scenario(data=validate(SCENARIO, "<compile-ahead>"), source="<compile-ahead>", kind="navigation")
-    covariance_analysis(scenario)
-    covariance_analysis(scenario, split=True)
