@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 import navsim
+from navsim import analysis
 from navsim.report import write_report
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "sins_cns_aircraft_vector.toml"
@@ -25,9 +26,8 @@ SWEEPS = {"gyro_x_star_sensor": [("imu.gyro.bias_turn_on_deg_per_h", [0.001, 0.0
 
 def main():
     scenario = navsim.resolve_scenario(SCENARIO)
-    kind = navsim.KINDS[scenario.kind]
-    budget = kind.covariance_budget(scenario, navsim.covariance(scenario, split=True))
-    print("\n".join(kind.covariance_budget_text(budget)))
+    budget = analysis.budget(scenario, navsim.covariance(scenario, split=True), navsim.KINDS[scenario.kind].COVARIANCE_SOURCES)
+    print("\n".join(analysis.budget_text(budget)))
     for name, vary in SWEEPS.items():
         result = navsim.run_sweep(SCENARIO, vary, "horizontal_position@4h", OUT / name, requirement=REQUIREMENT_M)
         meets = [point["values"] for point in result["points"] if point["value"] <= REQUIREMENT_M]

@@ -279,11 +279,11 @@ def budget_text(budget):
     return out
 
 
-def check_metric(scenario, name, time_s, units):
-    """An InputError unless ``name`` is one of the kind's summary quantities (``units`` {name: unit}) and ``time_s``
-    [s] (None: the end) lies in the run."""
-    if name not in units:
-        raise InputError(f"--metric {name}: unknown; choose one of {', '.join(units)}")
+def check_metric(scenario, name, time_s, quantities):
+    """An InputError unless ``name`` is one of the kind's summary ``quantities`` and ``time_s`` [s] (None: the end)
+    lies in the run."""
+    if name not in quantities:
+        raise InputError(f"--metric {name}: unknown; choose one of {', '.join(quantities)}")
     if time_s is not None and not 0.0 < time_s <= scenario["duration_s"]:
         raise InputError(f"--metric {name}@{time_s:g}s: the time must be inside the run (0, {scenario['duration_s']:g}] s")
 

@@ -152,6 +152,7 @@ def _tune(args):
 
 
 def _budget(args):
+    from navsim.analysis import budget_text
     from navsim.campaign.budget import run_budget
     from navsim.kinds import resolve_scenario, run_kind
     from navsim.report import write_report
@@ -160,8 +161,7 @@ def _budget(args):
     scenario = resolve_scenario(args.scenario, args.set or ())
     budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed, method=args.method)
     write_report(args.out, Path(args.out) / "budget.pdf")
-    kind = run_kind(scenario, "an error budget")
-    text = kind.covariance_budget_text if args.method == "covariance" else kind.budget_text
+    text = budget_text if args.method == "covariance" else run_kind(scenario, "an error budget").budget_text
     print("\n".join(text(budget)))
     print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
     if args.method == "covariance":
@@ -170,13 +170,14 @@ def _budget(args):
 
 
 def _covariance(args):
+    from navsim.analysis import lines
     from navsim.kinds import resolve_scenario, run_kind
     from navsim.output import write_covariance
     from navsim.simulation import covariance
     from startrack.paths import check_file
 
     scenario = resolve_scenario(args.scenario, args.set or ())
-    kind = run_kind(scenario, "a covariance analysis")
+    run_kind(scenario, "a covariance analysis")  # a static study has none: one clear line now
     runs = _campaign_series(args.compare, scenario) if args.compare else None
     if args.report:
         check_file(args.report, "--report", (".pdf",))
@@ -184,7 +185,7 @@ def _covariance(args):
     analysis = covariance(scenario, split=args.budget)
     comparison = analysis.compare(runs) if runs else None
     out = publish(args.out, "covariance", lambda directory: write_covariance(directory, scenario, analysis, comparison))
-    print("\n".join(kind.covariance_lines(analysis.summary(scenario))))
+    print("\n".join(lines(analysis.summary(scenario))))
     if comparison is not None:
         print(f"Monte Carlo         {comparison['runs']} runs: {comparison['inside']} of {comparison['checks']} RMS values inside "
               f"their 95 % band, {comparison['inside_family']} inside the family-wise band")
@@ -286,7 +287,12 @@ def build_parser():
     p.add_argument("--seed", type=int, default=None, help="Monte Carlo base seed (default: the scenario's)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_budget)
+    _add_sizing_commands(sub)
+    return parser
 
+
+def _add_sizing_commands(sub):
+    """The ``covariance`` and ``sweep`` commands of ``sub`` (the parser's subcommands)."""
     p = sub.add_parser("covariance", help="linear covariance analysis: the true RMS of every error along the scenario's "
                                           "nominal trajectory in one pass, the filter's own sigma beside it")
     p.add_argument("scenario", help="scenario TOML file")
@@ -315,7 +321,6 @@ def build_parser():
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT", help="a Dask distributed scheduler")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_sweep)
-    return parser
 
 
 def main(argv=None) -> int:

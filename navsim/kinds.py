@@ -24,8 +24,8 @@ A **run kind** is a package providing (each name loaded on first use; :mod:`navs
     run_report(run), campaign_report(campaign)    its PDF reports (:mod:`navsim.typeset`)
     REQUIRED_SERIES, CAMPAIGN_SERIES              the arrays its reports need, of a run and per campaign run
     covariance_analysis(scenario, split, star_catalog) -> navsim.analysis.Analysis   its linear covariance analysis
-    covariance_lines, covariance_budget, covariance_budget_text   what the command line prints, its budget
-    metric_unit, check_metric, covariance_metric, montecarlo_metric   a sweep's metric (its summary quantities)
+    COVARIANCE_QUANTITIES, COVARIANCE_SOURCES     its summary quantities {name: (unit, SI size)}, error sources {key: label}
+    covariance_run_errors(scenario)               the quantities' errors of a run series (Monte Carlo against the analysis)
 
 A kind whose ``budget_parts`` returns parts also provides ``summarize_budget`` and ``budget_text``. A third
 kind is a new package providing these (:data:`INTERFACE`), and one more entry in :data:`KINDS`.
@@ -40,9 +40,8 @@ from startrack.errors import InputError
 #: The names every run kind provides (module docstring).
 INTERFACE = ("NAME", "TABLE", "validate", "prepare", "simulate", "lanes", "TRUTH_SOURCES", "check_truth_off",
              "budget_parts", "check_tuning", "RunSummary", "CampaignSummary", "pool", "run_lines", "campaign_lines",
-             "run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES", "covariance_analysis", "covariance_lines",
-             "covariance_budget", "covariance_budget_text", "metric_unit", "check_metric", "covariance_metric",
-             "montecarlo_metric")
+             "run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES", "covariance_analysis", "COVARIANCE_QUANTITIES",
+             "COVARIANCE_SOURCES", "covariance_run_errors")
 #: The run kinds by name; the one without a table takes every scenario no other kind claims.
 KINDS = {kind.NAME: kind for kind in (attitude, navigation)}
 #: The name of the static studies' kind, and the table that marks them.

@@ -18,12 +18,11 @@ import time
 
 import numpy as np
 
-from navsim import analysis
 from navsim.analysis import Analysis, Quantity
 from navsim.attitude import build
 from navsim.build.faults import bias_steps
 from navsim.build.star_sensor import vector_equivalent
-from navsim.estimation.att_lincov import BLOCK, Measurements, run
+from navsim.estimation.att_lincov import Measurements, run
 from navsim.estimation.attitude_filter import AttitudeFilter
 from navsim.estimation.kernels import FilterModel, process_noise
 from navsim.scenario.star_sensor_fields import mounting
@@ -35,13 +34,13 @@ from startrack import units
 from startrack.star_catalog import load_star_catalog
 
 #: The error sources, in order, with their labels.
-SOURCES = {"initial": "filter's initial attitude error", "gyro_bias": "gyro bias (turn-on, random walk, instability)",
+COVARIANCE_SOURCES = {"initial": "filter's initial attitude error", "gyro_bias": "gyro bias (turn-on, random walk, instability)",
            "gyro_noise": "gyro angle random walk", "gyro_calibration": "gyro scale factors and misalignments",
            "mounting": "star-sensor mounting error", "star_noise": "star-sensor noise"}
 #: At most this many output rows.
 MAX_ROWS = 4000
 #: The summary quantities: their unit at the edge and its size in SI.
-QUANTITIES = {"attitude": ("arcsec", units.ARCSEC), "cross_boresight": ("arcsec", units.ARCSEC),
+COVARIANCE_QUANTITIES = {"attitude": ("arcsec", units.ARCSEC), "cross_boresight": ("arcsec", units.ARCSEC),
               "roll": ("arcsec", units.ARCSEC), "gyro_bias": ("deg/h", units.DEG / units.HOUR)}
 #: The groups of the error state after δθ and δb, their name prefixes and edge units.
 GROUPS = (("bias_instability", "dg", 3, "deg/h", units.DEG / units.HOUR), ("scale_factor", "ds", 3, "ppm", units.PPM),
@@ -83,9 +82,9 @@ def _present(model):
 
 
 def _initial(scenario, gyro, filt, tm, names, dt):
-    """(P0 (S, n, n), m0 (S, n), Q (S, n, n)) of the truth by source (:data:`SOURCES`)."""
-    S, n = len(SOURCES), len(names)
-    src = {key: i for i, key in enumerate(SOURCES)}
+    """(P0 (S, n, n), m0 (S, n), Q (S, n, n)) of the truth by source (:data:`COVARIANCE_SOURCES`)."""
+    S, n = len(COVARIANCE_SOURCES), len(names)
+    src = {key: i for i, key in enumerate(COVARIANCE_SOURCES)}
     P0, m0 = np.zeros((S, n, n)), np.zeros((S, n))
     fixed = scenario["filter"]["initial_attitude_error_arcsec"]
     if fixed is None:
@@ -161,7 +160,7 @@ def covariance_analysis(scenario, split=False, star_catalog=None):
     for j, name in enumerate(names_f):
         W[names_t.index(name), j] = 1.0
     P0, m0, Q = _initial(scenario, gyro, filt, tm, names_t, dt)
-    keys = tuple(SOURCES)
+    keys = tuple(COVARIANCE_SOURCES)
     if split:
         present = [i for i in range(len(keys)) if np.any(P0[i]) or np.any(m0[i]) or np.any(Q[i]) or keys[i] == "star_noise"]
         sources, P0, m0, Q = tuple(keys[i] for i in present), P0[present], m0[present], Q[present]
@@ -190,7 +189,7 @@ def covariance_analysis(scenario, split=False, star_catalog=None):
                     diag_f=diag_f, block=block, filter_diag=filter_diag, filter_block=filter_block, nees=nees, nees_dof=6,
                     T=np.ascontiguousarray(W.T), quantities=quantities(rot.to_matrix(q_BS), K), units_t=units_t,
                     scale_t=np.broadcast_to(size_t, (K, size_t.size)), units_f=units_f,
-                    scale_f=np.broadcast_to(size_f, (K, size_f.size)), run_errors=functools.partial(run_errors, rot.to_matrix(q_BS)),
+                    scale_f=np.broadcast_to(size_f, (K, size_f.size)), run_errors=covariance_run_errors(scenario),
                     notes=() if note is None else (note,), wall_seconds=time.perf_counter() - started)
 
 
@@ -199,7 +198,7 @@ def quantities(R_BS, K):
     in sensor axes (R_SB δθ) and the gyro-bias error, on the leading block (δθ, δb)."""
     rows = {"attitude": np.hstack([np.eye(3), np.zeros((3, 3))]), "cross_boresight": np.hstack([R_BS.T[0:2], np.zeros((2, 3))]),
             "roll": np.hstack([R_BS.T[2:3], np.zeros((1, 3))]), "gyro_bias": np.hstack([np.zeros((3, 3)), np.eye(3)])}
-    return {name: Quantity(unit=QUANTITIES[name][0], size=QUANTITIES[name][1],
+    return {name: Quantity(unit=COVARIANCE_QUANTITIES[name][0], size=COVARIANCE_QUANTITIES[name][1],
                            rows=np.broadcast_to(J, (K, *J.shape)).copy()) for name, J in rows.items()}
 
 
@@ -211,30 +210,7 @@ def run_errors(R_BS, series):
     return {"attitude": e, "cross_boresight": e_S[:, 0:2], "roll": e_S[:, 2:3], "gyro_bias": bias}, np.hstack([e, bias])
 
 
-def covariance_lines(summary):
-    return analysis.lines(summary)
-
-
-def covariance_budget(scenario, result):
-    return analysis.budget(scenario, result, SOURCES)
-
-
-def covariance_budget_text(budget):
-    return analysis.budget_text(budget)
-
-
-def metric_unit(name):
-    return QUANTITIES[name][0]
-
-
-def check_metric(scenario, name, time_s):
-    analysis.check_metric(scenario, name, time_s, {k: unit for k, (unit, _) in QUANTITIES.items()})
-
-
-def covariance_metric(result, name, time_s):
-    return analysis.covariance_metric(result, name, time_s)
-
-
-def montecarlo_metric(scenario, runs, name, time_s):
-    R_BS = rot.to_matrix(mounting(scenario["star_sensor"])[0])
-    return analysis.montecarlo_metric(runs, name, time_s, functools.partial(run_errors, R_BS), QUANTITIES[name][1])
+def covariance_run_errors(scenario):
+    """The errors of a run series of ``scenario`` that make its summary quantities (:func:`run_errors` with its
+    mounting)."""
+    return functools.partial(run_errors, rot.to_matrix(mounting(scenario["star_sensor"])[0]))

@@ -1,5 +1,5 @@
 """The error budget of a scenario, by linear covariance analysis (the default: one pass with each error
-source apart, :mod:`navsim.estimation.lincov`; the kind's ``covariance_analysis`` and ``covariance_budget``) or by
+source apart, :mod:`navsim.estimation.lincov`; the kind's ``covariance_analysis`` and :func:`navsim.analysis.budget`) or by
 Monte Carlo: one campaign per part (each error source alone in the truth under the scenario's own filter, then
 the whole scenario), resumable, and the budget the kind draws from them
 (:func:`navsim.navigation.budget.budget_parts`, ``summarize_budget``: the star-aided navigation kind's sources,
@@ -15,6 +15,7 @@ what is missing; its campaign.json records what the truth leaves out); ``DIR/bud
 budget, and ``navsim report DIR`` (:mod:`navsim.report.budget`) typesets it.
 """
 
+from navsim.analysis import budget as analysis_budget
 from navsim.campaign.montecarlo import run_campaign
 from navsim.kinds import resolve_scenario, run_kind
 from navsim.output import write_json, write_npz
@@ -64,7 +65,7 @@ def _covariance_budget(scenario, out):
     """The budget by linear covariance analysis: ``out/budget.json`` and ``out/timeseries.npz``."""
     kind = run_kind(scenario, "an error budget")
     analysis = kind.covariance_analysis(scenario, split=True)  # seconds: bad input found before --out is made
-    budget = kind.covariance_budget(scenario, analysis)
+    budget = analysis_budget(scenario, analysis, kind.COVARIANCE_SOURCES)
     directory = check_output(out, "budget")
     mark(directory, "budget")
     write_npz(directory / "timeseries.npz", analysis.series())

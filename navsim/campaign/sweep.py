@@ -21,6 +21,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from navsim.analysis import check_metric, covariance_metric, montecarlo_metric
 from navsim.campaign.montecarlo import SINGLE_THREADED_BLAS, _connect, _environment, load_runs, run_campaign
 from navsim.kinds import resolve_scenario, run_kind, scenario_from_dict
 from navsim.output import write_json
@@ -113,10 +114,10 @@ def run_sweep(scenario, varies, metric, out, method="covariance", runs=None, req
     name, time_s = parse_metric(metric)
     points = grid(source, varies, overrides)
     for _, point in points:
-        kind.check_metric(point, name, time_s)
+        check_metric(point, name, time_s, kind.COVARIANCE_QUANTITIES)
     request = {"format": FORMAT, "scenario": scenario.name, "source": scenario.source, "scenario_data": scenario.data,
                "vary": [[key, values] for key, values in varies], "metric": name, "time_s": time_s, "method": method,
-               "runs": runs, "requirement": requirement, "unit": kind.metric_unit(name)}
+               "runs": runs, "requirement": requirement, "unit": kind.COVARIANCE_QUANTITIES[name][0]}
     directory = check_output(out, "sweep")
     _check_request(directory, request)
     mark(directory, "sweep")
@@ -151,7 +152,7 @@ def covariance_point(data, source, name, time_s):
     """One point by covariance analysis (a worker's job): the metric's value and the filter's σ of it."""
     scenario = scenario_from_dict(data, source=source)
     kind = run_kind(scenario, "a sweep")
-    return kind.covariance_metric(kind.covariance_analysis(scenario), name, time_s)
+    return covariance_metric(kind.covariance_analysis(scenario), name, time_s)
 
 
 def _covariance_points(directory, todo, name, time_s, workers, scheduler, bar):
@@ -195,7 +196,8 @@ def _montecarlo_point(kind, directory, k, point, name, time_s, runs, workers, sc
     _, finished, _ = load_runs(campaign)
     if not finished:
         raise InputError(f"sweep point {k} ({values}): no run finished ({campaign}/runs/*/error.json)")
-    _write_point(directory, k, [(k, point)], kind.montecarlo_metric(scenario, [series for _, _, series in finished], name, time_s))
+    _write_point(directory, k, [(k, point)], montecarlo_metric(
+        [series for _, _, series in finished], name, time_s, kind.covariance_run_errors(scenario), kind.COVARIANCE_QUANTITIES[name][1]))
 
 
 def _write_point(directory, k, todo, metric):

@@ -18,7 +18,7 @@ from collections import namedtuple
 import numpy as np
 
 from navsim.estimation.kernels import fix_residual, star_residuals, transition
-from navsim.estimation.lincov import expected_nees, propagate, update
+from navsim.estimation.lincov import allocate_log, keep, propagate, trimmed, update
 from startrack.jit import njit
 
 #: The measurements of a pass, per frame f of F: identified stars (rows ``star_offsets[f]:star_offsets[f+1]`` of
@@ -69,11 +69,7 @@ def run(omega, q_IB, dt, ratio, stride, truth_model, Q_t, filter_model, Q_f, W, 
     first ``nees_dof`` states."""
     frames = omega.shape[0] // ratio
     S, n_t, n_f = P.shape[0], P.shape[1], P_f.shape[0]
-    kept = (frames + stride - 1) // stride
-    t_out, mean_out = np.empty(kept), np.empty((S, kept, n_t))
-    diag_t, diag_f = np.empty((S, kept, n_t)), np.empty((S, kept, n_f))
-    block, filter_diag, filter_block = np.empty((S, kept, BLOCK, BLOCK)), np.empty((kept, n_f)), np.empty((kept, BLOCK, BLOCK))
-    nees_out = np.empty(kept)
+    log = allocate_log((frames + stride - 1) // stride, S, n_t, n_f, BLOCK)
     out = 0
     for f in range(frames):
         for k in range(f * ratio, (f + 1) * ratio):
@@ -87,21 +83,6 @@ def run(omega, q_IB, dt, ratio, stride, truth_model, Q_t, filter_model, Q_f, W, 
         end = (f + 1) * ratio
         _update_frame(P, mean, P_f, q_IB[end], q_BS, f, meas, n_t, W, estimated)
         if (f + 1) % stride == 0 or f == frames - 1:
-            t_out[out] = end * dt
-            total = np.zeros(n_t)
-            second = np.zeros((n_t, n_t))
-            for s in range(S):
-                mean_out[s, out] = mean[s]
-                total += mean[s]
-                second += P[s]
-                diag_t[s, out] = np.diag(P[s])
-                diag_f[s, out] = np.diag(T @ P[s] @ T.T)
-                block[s, out] = P[s, :BLOCK, :BLOCK]
-            second += np.outer(total, total)
-            filter_diag[out], filter_block[out] = np.diag(P_f), P_f[:BLOCK, :BLOCK]
-            C = T @ second @ T.T
-            nees_out[out] = expected_nees(np.ascontiguousarray(P_f[:nees_dof, :nees_dof]),
-                                          np.ascontiguousarray(C[:nees_dof, :nees_dof]))
+            keep(log, out, end * dt, P, mean, P_f, T, nees_dof)
             out += 1
-    return t_out[:out], mean_out[:, :out], diag_t[:, :out], diag_f[:, :out], block[:, :out], filter_diag[:out], \
-        filter_block[:out], nees_out[:out]
+    return trimmed(log, out)

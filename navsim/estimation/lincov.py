@@ -77,3 +77,44 @@ def update(P, mean, P_f, W, H_t, R_t, R_f, d, estimated, source, offset_source):
 def expected_nees(P_f, C):
     """E[NEES] = tr(P_f⁻¹ C) of an error of second moment C (n_f, n_f) (covariance plus m mᵀ)."""
     return np.trace(np.linalg.solve(P_f, C))
+
+
+@njit
+def allocate_log(kept, S, n_t, n_f, block):
+    """The arrays a pass keeps at ``kept`` frames (:func:`keep`): times (K,), means (S, K, n_t), each source's
+    diagonal in the truth's (S, K, n_t) and the filter's coordinates (S, K, n_f) and leading ``block`` x block,
+    the filter's own diagonal (K, n_f) and block, its expected NEES (K,)."""
+    return (np.empty(kept), np.empty((S, kept, n_t)), np.empty((S, kept, n_t)), np.empty((S, kept, n_f)),
+            np.empty((S, kept, block, block)), np.empty((kept, n_f)), np.empty((kept, block, block)), np.empty(kept))
+
+
+@njit
+def keep(log, out, t, P, mean, P_f, T, nees_dof):
+    """Write row ``out`` of ``log`` (:func:`allocate_log`) at time ``t`` [s]: the sources' means and covariances,
+    the filter's own, and its expected NEES over its first ``nees_dof`` states, tr(P_f⁻¹ T (Σ P + m mᵀ) Tᵀ)
+    (m the summed mean)."""
+    t_out, mean_out, diag_t, diag_f, block, filter_diag, filter_block, nees_out = log
+    B = block.shape[2]
+    n_t = P.shape[1]
+    t_out[out] = t
+    total = np.zeros(n_t)
+    second = np.zeros((n_t, n_t))
+    for s in range(P.shape[0]):
+        mean_out[s, out] = mean[s]
+        total += mean[s]
+        second += P[s]
+        diag_t[s, out] = np.diag(P[s])
+        diag_f[s, out] = np.diag(T @ P[s] @ T.T)
+        block[s, out] = P[s, :B, :B]
+    second += np.outer(total, total)
+    filter_diag[out], filter_block[out] = np.diag(P_f), P_f[:B, :B]
+    C = T @ second @ T.T
+    nees_out[out] = expected_nees(np.ascontiguousarray(P_f[:nees_dof, :nees_dof]), np.ascontiguousarray(C[:nees_dof, :nees_dof]))
+
+
+@njit
+def trimmed(log, rows):
+    """The first ``rows`` kept frames of ``log``."""
+    t_out, mean_out, diag_t, diag_f, block, filter_diag, filter_block, nees_out = log
+    return (t_out[:rows], mean_out[:, :rows], diag_t[:, :rows], diag_f[:, :rows], block[:, :rows], filter_diag[:rows],
+            filter_block[:rows], nees_out[:rows])

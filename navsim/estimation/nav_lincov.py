@@ -17,7 +17,7 @@ import numpy as np
 from navsim.earth.wgs84 import radii
 from navsim.estimation.celestial_kernels import fix_terms, star_terms
 from navsim.estimation.linalg import van_loan
-from navsim.estimation.lincov import expected_nees, propagate, update
+from navsim.estimation.lincov import allocate_log, keep, propagate, trimmed, update
 from navsim.estimation.nav_kernels import DP, continuous_f, discretize, noise_densities
 from startrack.jit import njit
 from startrack.rotation_jit import quat_to_matrix
@@ -191,11 +191,7 @@ def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_
     diagonal and block, and the filter's expected NEES tr(P_f⁻¹ (T (Σ P + m mᵀ) Tᵀ))."""
     frames = (q_nb.shape[0] - 1) // ratio
     S, n_t, n_f = P.shape[0], tl.n, P_f.shape[0]
-    kept = (frames + stride - 1) // stride
-    t_out, mean_out = np.empty(kept), np.empty((S, kept, n_t))
-    diag_t, diag_f = np.empty((S, kept, n_t)), np.empty((S, kept, n_f))
-    block, filter_diag, filter_block = np.empty((S, kept, BLOCK, BLOCK)), np.empty((kept, n_f)), np.empty((kept, BLOCK, BLOCK))
-    nees_out = np.empty(kept)
+    log = allocate_log((frames + stride - 1) // stride, S, n_t, n_f, BLOCK)
     out = 0
     for f in range(frames):
         for s in range(step_frames.shape[0]):
@@ -219,19 +215,6 @@ def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_
             update(P, mean, P_f, W, H_t, R, meas.r_scale2 * R, z, estimated, meas.star_source, meas.offset_source)
         _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
         if (f + 1) % stride == 0 or f == frames - 1:
-            t_out[out] = end * dt
-            total = np.zeros(n_t)
-            second = np.zeros((n_t, n_t))
-            for s in range(S):
-                mean_out[s, out] = mean[s]
-                total += mean[s]
-                second += P[s]
-                diag_t[s, out] = np.diag(P[s])
-                diag_f[s, out] = np.diag(T @ P[s] @ T.T)
-                block[s, out] = P[s, :BLOCK, :BLOCK]
-            second += np.outer(total, total)
-            filter_diag[out], filter_block[out] = np.diag(P_f), P_f[:BLOCK, :BLOCK]
-            nees_out[out] = expected_nees(P_f, np.ascontiguousarray(T @ second @ T.T))
+            keep(log, out, end * dt, P, mean, P_f, T, n_f)
             out += 1
-    return t_out[:out], mean_out[:, :out], diag_t[:, :out], diag_f[:, :out], block[:, :out], filter_diag[:out], \
-        filter_block[:out], nees_out[:out]
+    return trimmed(log, out)

@@ -27,7 +27,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim import analysis
 from navsim.analysis import Analysis, Quantity
 from navsim.build.faults import bias_steps
 from navsim.build.star_sensor import vector_equivalent
@@ -39,6 +38,7 @@ from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
 from navsim.navigation import build
+from navsim.navigation.budget import SOURCES as BUDGET_SOURCES
 from navsim.navigation.run import fixed_initial_error
 from navsim.navigation.scenario import frame_rate
 from navsim.scenario.star_sensor_fields import mounting
@@ -51,14 +51,16 @@ from startrack import units
 from startrack.aberration import aberrate
 from startrack.star_catalog import load_star_catalog
 
-#: The error sources of the budget, in order (the keys of :data:`navsim.navigation.budget.SOURCES`).
-SOURCES = ("initial", "inertial", "accel_bias", "gravity", "mounting", "star_noise", "aberration", "aiding")
+#: The error sources of the budget, in order, with their labels (those of :data:`navsim.navigation.budget.SOURCES`).
+COVARIANCE_SOURCES = {key: {s.key: s.label for s in BUDGET_SOURCES}[key] for key in ("initial", "inertial", "accel_bias", "gravity", "mounting", "star_noise",
+                                                   "aberration", "aiding")}
+SOURCES = tuple(COVARIANCE_SOURCES)
 #: The nominal is sampled at the IMU rate coarsened by a whole factor to no less than this [Hz] (:func:`_coarsening`).
 MIN_RATE_HZ = 10.0
 #: At most this many output rows (frames are kept at a stride to stay under it).
 MAX_ROWS = 4000
 #: The summary quantities: their unit at the edge and its size in SI.
-QUANTITIES = {"horizontal_position": ("m", 1.0), "vertical_position": ("m", 1.0),
+COVARIANCE_QUANTITIES = {"horizontal_position": ("m", 1.0), "vertical_position": ("m", 1.0),
               "horizontal_velocity": ("m/s", 1.0), "vertical_velocity": ("m/s", 1.0),
               "tilt": ("arcsec", units.ARCSEC), "heading": ("arcsec", units.ARCSEC)}
 #: Edge units of the error states by the first letters of their names.
@@ -373,7 +375,7 @@ def quantities(lat, h):
         sel = np.zeros((K, len(components), BLOCK))
         for r, (column, scale) in enumerate(components):
             sel[:, r, column] = scale
-        out[name] = Quantity(unit=QUANTITIES[name][0], size=QUANTITIES[name][1], rows=sel)
+        out[name] = Quantity(unit=COVARIANCE_QUANTITIES[name][0], size=COVARIANCE_QUANTITIES[name][1], rows=sel)
     return out
 
 
@@ -385,36 +387,6 @@ def run_errors(series_arrays):
              "vertical_velocity": e[:, 5:6], "tilt": e[:, 0:2], "heading": e[:, 2:3]}, e)
 
 
-def covariance_lines(summary):
-    """What the command line prints of the analysis's summary."""
-    return analysis.lines(summary)
-
-
-def covariance_budget(scenario, result):
-    """The budget of the analysis ``result`` with its sources apart (:func:`navsim.analysis.budget`), labelled
-    as :data:`navsim.navigation.budget.SOURCES`."""
-    from navsim.navigation.budget import SOURCES as LABELLED  # the labels of the same sources
-
-    return analysis.budget(scenario, result, {source.key: source.label for source in LABELLED})
-
-
-def covariance_budget_text(budget):
-    return analysis.budget_text(budget)
-
-
-def metric_unit(name):
-    """The edge unit of the sweep metric ``name`` (a summary quantity)."""
-    return QUANTITIES[name][0]
-
-
-def check_metric(scenario, name, time_s):
-    """An InputError unless ``name`` is a summary quantity and ``time_s`` [s] (None: the end) lies in the run."""
-    analysis.check_metric(scenario, name, time_s, {k: unit for k, (unit, _) in QUANTITIES.items()})
-
-
-def covariance_metric(result, name, time_s):
-    return analysis.covariance_metric(result, name, time_s)
-
-
-def montecarlo_metric(scenario, runs, name, time_s):
-    return analysis.montecarlo_metric(runs, name, time_s, run_errors, QUANTITIES[name][1])
+def covariance_run_errors(scenario):
+    """The errors of a run series of ``scenario`` that make its summary quantities (:func:`run_errors`)."""
+    return run_errors

@@ -1,7 +1,7 @@
 """The PDF of an error budget (``budget.json``: :mod:`navsim.campaign.budget`): by Monte Carlo (the star-aided
 navigation kind's :mod:`navsim.navigation.budget`) which source leaves how many metres of horizontal position
 error, as a table and a bar chart, with the total and the root-sum-square of the parts; by covariance analysis
-(:func:`navsim.navigation.covariance.covariance_budget`) each source's share of every summary quantity, as a
+(:func:`navsim.analysis.budget`) each source's share of every summary quantity, as a
 table and its horizontal position error's shares stacked over time."""
 
 import tempfile
