@@ -1,10 +1,14 @@
 """Where built tables are cached: never inside the installed package.
 
 ``$STARTRACK_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/startrack``, else
-``~/.cache/startrack``.
+``~/.cache/startrack``. Processes that fill the cache at once (the workers of a campaign, a parallel
+test suite) each write their own temporary and rename it into place (:func:`publish_file`,
+:func:`publish_folder`): a reader sees a whole table or none.
 """
 
 import os
+import shutil
+import uuid
 from pathlib import Path
 
 
@@ -18,3 +22,39 @@ def cache_dir() -> Path:
         path = Path(base) / "startrack"
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def _temporary(path: Path) -> Path:
+    """A name beside ``path`` that no other writer uses (hidden, same suffix: ``np.savez`` keeps it)."""
+    return path.with_name(f".{path.stem}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{path.suffix}")
+
+
+def publish_file(path, write) -> Path:
+    """Write the file ``path`` by ``write(temporary)`` and an atomic rename over it; returns ``path``."""
+    path = Path(path)
+    temporary = _temporary(path)
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return path
+
+
+def publish_folder(folder, write) -> Path:
+    """Write the folder ``folder`` by ``write(temporary)`` (an empty folder) and a rename in place of the old
+    one; when another writer renamed its own first, theirs stays (the same table). Returns ``folder``."""
+    folder = Path(folder)
+    temporary = _temporary(folder)
+    temporary.mkdir(parents=True)
+    try:
+        write(temporary)
+        shutil.rmtree(folder, ignore_errors=True)
+        try:
+            os.replace(temporary, folder)
+        except OSError:
+            if not folder.is_dir():
+                raise
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
+    return folder

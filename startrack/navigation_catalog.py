@@ -69,7 +69,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from startrack import address as _address
-from startrack.cache import cache_dir
+from startrack.cache import cache_dir, publish_file
 from startrack.errors import InputError
 from startrack.kvector import KVector
 from startrack.sphere import radec_to_vector
@@ -484,10 +484,7 @@ class NavigationCatalog:
             "layout": _LAYOUT_VERSION,
         }
         arrays = {name: getattr(self, name) for name in _ARRAY_FIELDS}
-        temporary = path.with_name(path.name + ".tmp.npz")
-        np.savez(temporary, meta=np.array(json.dumps(meta)), **arrays)
-        temporary.replace(path)
-        return path
+        return publish_file(path, lambda temporary: np.savez(temporary, meta=np.array(json.dumps(meta)), **arrays))
 
     @classmethod
     def load(cls, path) -> "NavigationCatalog":

@@ -53,7 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.cache import cache_dir
+from startrack.cache import cache_dir, publish_file
 from startrack.errors import InputError
 from startrack.sphere import local_frame, vector_to_radec
 from startrack.units import MILLIARCSEC
@@ -214,9 +214,7 @@ def load_hip2_table() -> dict:
             table = None  # damaged cache: parse again and overwrite it
     if table is None:
         table = parse_hip2(path)
-        temporary = cached.with_suffix(".tmp.npz")
-        np.savez(temporary, **table)
-        temporary.replace(cached)
+        publish_file(cached, lambda temporary: np.savez(temporary, **table))
     return {name: _readonly(array) for name, array in table.items()}
 
 

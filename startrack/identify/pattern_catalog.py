@@ -38,14 +38,13 @@ import hashlib
 import itertools
 import json
 import math
-import shutil
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from startrack.cache import cache_dir
+from startrack.cache import cache_dir, publish_folder
 from startrack.errors import InputError
 from startrack.jit import njit
 from startrack.units import DEG
@@ -357,20 +356,17 @@ class PatternCatalog:
 
     def save(self, folder: Path) -> Path:
         """Write the catalog as ``.npy`` files and ``meta.json`` into ``folder`` (replaced atomically)."""
-        temporary = folder.with_name(folder.name + ".tmp")
-        shutil.rmtree(temporary, ignore_errors=True)
-        temporary.mkdir(parents=True)
-        np.save(temporary / "hip.npy", self.hip, allow_pickle=False)
+        return publish_folder(folder, self._write)
+
+    def _write(self, folder: Path) -> None:
+        np.save(folder / "hip.npy", self.hip, allow_pickle=False)
         meta = {"params": dataclasses.asdict(self.params), "layout": _LAYOUT, "levels": []}
         for l, level in enumerate(self.levels):
             for name in ("stars", "keys", "slots"):
-                np.save(temporary / f"level{l}-{name}.npy", getattr(level, name), allow_pickle=False)
+                np.save(folder / f"level{l}-{name}.npy", getattr(level, name), allow_pickle=False)
             meta["levels"].append({"fov": level.fov, "width": level.width, "base": level.base,
                                    "tolerance": level.tolerance})
-        (temporary / "meta.json").write_text(json.dumps(meta))
-        shutil.rmtree(folder, ignore_errors=True)
-        temporary.replace(folder)
-        return folder
+        (folder / "meta.json").write_text(json.dumps(meta))
 
     @classmethod
     def read(cls, folder: Path) -> "PatternCatalog":
