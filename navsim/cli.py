@@ -4,7 +4,7 @@
     navsim report DIR -o FILE.pdf
     navsim montecarlo SCENARIO.toml --runs N --out DIR [--workers K | --scheduler tcp://HOST:PORT]
     navsim tune SCENARIO.toml [--runs N] [--set key=value ...]
-    navsim budget SCENARIO.toml --out DIR [--method covariance | --method montecarlo [--runs N] [--workers W]]
+    navsim budget SCENARIO.toml --out DIR [--method covariance [--compare MC_BUDGET_DIR] | --method montecarlo [--runs N] [--workers W]]
     navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR] [--report [FILE.pdf]]
     navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
                  [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
@@ -159,10 +159,14 @@ def _budget(args):
 
     _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
-    budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed, method=args.method)
+    budget = run_budget(scenario, args.out, runs=args.runs, workers=args.workers, base_seed=args.seed, method=args.method,
+                        compare=args.compare)
     write_report(args.out, Path(args.out) / "budget.pdf")
     text = budget_text if args.method == "covariance" else run_kind(scenario, "an error budget").budget_text
     print("\n".join(text(budget)))
+    for part in budget.get("comparison", {}).values():
+        print(f"Monte Carlo         {part['label']}: {part['runs']} runs, {part['inside']} of {part['checks']} RMS values "
+              f"inside their 95 % band, {part['inside_family']} inside the family-wise band")
     print(f"written to          {Path(args.out) / 'budget.json'}, {Path(args.out) / 'budget.pdf'}")
     if args.method == "covariance":
         return 0
@@ -171,6 +175,7 @@ def _budget(args):
 
 def _covariance(args):
     from navsim.analysis import lines
+    from navsim.campaign.montecarlo import finished_series
     from navsim.kinds import resolve_scenario, run_kind
     from navsim.output import write_covariance
     from navsim.simulation import covariance
@@ -178,7 +183,7 @@ def _covariance(args):
 
     scenario = resolve_scenario(args.scenario, args.set or ())
     run_kind(scenario, "a covariance analysis")  # a static study has none: one clear line now
-    runs = _campaign_series(args.compare, scenario) if args.compare else None
+    runs = finished_series(args.compare, scenario) if args.compare else None
     if args.report:
         check_file(args.report, "--report", (".pdf",))
     check_output(args.out, "covariance")
@@ -216,24 +221,6 @@ def _sweep(args):
         print(" ".join(f"{str(v):>24}" for v in point["values"]) + f" {point['value']:28.4g}{meets}")
     print(f"written to          {Path(args.out) / 'sweep.json'}, {Path(args.out) / 'sweep.csv'}, {pdf}")
     return 0
-
-
-def _campaign_series(directory, scenario):
-    """The finished runs' series of the campaign ``directory``; an InputError unless it is a campaign of the
-    same scenario with finished runs."""
-    from navsim.campaign.montecarlo import load_runs
-    from navsim.kinds import validate
-    from navsim.places import output_kind
-
-    if not Path(directory).is_dir() or output_kind(directory) != "campaign":
-        raise InputError(f"--compare {directory}: not a campaign directory (navsim montecarlo --out)")
-    request, finished, _ = load_runs(directory)
-    if validate(request["scenario_data"], scenario.source).data != scenario.data:  # validated now: today's defaults
-        raise InputError(f"--compare {directory}: a campaign of another scenario (or other --set values) than "
-                         f"{scenario.source}")
-    if not finished:
-        raise InputError(f"--compare {directory}: no finished runs")
-    return [series for _, _, series in finished]
 
 
 def build_parser():
@@ -285,6 +272,8 @@ def build_parser():
     p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs per source (default 5)")
     p.add_argument("--workers", type=int, default=None, help="Monte Carlo local processes (default: all cores)")
     p.add_argument("--seed", type=int, default=None, help="Monte Carlo base seed (default: the scenario's)")
+    p.add_argument("--compare", default=None, metavar="BUDGET_DIR", help="check the covariance budget part by part "
+                   "against a Monte Carlo budget of the same scenario (navsim budget --method montecarlo --out)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_budget)
     _add_sizing_commands(sub)

@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from navsim.kinds import of, resolve_scenario, run_kind
+from navsim.kinds import of, resolve_scenario, run_kind, validate
 from navsim.output import read_npz, write_json, write_run
-from navsim.places import campaign_lock, check_output, mark
+from navsim.places import campaign_lock, check_output, mark, output_kind
 from navsim.scenario import Scenario
 from navsim.simulation import prepare, simulate
 from navsim.studies import observers
@@ -323,6 +323,24 @@ def load_runs(directory):
             record = json.loads((run_dir / "error.json").read_text())
             failed.append((k, record["error"], record.get("cause", "scenario")))
     return request, finished, failed
+
+
+def finished_series(directory, scenario, option="--compare", truth_off=()):
+    """The finished runs' series of the campaign ``directory``; an InputError (naming ``option``) unless it is a
+    campaign of ``scenario`` (validated again: today's defaults) with the truth sources ``truth_off`` switched off
+    and finished runs."""
+    if not Path(directory).is_dir() or output_kind(directory) != "campaign":
+        raise InputError(f"{option} {directory}: not a campaign directory (navsim montecarlo --out)")
+    request, finished, _ = load_runs(directory)
+    if validate(request["scenario_data"], scenario.source).data != scenario.data:
+        raise InputError(f"{option} {directory}: a campaign of another scenario (or other --set values) than "
+                         f"{scenario.source}")
+    if sorted(request.get("truth_off", ())) != sorted(truth_off):
+        raise InputError(f"{option} {directory}: its truth switches off {sorted(request.get('truth_off', ())) or 'nothing'}, "
+                         f"not {sorted(truth_off) or 'nothing'}")
+    if not finished:
+        raise InputError(f"{option} {directory}: no finished runs")
+    return [series for _, _, series in finished]
 
 
 def aggregate(directory):

@@ -12,6 +12,8 @@ from scipy.special import gammaincinv
 from navsim.estimation.linalg import quadratic_forms
 
 BAND_PROBABILITY = 0.95
+#: The most degrees of freedom :func:`mean_square_band` takes: its band is then within 1e-5 of E either way.
+MAX_DOF = 1e12
 
 
 def chi2_quantile(probability, dof):
@@ -46,8 +48,11 @@ def mean_square_band(expected, variance, runs, probability=BAND_PROBABILITY):
     whose expectation is ``expected`` and variance ``variance`` (arrays alike): the draw taken as a scaled
     χ² of ν = 2 E²/Var dof (exact for a central Gaussian error of equal variances; Satterthwaite's
     approximation otherwise, e.g. for |y|² of y ~ N(m, C): E = tr C + |m|², Var = 2 tr C² + 4 mᵀ C m), so
-    the mean is E χ²(runs ν)/(runs ν)."""
+    the mean is E χ²(runs ν)/(runs ν). A draw without spread (Var = 0: a fixed error, or none) has the band E."""
     expected, variance = np.asarray(expected, dtype=float), np.asarray(variance, dtype=float)
-    dof = runs * 2.0 * expected**2 / np.maximum(variance, np.finfo(float).tiny)
+    spread = variance > 0.0
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        dof = np.clip(runs * 2.0 * expected**2 / np.where(spread, variance, 1.0), np.finfo(float).tiny, MAX_DOF)
     tail = (1.0 - probability) / 2.0
-    return expected * chi2_quantile(tail, dof) / dof, expected * chi2_quantile(1.0 - tail, dof) / dof
+    lo, hi = expected * chi2_quantile(tail, dof) / dof, expected * chi2_quantile(1.0 - tail, dof) / dof
+    return np.where(spread, lo, expected), np.where(spread, hi, expected)

@@ -146,6 +146,15 @@ def test_budget_parts_add_up_and_follow_eq_1(level, tmp_path, capsys):
     text, _ = pdf_text(out / "budget.pdf")
     assert "Error budget: level_sins_cns" in text and "root-sum-square of the parts" in text
     assert f"its ratio to the total {rss['ratio_to_total']['schuler_mean_m']:.3f}" in text
+    # the covariance budget part by part against these runs: each source alone under the same filter
+    compared = tmp_path / "covariance_budget"
+    status, err = run_cli(cli.main, ["budget", level, "--out", compared, "--compare", out, *argv[10:]], capsys)
+    assert status == 0, err
+    comparison = json.loads((compared / "budget.json").read_text())["comparison"]
+    assert set(comparison) == {key for key, row in parts.items() if row["status"] == "run"} | {"total"}
+    for key, part in comparison.items():
+        assert part["runs"] == 2 and part["inside_family"] == part["checks"], key
+    assert "Against the Monte Carlo budget" in pdf_text(compared / "budget.pdf")[0]
     mtime = (out / "parts" / "total" / "runs" / "run_00000" / "summary.json").stat().st_mtime_ns
     status, err = run_cli(cli.main, argv, capsys)
     assert status == 0, err
@@ -162,6 +171,8 @@ MONTE_CARLO = ["--method", "montecarlo"]
     ("base_sins_cns.toml", [*MONTE_CARLO, "--workers", "0"], "--workers must be at least 1"),
     ("base_sins_cns.toml", ["--runs", "5"], "--runs: Monte Carlo options"),
     ("base_sins_cns.toml", ["--method", "guess"], "--method guess: must be one of covariance, montecarlo"),
+    ("base_sins_cns.toml", [*MONTE_CARLO, "--compare", "."], "--compare: checks a covariance budget against a Monte Carlo one"),
+    ("base_sins_cns.toml", ["--compare", "."], "not a Monte Carlo budget directory"),
 ])
 def test_budget_bad_input(scenario, extra, message, tmp_path, capsys):
     out = tmp_path / "budget"
