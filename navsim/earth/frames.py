@@ -52,6 +52,11 @@ def transport_rate_n(lat, h, v_north, v_east):
     return v_east / (r_n + h), -v_north / (r_m + h), -v_east * np.tan(lat) / (r_n + h)
 
 
+#: Step [s] of the grid of :func:`slowly`: the fastest terms of the precession-nutation (13.7 d) and of the
+#: geocentre's velocity (the Moon's pull, 27.3 d; the year) leave < 1e-14 rad and < 1e-6 m/s between its points.
+SLOW_STEP_S = 60.0
+
+
 def utc_epoch(text):
     """Two-part Julian date (jd1, jd2) of a UTC calendar epoch 'YYYY-MM-DDTHH:MM:SS[.ffffff]'."""
     try:
@@ -85,12 +90,30 @@ def c_ei(epoch_utc, t=0.0, dut1=0.0):
     """C_ei (..., 3, 3): ICRS (GCRS axes) into ITRS at ``t`` [s] (scalar or array) after the UTC
     epoch ``epoch_utc``, with UT1 − UTC = ``dut1`` [s] and zero polar motion.
 
-    The IAU 2006/2000A celestial-to-terrestrial matrix of pyerfa, ``erfa.c2t06a`` (CIO based: the
-    Earth rotation angle ERA(UT1) between the CIP/CIO precession-nutation-bias matrix and polar
-    motion; IERS Conventions 2010, eq. 5.1). ``t`` is added to UTC as uniform seconds (a leap
-    second inside the span is not inserted).
+    The IAU 2006/2000A celestial-to-terrestrial matrix of pyerfa, ``erfa.c2t06a``'s product (CIO
+    based: the Earth rotation angle ERA(UT1) between the CIP/CIO precession-nutation-bias matrix and
+    polar motion; IERS Conventions 2010, eq. 5.1), its slow precession-nutation ``erfa.c2i06a`` on the
+    grid of :func:`slowly` and ERA at every time (within 1e-14 rad of ``c2t06a``). ``t`` is added to
+    UTC as uniform seconds (a leap second inside the span is not inserted).
     """
     utc1, utc2 = _utc(epoch_utc, t)
     tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
     ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
-    return erfa.c2t06a(tt1, tt2, ut11, ut12, 0.0, 0.0)
+    c2i = slowly(lambda s: erfa.c2i06a(*tt_epoch(epoch_utc, s)), t)
+    return erfa.c2tcio(c2i, erfa.era00(ut11, ut12), erfa.pom00(0.0, 0.0, erfa.sp00(tt1, tt2)))
+
+
+def slowly(values_at, t):
+    """``values_at(t)`` (..., ...) of a function of time that varies slowly, at times ``t`` [s] (scalar or
+    array): evaluated on a grid of :data:`SLOW_STEP_S` spanning ``t`` and interpolated linearly (directly
+    when ``t`` has no more elements than the grid)."""
+    t = np.asarray(t, dtype=float)
+    flat = t.ravel()
+    start = flat.min() if flat.size else 0.0
+    n = int(np.ceil((flat.max() - start) / SLOW_STEP_S)) + 1 if flat.size else 0
+    if flat.size <= n + 1:
+        return values_at(t)
+    grid = values_at(start + np.arange(n + 1) * SLOW_STEP_S)
+    k = np.minimum(((flat - start) // SLOW_STEP_S).astype(np.int64), n - 1)
+    w = ((flat - start) / SLOW_STEP_S - k).reshape((-1,) + (1,) * (grid.ndim - 1))
+    return (grid[k] * (1.0 - w) + grid[k + 1] * w).reshape(t.shape + grid.shape[1:])

@@ -2,7 +2,7 @@
 
 C_ie (ICRS axes from ITRS axes) is :func:`navsim.earth.frames.c_ei` (pyerfa's ``c2t06a``) and the
 barycentric velocity of the geocentre comes from the ephemeris of :mod:`startrack.aberration`
-(``erfa.epv00``); both depend on time only, so a scenario computes them once for its frame times
+(``erfa.epv00``, on the grid of :func:`navsim.earth.frames.slowly`); both depend on time only, so a scenario computes them once for its frame times
 (:class:`EarthOrientation`), for the truth and the filter alike. The observer's velocity relative
 to the solar-system barycentre, which sets the aberration of the stars it sees, is (ICRS axes)
 
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.earth.frames import c_ei, q_en, tt_epoch
+from navsim.earth.frames import c_ei, q_en, slowly, tt_epoch
 from navsim.earth.wgs84 import OMEGA_IE, geodetic_to_ecef
 from startrack import rotation as rot
 from startrack.aberration import earth_barycentric_velocity
@@ -43,7 +43,7 @@ class EarthOrientation:
         ``dut1`` [s] (TDB taken as TT for the ephemeris: they differ by < 2 ms)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         c_ie = np.swapaxes(c_ei(epoch_utc, t, dut1), -1, -2)
-        v_earth = earth_barycentric_velocity(*tt_epoch(epoch_utc, t))
+        v_earth = slowly(lambda s: earth_barycentric_velocity(*tt_epoch(epoch_utc, s)), t)
         return cls(t=t, q_ie=rot.from_matrix(c_ie), c_ie=c_ie, v_earth=v_earth)
 
     def index(self, t):

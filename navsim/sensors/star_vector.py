@@ -90,11 +90,13 @@ class StarVectorSensor:
         cos_half = np.cos(0.5 * self.fov)
         frames, stars = [], []
         for start in range(0, len(q_IS), chunk):
-            inside = boresight[start : start + chunk] @ catalog.T >= cos_half
+            axes = boresight[start : start + chunk]
+            near = _near(catalog, axes, 0.5 * self.fov)
+            inside = axes @ catalog[near].T >= cos_half
             inside &= np.cumsum(inside, axis=1) <= self.max_stars
             f, k = np.nonzero(inside)
             frames.append(f + start)
-            stars.append(k)
+            stars.append(near[k])
         frame = np.concatenate(frames)
         index = order[np.concatenate(stars)]
         ref_I = self.star_vectors[index]
@@ -105,6 +107,23 @@ class StarVectorSensor:
         obs /= np.linalg.norm(obs, axis=1, keepdims=True)
         offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=len(q_IS)))])
         return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index])
+
+
+#: Margin [rad] of :func:`_near`'s cap over the rounding of its cosines.
+NEAR_MARGIN = 1e-9
+
+
+def _near(catalog, axes, half_fov):
+    """The indices (ascending) of the unit vectors ``catalog`` (N, 3) that may lie within ``half_fov`` [rad] of
+    any of the unit ``axes`` (K, 3): those inside the cap around the axes' mean direction that reaches the
+    farthest axis plus the half field (all of them when the axes spread over a hemisphere)."""
+    centre = axes.sum(axis=0)
+    norm = np.linalg.norm(centre)
+    if norm < 1e-6 * len(axes):
+        return np.arange(len(catalog))
+    centre /= norm
+    reach = np.arccos(np.clip(np.min(axes @ centre), -1.0, 1.0)) + half_fov + NEAR_MARGIN
+    return np.arange(len(catalog)) if reach >= np.pi else np.flatnonzero(catalog @ centre >= np.cos(reach))
 
 
 @dataclass(frozen=True)
