@@ -125,12 +125,12 @@ def test_c_ei_rotates_at_the_earth_rate():
 
 
 def test_slow_terms_on_their_grid_equal_erfa_at_every_second():
-    """A day of frames every second: C_ei with the precession-nutation interpolated from its 60 s grid equals
+    """Six hours of frames every second: C_ei with the precession-nutation interpolated from its 60 s grid equals
     erfa.c2t06a (within 1e-14 rad; measured 5e-15), and the geocentre's velocity erfa.epv00 (within 1e-6 m/s,
     3e-15 of aberration; measured 5e-7)."""
     import erfa
 
-    epoch, t, dut1 = "2024-03-20T20:00:00", np.arange(1, 86_401) + 0.37, 0.3
+    epoch, t, dut1 = "2024-03-20T20:00:00", np.arange(1, 21_601) + 0.37, 0.3
     utc = frames._utc(epoch, t)
     tt = erfa.taitt(*erfa.utctai(*utc))
     assert np.abs(frames.c_ei(epoch, t, dut1) - erfa.c2t06a(*tt, *erfa.utcut1(*utc, dut1), 0.0, 0.0)).max() < 1e-14
