@@ -24,6 +24,10 @@ def cache_dir() -> Path:
     return path
 
 
+#: How many times :func:`publish_folder` renames its folder into place while other writers do the same.
+PUBLISH_ATTEMPTS = 100
+
+
 def _temporary(path: Path) -> Path:
     """A name beside ``path`` that no other writer uses (hidden, same suffix: ``np.savez`` keeps it)."""
     return path.with_name(f".{path.stem}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{path.suffix}")
@@ -43,18 +47,31 @@ def publish_file(path, write) -> Path:
 
 def publish_folder(folder, write) -> Path:
     """Write the folder ``folder`` by ``write(temporary)`` (an empty folder) and a rename in place of the old
-    one; when another writer renamed its own first, theirs stays (the same table). Returns ``folder``."""
+    one (moved aside first, then deleted); when another writer's rename wins, theirs stays (the same table).
+    Returns ``folder``."""
     folder = Path(folder)
     temporary = _temporary(folder)
     temporary.mkdir(parents=True)
     try:
         write(temporary)
-        shutil.rmtree(folder, ignore_errors=True)
-        try:
-            os.replace(temporary, folder)
-        except OSError:
-            if not folder.is_dir():
-                raise
+        for _ in range(PUBLISH_ATTEMPTS):
+            _discard(folder)
+            try:
+                os.replace(temporary, folder)
+                return folder
+            except OSError:
+                if folder.is_dir():
+                    return folder
+        raise OSError(f"{folder}: could not be replaced ({PUBLISH_ATTEMPTS} attempts against other writers)")
     finally:
         shutil.rmtree(temporary, ignore_errors=True)
-    return folder
+
+
+def _discard(folder):
+    """Move ``folder`` aside (one atomic rename: a reader sees it whole or not at all) and delete it."""
+    aside = _temporary(folder)
+    try:
+        os.replace(folder, aside)
+    except FileNotFoundError:
+        return
+    shutil.rmtree(aside, ignore_errors=True)

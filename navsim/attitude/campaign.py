@@ -45,5 +45,5 @@ def _identification(summaries):
     if not per_mode:
         return None
     frames = sum(per_mode.values())
-    lost = sum(per_mode.get(mode, 0) for mode in ("no_fix", "outage", "dropped"))
+    lost = sum(per_mode.get(mode, 0) for mode in ("no_fix", "outage", "dropped", "excluded"))
     return {"frames_per_mode": per_mode, "fix_fraction": 1.0 - lost / frames}

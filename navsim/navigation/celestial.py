@@ -41,16 +41,31 @@ SCHULER_PERIOD_S = 5063.0
 EIGEN_COMPONENTS = 3
 
 
-def summary(scenario, series, sky, orientation, q_BS_true):
-    """The ``celestial`` block of a star-aided run's summary (module docstring)."""
+def summary(scenario, series, sky, orientation, q_BS_true, geometry):
+    """The ``celestial`` block of a star-aided run's summary (module docstring); ``geometry`` the frames'
+    :class:`~navsim.navigation.exclusion.SkyGeometry`."""
     sensor = scenario["star_sensor"]
     steady = series["t"] >= scenario["settle_s"]
     return {"star_sensor": {"fidelity": sensor["fidelity"], "measurement": sensor["measurement"],
                             "rate_hz": sensor["rate_hz"], "aberration_correction": sensor["aberration_correction"],
                             "frames_with_stars": int(np.count_nonzero(series["n_measurements"]))},
+            "sky": sky_summary(geometry),
             "horizon_floor": horizon_floor(series, steady),
             "aberration": aberration(series, sky, orientation, q_BS_true, sensor["aberration_correction"], steady),
             "observability": observability(series)}
+
+
+def sky_summary(geometry):
+    """The Sun, the Moon and the horizon over the frames: the least angles of the Sun and the Moon from the
+    boresight, the boresight's lowest elevation [deg], the frames with the Sun above the horizon, the Moon's mean
+    illuminated fraction and the frames each exclusion took (:mod:`navsim.navigation.exclusion`)."""
+    degrees = np.degrees
+    return {"sun_angle_min_deg": float(degrees(geometry.sun_angle.min())),
+            "moon_angle_min_deg": float(degrees(geometry.moon_angle.min())),
+            "boresight_elevation_min_deg": float(degrees(geometry.boresight_elevation.min())),
+            "frames_sun_up": int(np.count_nonzero(geometry.sun_elevation > 0.0)),
+            "moon_illuminated_mean": float(np.mean(geometry.moon_illuminated)),
+            "frames_excluded": geometry.counts()}
 
 
 def floor_ned(series, bias=None):

@@ -37,7 +37,7 @@ from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
-from navsim.navigation import build
+from navsim.navigation import build, exclusion
 from navsim.navigation.budget import SOURCES as BUDGET_SOURCES
 from navsim.navigation.run import fixed_initial_error
 from navsim.navigation.scenario import frame_rate
@@ -243,7 +243,8 @@ def measurements(scenario, nom, filt, star_catalog, src):
     if nom.sky is not None:
         catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
         sensor, note = vector_equivalent(scenario, catalog, 1.0 / scenario["star_sensor"]["rate_hz"], build.catalog_epoch(scenario))
-        available = sensor.faults.available(nom.frame_k * dt)
+        geometry = exclusion.geometry(scenario, nom.trajectory, nom.orientation, nom.frame_k, sensor.q_BS_true)
+        available = exclusion.excluding(sensor, geometry, nom.frame_k * dt).faults.available(nom.frame_k * dt)
         correct = scenario["star_sensor"]["aberration_correction"]
         if isinstance(sensor, AttitudeFixSensor):
             fix_R = sensor.R_S

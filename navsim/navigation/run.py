@@ -36,7 +36,7 @@ from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
 from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter
-from navsim.navigation import build, celestial
+from navsim.navigation import build, celestial, exclusion
 from navsim.navigation.scenario import frame_rate
 from navsim.navigation.summary import navigation_series, summarize
 from navsim.records import RunResult
@@ -78,6 +78,7 @@ class Prepared:
     disturbance: GravityDisturbance | None
     star_sensor: object = None
     orientation: EarthOrientation | None = None
+    sky_geometry: exclusion.SkyGeometry | None = None
     observers: tuple = ()
     bias_steps: tuple = ()
     attitude_jumps: tuple = ()
@@ -140,17 +141,19 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     truth = None if random_field else trajectory.with_gravity(kinematics, disturbance)
     gyro, accel = build.imu(scenario)
     baro = build.baro(scenario)
-    star_sensor = orientation = None
+    star_sensor = orientation = sky_geometry = None
     if "star_sensor" in scenario.data:
         star_catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
         star_sensor = build.star_sensor(scenario, star_catalog, lanes(scenario))
         if "mounting" in truth_off:
             star_sensor = dataclasses.replace(star_sensor, q_BS_true=mounting(scenario["star_sensor"])[0])
         orientation = EarthOrientation.compute(scenario["epoch_utc"], grid.frame_k * grid.dt)
+        sky_geometry = exclusion.geometry(scenario, kinematics, orientation, grid.frame_k, star_sensor.q_BS_true)
+        star_sensor = exclusion.excluding(star_sensor, sky_geometry, grid.frame_k * grid.dt)
     return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
                               baro_every=0 if baro is None else int(round(frame_hz / baro.rate_hz)),
                               position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
-                              star_sensor=star_sensor, orientation=orientation,
+                              star_sensor=star_sensor, orientation=orientation, sky_geometry=sky_geometry,
                               observers=() if star_sensor is None else observers(scenario, star_sensor),
                               bias_steps=faults.bias_steps(scenario["faults"]),
                               attitude_jumps=faults.attitude_jumps(scenario["faults"]), truth_off=truth_off,
@@ -193,7 +196,8 @@ def simulate(prepared, seed, compiled=True):
                                                                           series["q_bs"]))
     summary = summarize(scenario, seed, series, grid)
     if p.star_sensor is not None:
-        summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true))
+        summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true,
+                                                              p.sky_geometry))
     summary, timing = star_run.finish(summary, series, log, observer_runs, series["t"] >= scenario["settle_s"])
     summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
     return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,

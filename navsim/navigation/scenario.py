@@ -135,6 +135,12 @@ SCHEMA = Table(
             "aberration_correction": Value("bool", default=True,
                                            doc="the processing aberrates the catalog stars with the INS's velocity and "
                                                "the ephemeris (the truth always sees apparent stars)"),
+            "sun_exclusion_deg": Value("float", default=0.0, minimum=0.0, maximum=180.0,
+                                       doc="no frame while the Sun is within this angle of the boresight (0: none)"),
+            "moon_exclusion_deg": Value("float", default=0.0, minimum=0.0, maximum=180.0,
+                                        doc="no frame while the Moon is within this angle of the boresight (0: none)"),
+            "min_elevation_deg": Value("float", default=-90.0, minimum=-90.0, maximum=90.0,
+                                       doc="no frame while the boresight is lower above the local horizon (-90: none)"),
         }, optional=True, doc="a star sensor aiding the INS (SINS/CNS) at its rate, vector or image fidelity"),
         "faults": Table(dict(FAULTS), doc="outages, dropped frames, false-star storms and attitude jumps of the star "
                                           "sensor; gyro bias steps"),

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 #: Frame modes, in the order of their integer codes in the time series.
-MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped")
+MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped", "excluded")
 MODE_CODE = {name: code for code, name in enumerate(MODES)}
 
 
