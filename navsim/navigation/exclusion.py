@@ -43,11 +43,6 @@ class SkyGeometry:
         return {text: int(np.sum(self.reason == k)) for k, text in enumerate(REASONS)}
 
 
-def active(sensor):
-    """Whether a ``star_sensor`` table excludes anything."""
-    return sensor["sun_exclusion_deg"] > 0.0 or sensor["moon_exclusion_deg"] > 0.0 or sensor["min_elevation_deg"] > -90.0
-
-
 def geometry(scenario, path, orientation, frame_k, q_BS_true):
     """The :class:`SkyGeometry` of the frames (the samples ``frame_k`` of the trajectory ``path``, the Earth's
     ``orientation`` at them) for the sensor mounted at ``q_BS_true``."""
@@ -74,3 +69,10 @@ def excluding(star_sensor, sky, t_frames):
     faults = dataclasses.replace(star_sensor.faults, excluded_s=np.asarray(t_frames, dtype=float)[hit],
                                  excluded_reasons=tuple(REASONS[k] for k in sky.reason[hit]))
     return dataclasses.replace(star_sensor, faults=faults)
+
+
+def series(sky):
+    """The run series of the frames' sky: the Sun's and the Moon's angles from the boresight, the boresight's and
+    the Sun's elevations [rad] and each frame's exclusion (an index of :data:`REASONS`, −1: none)."""
+    return {"sun_angle": sky.sun_angle, "moon_angle": sky.moon_angle, "boresight_elevation": sky.boresight_elevation,
+            "sun_elevation": sky.sun_elevation, "sky_excluded": sky.reason}

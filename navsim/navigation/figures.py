@@ -217,3 +217,25 @@ def budget_shares(t, shares, labels):
     ax.set(xlabel="time [h]", ylabel="share of mean square [m²]")
     ax.legend(loc="upper left", ncol=2)
     return fig
+
+
+def sky(run):
+    """The Sun's and the Moon's angles from the boresight, the boresight's and the Sun's elevations [deg] against
+    time [min], the scenario's exclusion angles dashed and the excluded frames shaded."""
+    s, sensor = run.series, (run.scenario or {}).get("star_sensor") or {}
+    t = _minutes(s["t"])
+    fig, axes = new_figure(3.2)
+    ax = axes[0, 0]
+    for key, label, color in (("sun_angle", "Sun from the boresight", "tab:orange"), ("moon_angle", "Moon from the boresight", "tab:blue"),
+                              ("boresight_elevation", "boresight elevation", "k"), ("sun_elevation", "Sun elevation", "tab:red")):
+        ax.plot(t, np.degrees(s[key]), color=color, lw=0.9, ls=":" if key == "sun_elevation" else "-", label=label)
+    for key, none, color in (("sun_exclusion_deg", 0.0, "tab:orange"), ("moon_exclusion_deg", 0.0, "tab:blue"),
+                             ("min_elevation_deg", -90.0, "k")):
+        if sensor.get(key, none) != none:
+            ax.axhline(sensor[key], color=color, lw=0.7, ls="--")
+    excluded = s["sky_excluded"] >= 0
+    if excluded.any():
+        ax.fill_between(t, 0.0, 1.0, where=excluded, transform=ax.get_xaxis_transform(), color="0.85", label="excluded")
+    ax.set(xlabel="time [min]", ylabel="angle [deg]", ylim=(-90.0, 180.0))
+    ax.legend(loc="upper right", ncols=3)
+    return fig

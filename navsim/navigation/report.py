@@ -144,6 +144,8 @@ def _star_sensor_section(doc, run):
     doc.figure(nav_figures.horizon_floor(run), "Horizontal position error north and east with the filter's ±3σ and "
                                                "the analytic-horizon floor of eq. (1) of the true "
                                                "accelerometer bias and of the bias the filter's estimate leaves, metres.")
+    if "sky" in celestial and "sun_angle" in run.series:
+        _sky_section(doc, run, celestial["sky"])
     corrected = "corrected" if aberration["corrected"] else "not corrected"
     doc.paragraph(markup(
         f"The aberration of the star directions is {corrected} by the processing; left uncorrected, its horizontal part "
@@ -158,6 +160,18 @@ def _star_sensor_section(doc, run):
         doc.figure(nav_figures.mounting(run), "Star-sensor mounting error μ: truth (black) and the filter's estimate "
                                               "with ±3σ, arcsec.")
     _observability_section(doc, celestial["observability"])
+
+
+def _sky_section(doc, run, sky):
+    """The Sun, the Moon and the horizon: the frames each exclusion took and the geometry over time."""
+    excluded = ", ".join(f"{count} ({reason})" for reason, count in sky["frames_excluded"].items() if count) or "none"
+    doc.paragraph(markup(
+        f"The Sun comes within {number(sky['sun_angle_min_deg'])} deg of the boresight and the Moon within "
+        f"{number(sky['moon_angle_min_deg'])} deg (mean illuminated fraction {number(sky['moon_illuminated_mean'])}); the "
+        f"boresight's lowest elevation is {number(sky['boresight_elevation_min_deg'])} deg and the Sun is up for "
+        f"{sky['frames_sun_up']} frames. Frames excluded: {excluded}."))
+    doc.figure(nav_figures.sky(run), "The Sun's and the Moon's angles from the boresight and the elevations of the "
+                                     "boresight and the Sun, deg; the exclusion angles dashed, excluded frames shaded.")
 
 
 def _horizon_rows(floor):

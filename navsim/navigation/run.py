@@ -194,6 +194,7 @@ def simulate(prepared, seed, compiled=True):
                                                                                       q_BS_true)), (grid.n_frames, 3)).copy()
         series["mounting_estimate"] = rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
                                                                           series["q_bs"]))
+        series.update(exclusion.series(p.sky_geometry))
     summary = summarize(scenario, seed, series, grid)
     if p.star_sensor is not None:
         summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true,

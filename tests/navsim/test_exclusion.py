@@ -59,6 +59,18 @@ def test_the_frames_with_the_body_in_the_cone_fuse_nothing(overrides, body, reas
     assert np.allclose(analysis.diag_f, scripted.diag_f, rtol=1e-9, atol=0.0)
 
 
+def test_the_run_report_draws_the_sky(tmp_path, capsys):
+    from navsim import cli
+    from tests.support import pdf_text, run_cli
+
+    out = tmp_path / "run"
+    argv = ["run", LEVEL, "--out", out, "--report", *[a for o in NOON for a in ("--set", o)], "--set", "duration_s=4000"]
+    status, err = run_cli(cli.main, argv, capsys)
+    assert status == 0, err
+    text, _ = pdf_text(out / "report.pdf")
+    assert "The Sun comes within 0.0" in text and "(Sun in the exclusion cone)" in text
+
+
 def test_no_exclusion_by_default_and_bad_angles_are_named():
     scenario = resolve_scenario(LEVEL, NOON[:-1])
     assert scenario["star_sensor"]["sun_exclusion_deg"] == 0.0 and scenario["star_sensor"]["min_elevation_deg"] == -90.0
