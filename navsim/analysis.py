@@ -214,7 +214,9 @@ def compare(analysis, runs, times=COMPARE_TIMES, probability=0.95):
            "quantities": {}, "states": {}}
 
     def entry(expected, variance, samples, size, filter_variance):
-        # the band of the runs' RMS, widened by the linearisation's allowance (a fixed error alone has no spread)
+        # the band of the runs' RMS, widened by the linearisation's allowance (a fixed error alone has no spread); a
+        # source that does not reach a state leaves it a variance of rounding size and either sign
+        expected, variance = max(expected, 0.0), max(variance, 0.0)
         allowance = LINEARISATION * np.sqrt(filter_variance)
         lo, hi = (np.sqrt(v) for v in mean_square_band(expected, variance, N, probability))
         flo, fhi = (np.sqrt(v) for v in mean_square_band(expected, variance, N, family))
