@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.bodies import SunMoon
-from navsim.earth.frames import q_en
+from navsim.truth.sky import inertial_attitude
 from startrack import rotation as rot
 from startrack import units
 from startrack.sphere import angular_distance
@@ -48,7 +48,7 @@ def geometry(scenario, path, orientation, frame_k, q_BS_true):
     ``orientation`` at them) for the sensor mounted at ``q_BS_true``."""
     lat, lon, h = path.lat[frame_k], path.lon[frame_k], path.h[frame_k]
     bodies = SunMoon.compute(scenario["epoch_utc"], orientation, lat, lon, h)
-    q_IB = rot.multiply(rot.multiply(orientation.q_ie, np.stack(q_en(lat, lon), axis=-1)), path.q_nb[frame_k])
+    q_IB = inertial_attitude(path, orientation, frame_k)
     boresight = rot.rotate(rot.multiply(q_IB, q_BS_true), np.array([0.0, 0.0, 1.0]))
     sensor = scenario["star_sensor"]
     sun, moon = angular_distance(boresight, bodies.sun_I), angular_distance(boresight, bodies.moon_I)

@@ -13,6 +13,13 @@ from navsim.truth.profiles import FrameTruth
 from startrack import rotation as rot
 
 
+def inertial_attitude(trajectory, orientation, frame_k):
+    """q_IB (F, 4) = q_ie ⊗ q_en(L, λ) ⊗ q_nb of the ``trajectory``'s samples ``frame_k`` (F,) for the Earth's
+    ``orientation`` at them."""
+    lat, lon = trajectory.lat[frame_k], trajectory.lon[frame_k]
+    return rot.multiply(rot.multiply(orientation.q_ie, np.stack(q_en(lat, lon), axis=-1)), trajectory.q_nb[frame_k])
+
+
 @dataclass(frozen=True)
 class SkyTruth:
     """Per frame f (closing IMU interval k = (f + 1)·``ratio``): ``q_IB`` (F, 4), ``omega_B`` (F, 3)
@@ -29,7 +36,7 @@ class SkyTruth:
         """The sky truth of a :class:`~navsim.truth.trajectory.Trajectory` at the frames' IMU samples
         ``frame_k`` (F,) for the :class:`~navsim.earth.orientation.EarthOrientation` at those frames."""
         lat, lon, h = trajectory.lat[frame_k], trajectory.lon[frame_k], trajectory.h[frame_k]
-        q_IB = rot.multiply(rot.multiply(orientation.q_ie, np.stack(q_en(lat, lon), axis=-1)), trajectory.q_nb[frame_k])
+        q_IB = inertial_attitude(trajectory, orientation, frame_k)
         v_n = trajectory.v_n[frame_k]
         v_I = np.array([observer_velocity(orientation.c_ie[f], orientation.v_earth[f], lat[f], lon[f], h[f], v_n[f])
                         for f in range(frame_k.size)])
