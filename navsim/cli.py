@@ -8,6 +8,7 @@
     navsim covariance SCENARIO.toml --out DIR [--set key=value ...] [--budget] [--compare CAMPAIGN_DIR] [--report [FILE.pdf]]
     navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
                  [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
+    navsim sky SCENARIO.toml [--set key=value ...] [--report FILE.pdf]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -203,6 +204,23 @@ def _covariance(args):
     return 0
 
 
+def _sky(args):
+    from navsim.kinds import resolve_scenario, run_kind
+    from startrack.paths import check_file
+
+    scenario = resolve_scenario(args.scenario, args.set or ())
+    if args.report:
+        check_file(args.report, "--report", (".pdf",))
+    availability = run_kind(scenario, "a star availability").star_availability(scenario)
+    print("\n".join(availability.lines()))
+    if args.report:
+        from navsim.report.sky import sky_report
+
+        Path(args.report).write_bytes(sky_report(availability))
+        print(f"report              {args.report}")
+    return 0
+
+
 def _sweep(args):
     from navsim.campaign.sweep import parse_vary, run_sweep
     from navsim.report import write_report
@@ -277,6 +295,13 @@ def build_parser():
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.set_defaults(func=_budget)
     _add_sizing_commands(sub)
+
+    p = sub.add_parser("sky", help="the stars the star sensor sees along a navigation scenario's trajectory (the Sun, "
+                                   "the Moon, the sky's brightness, the limiting magnitude), without running the filter")
+    p.add_argument("scenario", help="scenario TOML file (a navigation scenario with a [star_sensor])")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
+    p.add_argument("--report", default=None, metavar="FILE.pdf", help="also typeset the availability as a PDF")
+    p.set_defaults(func=_sky)
     return parser
 
 

@@ -26,6 +26,8 @@ A **run kind** is a package providing (each name loaded on first use; :mod:`navs
     covariance_analysis(scenario, split, star_catalog) -> navsim.analysis.Analysis   its linear covariance analysis
     COVARIANCE_QUANTITIES, COVARIANCE_SOURCES     its summary quantities {name: (unit, SI size)}, error sources {key: label}
     covariance_run_errors(scenario)               the quantities' errors of a run series (Monte Carlo against the analysis)
+    star_availability(scenario, star_catalog)     the stars its sensor sees along the run, without a filter
+                                                  (``navsim sky``; InputError if it has no sky)
 
 A kind whose ``budget_parts`` returns parts also provides ``summarize_budget`` and ``budget_text``. A third
 kind is a new package providing these (:data:`INTERFACE`), and one more entry in :data:`KINDS`.
@@ -41,7 +43,7 @@ from startrack.errors import InputError
 INTERFACE = ("NAME", "TABLE", "validate", "prepare", "simulate", "lanes", "TRUTH_SOURCES", "check_truth_off",
              "budget_parts", "check_tuning", "RunSummary", "CampaignSummary", "pool", "run_lines", "campaign_lines",
              "run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES", "covariance_analysis", "COVARIANCE_QUANTITIES",
-             "COVARIANCE_SOURCES", "covariance_run_errors")
+             "COVARIANCE_SOURCES", "covariance_run_errors", "star_availability")
 #: The run kinds by name; the one without a table takes every scenario no other kind claims.
 KINDS = {kind.NAME: kind for kind in (attitude, navigation)}
 #: The name of the static studies' kind, and the table that marks them.

@@ -100,8 +100,9 @@ def chord(angle):
 class NavigationCatalogParams:
     """Every parameter of a navigation-catalog build (SI/radians; defaults of 000 §5).
 
-    ``mag_limit`` m_t [V mag]; ``fov`` theta_FOV, the diameter of the circular
-    field [rad]; ``n_d`` declination divisions of eq. 1; ``sigma`` the largest
+    ``mag_limit`` m_t [mag in ``band``: V by default; a sensor's own band picks
+    the stars it sees brightest, :meth:`startrack.star_catalog.StarCatalog.in_band`];
+    ``fov`` theta_FOV, the diameter of the circular field [rad]; ``n_d`` declination divisions of eq. 1; ``sigma`` the largest
     measurement error of an angular distance [rad] (theta_max = fov + sigma);
     ``max_delta`` the largest boresight-estimate error max(delta) of eq. 6 [rad];
     ``theta_min`` the smallest pair distance kept [rad]; ``epoch`` of the star
@@ -118,6 +119,7 @@ class NavigationCatalogParams:
     epoch: float = 2000.0
     exclude_multiple: bool = True
     exclude_variable: bool = True
+    band: str = "V"
 
     def __post_init__(self):
         def finite(name, value, low, high, unit_scale=1.0, unit=""):
@@ -196,10 +198,10 @@ def sub_catalog_radius(s_max: float, max_delta: float, fov: float) -> float:
 def candidate_mask(stars, params: NavigationCatalogParams):
     """Boolean candidate mask over ``stars`` and the number of stars each rule removed (in order).
 
-    Rules, applied in turn: ``magnitude`` (V > m_t), ``multiple``, ``variable``.
+    Rules, applied in turn: ``magnitude`` (fainter than m_t in the catalog's band), ``multiple``, ``variable``.
     """
-    keep = stars.v_mag <= params.mag_limit
-    excluded = {"magnitude": int(stars.v_mag.size - keep.sum())}
+    keep = stars.mag <= params.mag_limit
+    excluded = {"magnitude": int(stars.mag.size - keep.sum())}
     for rule, flag, active in (
         ("multiple", stars.multiple, params.exclude_multiple),
         ("variable", stars.variable, params.exclude_variable),
@@ -322,7 +324,7 @@ class NavigationCatalog:
     ``ring_offsets`` (first flat index of each ring, total at the end).
     Guide stars (n_g): ``guide_hip`` int32, ``guide_ra``, ``guide_dec``,
     ``guide_vectors`` (n_g, 3) ICRS unit vectors at ``params.epoch``,
-    ``guide_v_mag``. Pattern pairs (n_s, ascending distance): ``pair_theta``
+    ``guide_v_mag`` (in the params' band). Pattern pairs (n_s, ascending distance): ``pair_theta``
     float64 [rad], ``pair_i``, ``pair_j`` int32 guide-star indices;
     ``kvector`` their :class:`KVector` (``kvector_k`` its k array).
     Sub-catalogs (CSR): ``sub_star_offsets``/``sub_star_index`` and
@@ -544,7 +546,7 @@ def build_navigation_catalog(params: NavigationCatalogParams | None = None, prog
             bar.set_postfix_str(name, refresh=False)
             bar.update(1)
 
-        stars = load_star_catalog(params.epoch)
+        stars = load_star_catalog(params.epoch).in_band(params.band)
         step(steps[0])
         keep, excluded = candidate_mask(stars, params)
         candidates = stars.select(keep)
@@ -586,7 +588,7 @@ def build_navigation_catalog(params: NavigationCatalogParams | None = None, prog
         guide_ra=guides.ra,
         guide_dec=guides.dec,
         guide_vectors=guides.vectors,
-        guide_v_mag=guides.v_mag,
+        guide_v_mag=guides.mag,
         pair_theta=pair_theta,
         pair_i=pair_i,
         pair_j=pair_j,

@@ -89,3 +89,29 @@ def stackable_snr_range(n_frames, a=5.0):
     if n_frames < 1:
         raise InputError(f"number of stacked frames must be >= 1, got {n_frames!r}")
     return a / np.sqrt(n_frames), float(a)
+
+
+def trail_peak_fraction(sigma_px, length_px):
+    """The mean over the star's sub-pixel phase of the fraction of its light in its brightest pixel, in one
+    dimension, for a Gaussian of radius ``sigma_px`` moving by ``length_px`` along that axis [px]:
+
+        f = (1/L') ∫_{−L'/2}^{L'/2} F(s) ds,   L' = √(L² + 1),   F of :func:`pixel_fraction`,
+
+    the phase average (a uniform offset over one pixel, L' = 1 without smear) and the trail's average over
+    its length merged into one average over L' (exact at L = 0 and for L ≫ 1, within 3 % between: tested).
+    The integral is closed: ∫ erf(x/a) dx = x erf(x/a) + a e^(−x²/a²)/√π."""
+    a = np.sqrt(2.0) * np.asarray(sigma_px, dtype=float)
+    half = 0.5 * np.sqrt(np.square(np.asarray(length_px, dtype=float)) + 1.0)
+
+    def integral(x):  # ∫_0^x erf(t/a) dt
+        return x * erf(x / a) + a * (np.exp(-np.square(x / a)) - 1.0) / np.sqrt(np.pi)
+
+    total = integral(half + 0.5) - integral(0.5 - half) - integral(half - 0.5) + integral(-half - 0.5)
+    return 0.25 * total / half
+
+
+def peak_fraction(sigma_px, smear_px=0.0):
+    """The fraction of a star's light in its brightest pixel, averaged over its sub-pixel phase, for a trail
+    of ``smear_px`` [px] (taken along a pixel axis; a diagonal trail's peak is up to √2 higher)."""
+    return trail_peak_fraction(sigma_px, smear_px) * trail_peak_fraction(sigma_px, 0.0)
+

@@ -225,6 +225,50 @@ def centroid_bound(uv, flux_dn, psf_sigma_px, noise, smear_px=(0.0, 0.0)):
     return np.linalg.inv(J)[:2, :2]
 
 
+#: Grids of the tabulated bound (:func:`centroid_variance`): t = v/N [e⁻], a pixel's variance over the star's
+#: charge, and the trail length [px]; the sub-pixel phases it is averaged over.
+_BOUND_T = np.logspace(-5.0, 4.0, 19)
+_BOUND_SMEAR = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 24.0, 32.0, 40.0,
+                         48.0, 64.0])
+_BOUND_PHASES = (0.125, 0.375)
+
+
+@functools.lru_cache(maxsize=16)
+def _bound_table(psf_sigma_px):
+    """N σ²(t, L) on the grids: the bound's mean variance over the two axes and the sub-pixel phases times the
+    charge, a function of t = v/N and the trail alone (the Fisher information (3) scales as N at fixed v/N)."""
+    n = 1.0e6
+    table = np.empty((_BOUND_T.size, _BOUND_SMEAR.size))
+    for i, t in enumerate(_BOUND_T):
+        noise = PixelNoise(math.sqrt(t * n), gain_e_per_dn=1.0, quantised=False)
+        for j, length in enumerate(_BOUND_SMEAR):
+            traces = [np.trace(centroid_bound((40.0 + du, 40.0 + dv), n, psf_sigma_px, noise, (length, 0.0)))
+                      for du in _BOUND_PHASES for dv in _BOUND_PHASES]
+            table[i, j] = 0.5 * n * np.mean(traces)
+    return table
+
+
+def centroid_variance(electrons, pixel_variance_e2, psf_sigma_px, smear_px=0.0):
+    """The Cramér-Rao bound (3) on a star's position [px²] as one number per star: the mean over the two image
+    axes and over the star's sub-pixel phase, for a charge ``electrons`` [e⁻] on pixels of variance
+    ``pixel_variance_e2`` [e⁻²] (read noise and background shot noise), the PSF radius and a trail of
+    ``smear_px`` [px] (up to 64). The bound is exactly h(v/N; σ, L)/N; h is tabulated once per PSF radius
+    on 19 x 19 points (the phases' 2 x 2 midpoints, within 0.1 % of a fine average) and its logarithm
+interpolated, linear in log(v/N) and in L: within 1 % of the bound (tested)."""
+    n = np.asarray(electrons, dtype=float)
+    table = np.log(_bound_table(float(psf_sigma_px)))
+    log_t = np.log(np.clip(np.asarray(pixel_variance_e2, dtype=float) / n, _BOUND_T[0], _BOUND_T[-1]))
+    length = np.clip(np.abs(np.asarray(smear_px, dtype=float)), 0.0, _BOUND_SMEAR[-1])
+    log_t, length = np.broadcast_arrays(log_t, length)
+    i = np.clip(np.searchsorted(np.log(_BOUND_T), log_t) - 1, 0, _BOUND_T.size - 2)
+    j = np.clip(np.searchsorted(_BOUND_SMEAR, length) - 1, 0, _BOUND_SMEAR.size - 2)
+    wt = (log_t - np.log(_BOUND_T[i])) / (np.log(_BOUND_T[i + 1]) - np.log(_BOUND_T[i]))
+    wl = (length - _BOUND_SMEAR[j]) / (_BOUND_SMEAR[j + 1] - _BOUND_SMEAR[j])
+    h = ((1 - wt) * (1 - wl) * table[i, j] + wt * (1 - wl) * table[i + 1, j]
+         + (1 - wt) * wl * table[i, j + 1] + wt * wl * table[i + 1, j + 1])
+    return np.exp(h) / n
+
+
 @dataclass(frozen=True)
 class StarFits:
     """The fits of N stars: positions ``uv`` (N, 2) [px], their covariance ``cov`` (N, 2, 2) [px²] (J⁻¹ at

@@ -14,9 +14,11 @@ characters. Columns used (bytes, 1-based, from the Vizier I/311 ReadMe)::
      44- 50  F7.2   Plx    parallax [mas]
      52- 59  F8.2   pmRA   proper motion mu_alpha* = mu_alpha cos(delta) [mas/yr]
      61- 68  F8.2   pmDE   proper motion mu_delta [mas/yr]
+     84- 89  F6.2   e_Plx  standard error of the parallax [mas]
     130-136  F7.4   Hpmag  Hipparcos magnitude Hp [mag]
         151  I1     VA     reference to the variability annex (0 none, 1, 2)
     153-158  F6.3   B-V    colour index [mag]
+    166-171  F6.3   V-I    colour index V - I (Cousins) [mag]
 
 In ``Sn = 10 d + s``, ``s`` is the solution (1 stochastic, 3 VIM = double star
 with a variable component, 5/7/9 = 5/7/9-parameter) and ``d`` a bit set of
@@ -97,14 +99,16 @@ _HIP2_COLUMNS = {
     "ra": (16, 28),
     "dec": (30, 42),
     "parallax": (44, 50),
+    "parallax_error": (84, 89),
     "pm_ra": (52, 59),
     "pm_dec": (61, 68),
     "hp_mag": (130, 136),
     "va": (151, 151),
     "b_v": (153, 158),
+    "v_i": (166, 171),
 }
 _HIP2_RECORD_LENGTH = 276
-_PARSE_FORMAT = 1  # bump when the parsed-table layout changes
+_PARSE_FORMAT = 2  # bump when the parsed-table layout changes
 
 
 def v_minus_hp(b_v):
@@ -150,8 +154,8 @@ def parse_hip2(path) -> dict:
     """Parse a hip2.dat file into a dict of J1991.25 arrays (units of the ReadMe converted to SI/rad).
 
     Keys: ``hip``, ``solution_type`` (Sn), ``old_solution_type`` (So), ``n_components``,
-    ``ra``, ``dec`` [rad], ``parallax`` [rad], ``pm_ra_cosdec``, ``pm_dec`` [rad/yr],
-    ``hp_mag``, ``b_v`` [mag], ``variability_annex`` (VA).
+    ``ra``, ``dec`` [rad], ``parallax``, ``parallax_error`` [rad], ``pm_ra_cosdec``, ``pm_dec`` [rad/yr],
+    ``hp_mag``, ``b_v``, ``v_i`` [mag], ``variability_annex`` (VA).
     """
     path = Path(path)
     if not path.is_file():
@@ -176,11 +180,13 @@ def parse_hip2(path) -> dict:
         "ra": ra,
         "dec": dec,
         "parallax": _field(records, *c["parallax"], np.float64) * MILLIARCSEC,
+        "parallax_error": _field(records, *c["parallax_error"], np.float64) * MILLIARCSEC,
         "pm_ra_cosdec": _field(records, *c["pm_ra"], np.float64) * MILLIARCSEC,
         "pm_dec": _field(records, *c["pm_dec"], np.float64) * MILLIARCSEC,
         "hp_mag": _field(records, *c["hp_mag"], np.float64),
         "variability_annex": _field(records, *c["va"], np.int8),
         "b_v": _field(records, *c["b_v"], np.float64),
+        "v_i": _field(records, *c["v_i"], np.float64),
     }
     for key in ("pm_ra_cosdec", "pm_dec", "parallax"):
         out[key] = np.nan_to_num(out[key], nan=0.0)
@@ -229,7 +235,9 @@ class StarCatalog:
     """Stars as parallel arrays of length N, positions propagated to ``epoch``.
 
     Angles in radians, proper motions in rad/yr, magnitudes in mag. ``vectors``
-    are ICRS (inertial frame I) unit vectors. Flags: ``n_components`` (Nc),
+    are ICRS (inertial frame I) unit vectors. ``mag`` is each star's magnitude in
+    the catalog's ``band`` (V unless :meth:`in_band` made it another,
+    :mod:`startrack.colours`); ``v_mag`` stays Johnson V. Flags: ``n_components`` (Nc),
     ``solution_type`` (Sn), ``variability_annex`` (VA), and the derived booleans
     ``multiple`` (Nc > 1, a double-star solution bit d & 1 of Sn, a VIM solution
     s = 3, or an old-reduction double/orbital/VIM solution So in 3..5) and
@@ -240,9 +248,13 @@ class StarCatalog:
     ra: np.ndarray
     dec: np.ndarray
     vectors: np.ndarray
+    mag: np.ndarray
     v_mag: np.ndarray
     hp_mag: np.ndarray
     b_v: np.ndarray
+    v_i: np.ndarray
+    parallax: np.ndarray
+    parallax_error: np.ndarray
     pm_ra_cosdec: np.ndarray
     pm_dec: np.ndarray
     n_components: np.ndarray
@@ -251,10 +263,11 @@ class StarCatalog:
     multiple: np.ndarray
     variable: np.ndarray
     epoch: float
+    band: str = "V"
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
-            if field.name != "epoch":
+            if field.name not in _SCALARS:
                 object.__setattr__(self, field.name, _readonly(getattr(self, field.name)))
 
     def __len__(self) -> int:
@@ -264,13 +277,26 @@ class StarCatalog:
         """The stars where ``mask`` (bool array or index array) selects, as a new catalog."""
         mask = np.asarray(mask)
         arrays = {
-            f.name: getattr(self, f.name)[mask] for f in dataclasses.fields(self) if f.name != "epoch"
+            f.name: getattr(self, f.name)[mask] for f in dataclasses.fields(self) if f.name not in _SCALARS
         }
-        return StarCatalog(epoch=self.epoch, **arrays)
+        return StarCatalog(epoch=self.epoch, band=self.band, **arrays)
 
-    def brighter_than(self, v_mag_max: float) -> "StarCatalog":
-        """Stars with visual magnitude V <= ``v_mag_max`` [mag]."""
-        return self.select(self.v_mag <= v_mag_max)
+    def brighter_than(self, mag_max: float) -> "StarCatalog":
+        """Stars with magnitude <= ``mag_max`` [mag] in the catalog's band."""
+        return self.select(self.mag <= mag_max)
+
+    def in_band(self, band: str) -> "StarCatalog":
+        """The same stars with ``mag`` in ``band`` (V, R, I, J, H), from their colours (:mod:`startrack.colours`)."""
+        from startrack.colours import band_magnitude
+
+        if band == self.band:
+            return self
+        mag = band_magnitude(band, self.v_mag, self.b_v, self.v_i, self.parallax, self.parallax_error)
+        return dataclasses.replace(self, mag=mag, band=band)
+
+
+#: The fields of a :class:`StarCatalog` that are not per-star arrays.
+_SCALARS = ("epoch", "band")
 
 
 def star_catalog_from_table(table: dict, epoch: float) -> StarCatalog:
@@ -279,6 +305,7 @@ def star_catalog_from_table(table: dict, epoch: float) -> StarCatalog:
         table["ra"], table["dec"], table["pm_ra_cosdec"], table["pm_dec"], epoch - HIPPARCOS_EPOCH
     )
     ra, dec = vector_to_radec(vectors)
+    v_mag = visual_magnitude(table["hp_mag"], table["b_v"])
     sn = table["solution_type"].astype(np.int16)
     so = table["old_solution_type"]
     multiple = (table["n_components"] > 1) | (((sn // 10) & 1) == 1) | (sn % 10 == 3) | ((so >= 3) & (so <= 5))
@@ -287,9 +314,13 @@ def star_catalog_from_table(table: dict, epoch: float) -> StarCatalog:
         ra=ra,
         dec=dec,
         vectors=vectors,
-        v_mag=visual_magnitude(table["hp_mag"], table["b_v"]),
+        mag=v_mag,
+        v_mag=v_mag,
         hp_mag=table["hp_mag"],
         b_v=table["b_v"],
+        v_i=table["v_i"],
+        parallax=table["parallax"],
+        parallax_error=table["parallax_error"],
         pm_ra_cosdec=table["pm_ra_cosdec"],
         pm_dec=table["pm_dec"],
         n_components=table["n_components"],

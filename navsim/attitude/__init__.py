@@ -14,7 +14,8 @@ NAME, TABLE = "attitude", None
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.attitude.scenario": ("validate", "check_tuning"),
-    "navsim.attitude.run": ("prepare", "simulate", "lanes", "check_truth_off", "budget_parts", "TRUTH_SOURCES"),
+    "navsim.attitude.run": ("prepare", "simulate", "lanes", "check_truth_off", "budget_parts", "star_availability",
+                            "TRUTH_SOURCES"),
     "navsim.attitude.records": ("RunSummary", "CampaignSummary"),
     "navsim.attitude.covariance": ("covariance_analysis", "COVARIANCE_QUANTITIES", "COVARIANCE_SOURCES",
                                    "covariance_run_errors"),

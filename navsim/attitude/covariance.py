@@ -126,13 +126,12 @@ def _measurements(scenario, truth, ratio, frames, dt, star_catalog, src):
     if isinstance(sensor, AttitudeFixSensor):
         fix_mask, fix_q, fix_R = available, rot.multiply(truth.q_IB[k], sensor.q_BS_true), sensor.R_S
     else:
-        stars = sensor.observe_frames(truth.q_IB[k], np.random.default_rng(0))
+        stars = sensor.observe_frames(truth.q_IB[k], np.random.default_rng(0), noise=False)
         frame = np.repeat(np.arange(frames), np.diff(stars.offsets))
         keep = available[frame]
-        frame, ref = frame[keep], stars.ref_I[keep]
-        obs = rot.rotate(rot.conjugate(rot.multiply(truth.q_IB[k][frame], sensor.q_BS_true)), ref)  # noise-free
+        frame, ref, obs = frame[keep], stars.ref_I[keep], stars.obs_S[keep]
         offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=frames))])
-        cov = isotropic_covariance(obs, sensor.sigma)
+        cov = isotropic_covariance(obs, stars.sigma[keep])
     meas = Measurements(star_offsets=offsets, star_ref=np.ascontiguousarray(ref), star_obs=np.ascontiguousarray(obs),
                         star_cov=np.ascontiguousarray(cov), fix_mask=fix_mask, fix_q=np.ascontiguousarray(fix_q),
                         fix_R=np.ascontiguousarray(fix_R, dtype=float),

@@ -178,6 +178,12 @@ def summarize(scenario, seed, series, R_BS):
     )
 
 
+def star_availability(scenario, star_catalog=None):
+    """An attitude scenario has no sky (its sensor looks at the stars from nowhere on the Earth): an InputError."""
+    raise InputError(f"{scenario.source}: not a navigation scenario (no [trajectory] table): the sky's star availability "
+                     "needs an observer on the Earth")
+
+
 def budget_parts(scenario):
     """An attitude scenario has no error budget (it is the star-aided INS's): an InputError."""
     raise InputError(f"{scenario.source}: not a navigation scenario (no [trajectory] table): an error budget needs a "

@@ -1,5 +1,6 @@
 """The star sensor of a scenario's ``star_sensor`` table (vector or image fidelity) with the faults that
-act on it, and the per-frame observers (:mod:`navsim.studies`) the scenario asks for, in SI units."""
+act on it, its light budget (``star_sensor.photometry``) and the per-frame observers (:mod:`navsim.studies`)
+the scenario asks for, in SI units. The stars are the catalog's in the sensor's band."""
 
 import dataclasses
 
@@ -11,22 +12,31 @@ from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
 from navsim.studies import observers as observer_kinds
 from startrack import units
+from startrack.bands import band
 from startrack.camera import Camera
+from startrack.detectors import detector
 from startrack.errors import InputError
 from startrack.identify.identifier import StarIdentifier
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
 from startrack.precompile import compile_ahead
 from startrack.render import SensorModel
+from startrack.sensor_photometry import SensorPhotometry
+
+#: The grey-level range of a sensor with a light budget: 16 bits over its full well (bias included).
+PHYSICAL_FULL_SCALE_DN = 65536
 
 
 def star_sensor(scenario, star_catalog, frame_interval, epoch, lanes=()):
     """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with the faults that
     act on it; ``star_catalog`` a :class:`startrack.star_catalog.StarCatalog` (stars measured or
     rendered), ``frame_interval`` the time between frames [s], ``epoch`` the catalog's [Julian year],
-    ``lanes`` the run's compile-ahead lanes (:mod:`startrack.precompile`; image fidelity)."""
+    ``lanes`` the run's compile-ahead lanes (:mod:`startrack.precompile`; image fidelity); an attitude-fix
+    sensor needs no catalog (None)."""
     sensor = scenario["star_sensor"]
     _, q_BS_true = mounting(scenario["star_sensor"])
     faults = sensor_faults(scenario["faults"], frame_interval)
+    if star_catalog is not None:
+        star_catalog = star_catalog.in_band(sensor["band"])
     if sensor["fidelity"] == "image":
         return image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes)
     if sensor["measurement"] == "attitude":
@@ -40,13 +50,53 @@ def star_sensor(scenario, star_catalog, frame_interval, epoch, lanes=()):
     return StarVectorSensor(
         star_vectors=np.asarray(stars.vectors),
         star_ids=np.asarray(stars.hip),
-        star_mags=np.asarray(stars.v_mag),
+        star_mags=np.asarray(stars.mag),
         fov=float(units.deg_to_rad(sensor["fov_deg"])),
         sigma=float(units.arcsec_to_rad(sensor["star_sigma_arcsec"])),
         max_stars=sensor["max_stars"],
         q_BS_true=q_BS_true,
         faults=faults,
+        photometry=photometry(sensor),
     )
+
+
+def camera(sensor):
+    """The :class:`startrack.camera.Camera` of a ``star_sensor`` table with an image table: its camera file's, or an
+    ideal pinhole of the field and the size."""
+    image, fov = sensor["image"], float(units.deg_to_rad(sensor["fov_deg"]))
+    if image["camera_file"] is not None:  # a calibrated camera (startrack solve --write-camera)
+        return dataclasses.replace(Camera.from_file(image["camera_file"]), circular_fov=image["field"] == "circular")
+    return Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
+
+
+def photometry(sensor):
+    """The :class:`startrack.sensor_photometry.SensorPhotometry` of a ``star_sensor`` table's light budget, or None
+    (no ``photometry`` table): its band, detector (the preset with the table's overrides), aperture and optics, and
+    the image table's exposure, PSF, detection threshold and pixel scale."""
+    table = sensor.get("photometry")
+    if table is None:
+        return None
+    overrides = {key: table[key] for key in ("qe", "read_noise_e", "dark_e_per_px_s", "full_well_e") if table[key] is not None}
+    image = sensor["image"]
+    return SensorPhotometry(band=band(sensor["band"]), detector=detector(table["detector"]).with_overrides(**overrides),
+                            aperture_area=np.pi * (0.5e-3 * table["aperture_mm"]) ** 2, transmission=table["transmission"],
+                            exposure_s=image["exposure_s"], psf_sigma_px=image["psf_sigma_px"],
+                            pixel_scale=1.0 / camera(sensor).focal_px, detection_sigmas=image["detection_sigmas"])
+
+
+def sensor_model(sensor):
+    """The renderer's :class:`startrack.render.SensorModel` of a ``star_sensor`` table's image table: with a light
+    budget its detector's zero point, read noise, dark current and full well (16 bits over the well); otherwise the
+    image table's zero point and read noise."""
+    image, budget = sensor["image"], photometry(sensor)
+    common = {"psf_sigma_px": image["psf_sigma_px"], "exposure_s": image["exposure_s"]}
+    if budget is None:
+        return SensorModel(zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"], **common)
+    d, bias = budget.detector, SensorModel.bias_dn
+    return SensorModel(zero_point_e_per_s=budget.zero_point_e_per_s / budget.transmission, transmission=budget.transmission,
+                       read_noise_e=d.read_noise_e, dark_e_per_px_s=d.dark_e_per_px_s, full_well_e=d.full_well_e,
+                       full_scale_dn=PHYSICAL_FULL_SCALE_DN, gain_e_per_dn=d.full_well_e / (PHYSICAL_FULL_SCALE_DN - 1 - bias),
+                       **common)
 
 
 def vector_equivalent(scenario, star_catalog, frame_interval, epoch):
@@ -58,18 +108,17 @@ def vector_equivalent(scenario, star_catalog, frame_interval, epoch):
     if table["fidelity"] != "image":
         return dataclasses.replace(star_sensor(scenario, star_catalog, frame_interval, epoch), q_BS_true=q_BS), None
     image, fov = table["image"], float(units.deg_to_rad(table["fov_deg"]))
-    camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
-    if image["camera_file"] is not None:
-        camera = Camera.from_file(image["camera_file"])
-    stars = star_catalog.brighter_than(table["mag_limit"])
-    sigma = image["centroid_sigma_px"] / camera.focal_px
+    stars = star_catalog.in_band(table["band"]).brighter_than(table["mag_limit"])
+    sigma = image["centroid_sigma_px"] / camera(table).focal_px
+    budget = photometry(table)
     sensor = StarVectorSensor(star_vectors=np.asarray(stars.vectors), star_ids=np.asarray(stars.hip),
-                              star_mags=np.asarray(stars.v_mag), fov=fov, sigma=float(sigma),
+                              star_mags=np.asarray(stars.mag), fov=fov, sigma=float(sigma),
                               max_stars=image["max_identified_stars"], q_BS_true=q_BS,
-                              faults=sensor_faults(scenario["faults"], frame_interval))
-    note = (f"image fidelity modelled by its vector-fidelity equivalent: the V <= {table['mag_limit']:g} stars in the "
-            f"{table['fov_deg']:g} deg field, at most {image['max_identified_stars']}, each "
-            f"{units.rad_to_arcsec(sigma):.2f}\" per axis (centroid {image['centroid_sigma_px']:g} px)")
+                              faults=sensor_faults(scenario["faults"], frame_interval), photometry=budget)
+    each = ("each at the Cramér-Rao bound of its SNR on the frame's sky" if budget is not None else
+            f"each {units.rad_to_arcsec(sigma):.2f}\" per axis (centroid {image['centroid_sigma_px']:g} px)")
+    note = (f"image fidelity modelled by its vector-fidelity equivalent: the {table['band']} <= {table['mag_limit']:g} "
+            f"stars in the {table['fov_deg']:g} deg field, at most {image['max_identified_stars']}, {each}")
     return sensor, note
 
 
@@ -79,22 +128,18 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes=()
     drawn into the frames; the run's kernels compiled ahead (``lanes``) once the scenario is checked."""
     sensor, image = scenario["star_sensor"], scenario["star_sensor"]["image"]
     fov = float(units.deg_to_rad(sensor["fov_deg"]))
-    camera = Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
-    if image["camera_file"] is not None:  # a calibrated camera (startrack solve --write-camera)
-        camera = dataclasses.replace(Camera.from_file(image["camera_file"]), circular_fov=image["field"] == "circular")
-    model = SensorModel(psf_sigma_px=image["psf_sigma_px"], exposure_s=image["exposure_s"],
-                        zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"])
     params = NavigationCatalogParams(mag_limit=sensor["mag_limit"], fov=fov, n_d=image["catalog_nd"],
                                      max_delta=float(units.deg_to_rad(image["catalog_max_pointing_error_deg"])),
-                                     epoch=epoch)
+                                     epoch=epoch, band=sensor["band"])
     stars = _rendered_stars(star_catalog, image)
     compile_ahead(lanes)  # the scenario checked: the identifier's kernels and the rest of the run's
-    identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera,
+    identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera(sensor),
                                 centroid_sigma_px=image["centroid_sigma_px"], max_stars=image["max_identified_stars"])
-    return ImageStarSensor(camera=camera, model=model, identifier=identifier, stars_I=np.asarray(stars.vectors),
-                           stars_mag=np.asarray(stars.v_mag), stars_hip=np.asarray(stars.hip),
+    return ImageStarSensor(camera=camera(sensor), model=sensor_model(sensor), identifier=identifier,
+                           stars_I=np.asarray(stars.vectors), stars_mag=np.asarray(stars.mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
-                           stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true, faults=faults)
+                           stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true,
+                           faults=faults, photometry=photometry(sensor))
 
 
 def _rendered_stars(star_catalog, image):

@@ -5,7 +5,8 @@ sensor (SINS/CNS).
 Its modules: ``scenario`` (schema and rules), ``build`` (its tables to SI models), ``run`` (prepare,
 simulate), ``summary`` and ``celestial`` (its series and summary), ``records`` (its run and campaign
 summaries), ``campaign`` (what a campaign pools), ``console`` (what the command line prints),
-``budget`` (the error budget's sources and parts), ``covariance`` (its linear covariance analysis), ``report``, ``figures`` and ``report_statistics``
+``budget`` (the error budget's sources and parts), ``covariance`` (its linear covariance analysis), ``exclusion``,
+``sky_background`` and ``availability`` (what the sky lets the star sensor see), ``report``, ``figures`` and ``report_statistics``
 (its PDF sections), ``warmup`` (its compile-ahead task). The names below are the run-kind interface of
 :mod:`navsim.kinds`, each loaded on first use.
 """
@@ -25,4 +26,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.navigation.campaign": ("pool",),
     "navsim.navigation.console": ("run_lines", "campaign_lines"),
     "navsim.navigation.report": ("run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES"),
+    "navsim.navigation.availability": ("star_availability",),
 })

@@ -49,23 +49,42 @@ def summary(scenario, series, sky, orientation, q_BS_true, geometry):
     return {"star_sensor": {"fidelity": sensor["fidelity"], "measurement": sensor["measurement"],
                             "rate_hz": sensor["rate_hz"], "aberration_correction": sensor["aberration_correction"],
                             "frames_with_stars": int(np.count_nonzero(series["n_measurements"]))},
-            "sky": sky_summary(geometry),
+            "sky": sky_summary(geometry, series, sensor),
             "horizon_floor": horizon_floor(series, steady),
             "aberration": aberration(series, sky, orientation, q_BS_true, sensor["aberration_correction"], steady),
             "observability": observability(series)}
 
 
-def sky_summary(geometry):
+def sky_summary(geometry, series, sensor):
     """The Sun, the Moon and the horizon over the frames: the least angles of the Sun and the Moon from the
     boresight, the boresight's lowest elevation [deg], the frames with the Sun above the horizon, the Moon's mean
-    illuminated fraction and the frames each exclusion took (:mod:`navsim.navigation.exclusion`)."""
+    illuminated fraction and the frames each exclusion took (:mod:`navsim.navigation.exclusion`); the hours with
+    stars measured and the stars per frame; with a light budget the band and the range of the sky's brightness
+    [mag arcsec⁻²] and of the limiting magnitude at the boresight (:mod:`navsim.navigation.sky_background`)."""
     degrees = np.degrees
-    return {"sun_angle_min_deg": float(degrees(geometry.sun_angle.min())),
-            "moon_angle_min_deg": float(degrees(geometry.moon_angle.min())),
-            "boresight_elevation_min_deg": float(degrees(geometry.boresight_elevation.min())),
-            "frames_sun_up": int(np.count_nonzero(geometry.sun_elevation > 0.0)),
-            "moon_illuminated_mean": float(np.mean(geometry.moon_illuminated)),
-            "frames_excluded": geometry.counts()}
+    stars = series["n_measurements"]
+    out = {"sun_angle_min_deg": float(degrees(geometry.sun_angle.min())),
+           "moon_angle_min_deg": float(degrees(geometry.moon_angle.min())),
+           "boresight_elevation_min_deg": float(degrees(geometry.boresight_elevation.min())),
+           "frames_sun_up": int(np.count_nonzero(geometry.sun_elevation > 0.0)),
+           "moon_illuminated_mean": float(np.mean(geometry.moon_illuminated)),
+           "frames_excluded": geometry.counts(),
+           "hours_with_stars": float(np.count_nonzero(stars) / sensor["rate_hz"] / units.HOUR),
+           "stars_per_frame": {"mean": float(np.mean(stars)), "median": float(np.median(stars)),
+                               "max": int(np.max(stars, initial=0))}}
+    if "limiting_mag" in series:
+        out["band"] = sensor["band"]
+        out["sky_background_mag"] = _range(series["sky_background_mag"])
+        out["limiting_mag"] = _range(series["limiting_mag"])
+    return out
+
+
+def _range(values):
+    """{min, median, max} of the finite ``values`` (None: none finite)."""
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return {"min": None, "median": None, "max": None}
+    return {"min": float(finite.min()), "median": float(np.median(finite)), "max": float(finite.max())}
 
 
 def floor_ned(series, bias=None):

@@ -37,7 +37,7 @@ from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
-from navsim.navigation import build, exclusion
+from navsim.navigation import build, exclusion, sky_background
 from navsim.navigation.budget import SOURCES as BUDGET_SOURCES
 from navsim.navigation.run import fixed_initial_error
 from navsim.navigation.scenario import frame_rate
@@ -244,25 +244,26 @@ def measurements(scenario, nom, filt, star_catalog, src):
         catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
         sensor, note = vector_equivalent(scenario, catalog, 1.0 / scenario["star_sensor"]["rate_hz"], build.catalog_epoch(scenario))
         geometry = exclusion.geometry(scenario, nom.trajectory, nom.orientation, nom.frame_k, sensor.q_BS_true)
-        available = exclusion.excluding(sensor, geometry, nom.frame_k * dt).faults.available(nom.frame_k * dt)
+        sensor = sky_background.seeing(exclusion.excluding(sensor, geometry, nom.frame_k * dt), scenario, geometry,
+                                       nom.trajectory, nom.frame_k)
+        available = sensor.faults.available(nom.frame_k * dt)
         correct = scenario["star_sensor"]["aberration_correction"]
         if isinstance(sensor, AttitudeFixSensor):
             fix_R = sensor.R_S
-            quiet = dataclasses.replace(sensor, sigma_cross=0.0, sigma_roll=0.0)
-            fix_q = quiet.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I)
+            fix_q = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False)
             if correct:
                 boresight = rot.rotate(fix_q, np.array([0.0, 0.0, 1.0]))
                 fix_q = rot.multiply(fix_rotation(boresight, nom.sky.v_I), fix_q)
             fix_mask = available
         else:
-            stars = dataclasses.replace(sensor, sigma=0.0).observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I)
+            stars = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False)
             frame = np.repeat(np.arange(F), np.diff(stars.offsets))
             keep = available[frame]
             frame, ref, obs = frame[keep], stars.ref_I[keep], stars.obs_S[keep]
             offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=F))])
             if correct:
                 ref = aberrate(ref, nom.sky.v_I[frame])
-            cov = isotropic_covariance(obs, sensor.sigma)
+            cov = isotropic_covariance(obs, stars.sigma[keep])
     position, baro = build.position_sensor(scenario, 1.0 / (nom.ratio * dt)), build.baro(scenario)
     position_mask, position_sigma = np.zeros(F, np.bool_), np.zeros(3)
     if position is not None:

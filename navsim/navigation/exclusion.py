@@ -27,15 +27,18 @@ REASONS = ("Sun in the exclusion cone", "Moon in the exclusion cone", "boresight
 @dataclass(frozen=True)
 class SkyGeometry:
     """Per frame: the angles [rad] of the Sun and the Moon from the boresight, the boresight's elevation,
-    the Sun's and the Moon's elevations [rad], the Moon's illuminated fraction, and the reason each frame is
-    excluded (an index of :data:`REASONS`, −1: not excluded)."""
+    the Sun's and the Moon's elevations [rad], the Moon's phase angle [rad] and illuminated fraction, the
+    local vertical (F, 3) in ICRS axes, and the reason each frame is excluded (an index of :data:`REASONS`,
+    −1: not excluded)."""
 
     sun_angle: np.ndarray
     moon_angle: np.ndarray
     boresight_elevation: np.ndarray
     sun_elevation: np.ndarray
     moon_elevation: np.ndarray
+    moon_phase_angle: np.ndarray
     moon_illuminated: np.ndarray
+    up_I: np.ndarray
     reason: np.ndarray
 
     def counts(self):
@@ -60,7 +63,8 @@ def geometry(scenario, path, orientation, frame_k, q_BS_true):
         reason[excluded[k]] = k
     return SkyGeometry(sun_angle=sun, moon_angle=moon, boresight_elevation=elevation,
                        sun_elevation=bodies.elevation(bodies.sun_I), moon_elevation=bodies.elevation(bodies.moon_I),
-                       moon_illuminated=bodies.moon_illuminated, reason=reason)
+                       moon_phase_angle=bodies.moon_phase_angle, moon_illuminated=bodies.moon_illuminated,
+                       up_I=bodies.up_I, reason=reason)
 
 
 def excluding(star_sensor, sky, t_frames):

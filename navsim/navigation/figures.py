@@ -239,3 +239,21 @@ def sky(run):
     ax.set(xlabel="time [min]", ylabel="angle [deg]", ylim=(-90.0, 180.0))
     ax.legend(loc="upper right", ncols=3)
     return fig
+
+
+def sky_stars(run):
+    """Stars measured per frame, and the sky's brightness at the boresight with the limiting magnitude there, against
+    time [h] (a sensor with a light budget)."""
+    s = run.series
+    hours = s["t"] / 3600.0
+    fig, axes = new_figure(4.0, 2, 1)
+    axes[0, 0].plot(hours, s["n_measurements"], color="k", lw=0.6)
+    axes[0, 0].set(ylabel="stars per frame")
+    ax = axes[1, 0]
+    ax.plot(hours, s["sky_background_mag"], color="tab:blue", lw=0.9, label="sky [mag/arcsec²]")
+    limit = np.where(np.isfinite(s["limiting_mag"]), s["limiting_mag"], np.nan)
+    ax.plot(hours, limit, color="tab:red", lw=0.9, label="limiting magnitude")
+    ax.invert_yaxis()
+    ax.set(xlabel="time [h]", ylabel="magnitude")
+    ax.legend(loc="lower right")
+    return fig

@@ -172,6 +172,21 @@ def _sky_section(doc, run, sky):
         f"{sky['frames_sun_up']} frames. Frames excluded: {excluded}."))
     doc.figure(nav_figures.sky(run), "The Sun's and the Moon's angles from the boresight and the elevations of the "
                                      "boresight and the Sun, deg; the exclusion angles dashed, excluded frames shaded.")
+    if "hours_with_stars" in sky:
+        per_frame = sky["stars_per_frame"]
+        text = (f"Stars were measured for {number(sky['hours_with_stars'])} h, {number(per_frame['mean'])} per frame on "
+                f"average (at most {per_frame['max']}).")
+        if "limiting_mag" in sky:
+            limit, background = sky["limiting_mag"], sky["sky_background_mag"]
+            text += (f" The sky decides what the sensor sees (its light budget in the {sky['band']} band): at the boresight "
+                     f"the sky is {number(background['min'])} to {number(background['max'])} mag/arcsec² and the limiting "
+                     f"magnitude {number(limit['min'])} to {number(limit['max'])} (median {number(limit['median'])}) when "
+                     "the sky leaves the detector any room.")
+        doc.paragraph(markup(text))
+    if "limiting_mag" in run.series:
+        doc.figure(nav_figures.sky_stars(run), "Stars measured per frame (top); the sky's brightness at the boresight "
+                                               "[mag/arcsec²] and the limiting magnitude there (bottom; none while the "
+                                               "sky fills the detector's well).")
 
 
 def _horizon_rows(floor):

@@ -36,7 +36,7 @@ from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
 from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter
-from navsim.navigation import build, celestial, exclusion
+from navsim.navigation import build, celestial, exclusion, sky_background
 from navsim.navigation.scenario import frame_rate
 from navsim.navigation.summary import navigation_series, summarize
 from navsim.records import RunResult
@@ -44,7 +44,6 @@ from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.aiding import AidingRun, draw_record
 from navsim.sensors.celestial_aiding import CelestialAidingRun
 from navsim.sensors.faults import apply_bias_steps
-from navsim.sensors.star_vector import AttitudeFixSensor, VectorRun
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
@@ -149,7 +148,8 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
             star_sensor = dataclasses.replace(star_sensor, q_BS_true=mounting(scenario["star_sensor"])[0])
         orientation = EarthOrientation.compute(scenario["epoch_utc"], grid.frame_k * grid.dt)
         sky_geometry = exclusion.geometry(scenario, kinematics, orientation, grid.frame_k, star_sensor.q_BS_true)
-        star_sensor = exclusion.excluding(star_sensor, sky_geometry, grid.frame_k * grid.dt)
+        star_sensor = sky_background.seeing(exclusion.excluding(star_sensor, sky_geometry, grid.frame_k * grid.dt),
+                                            scenario, sky_geometry, kinematics, grid.frame_k)
     return Prepared(scenario=scenario, truth=truth, grid=grid, gyro=gyro, accel=accel, baro=baro,
                               baro_every=0 if baro is None else int(round(frame_hz / baro.rate_hz)),
                               position_sensor=build.position_sensor(scenario, frame_hz), disturbance=disturbance,
@@ -195,6 +195,8 @@ def simulate(prepared, seed, compiled=True):
         series["mounting_estimate"] = rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
                                                                           series["q_bs"]))
         series.update(exclusion.series(p.sky_geometry))
+        if getattr(p.star_sensor, "sky", None) is not None:
+            series.update(p.star_sensor.sky.series())
     summary = summarize(scenario, seed, series, grid)
     if p.star_sensor is not None:
         summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true,
@@ -233,18 +235,11 @@ def _aiding_record(prepared, truth, position_ss, baro_ss):
 def _star_run(prepared, sky, seed, filt):
     """(the star sensor's run, the observers' runs, its attitude jumps or None) for the sky truth ``sky``:
     at vector fidelity every frame drawn from ``seed`` (without noise when ``truth_off`` has "star_noise":
-    the record keeps the sensor's σ, the filter's R); at image fidelity :func:`navsim.star_run.start_image`."""
+    the record keeps the stars' σ, the filter's R); at image fidelity :func:`navsim.star_run.start_image`."""
     sensor, grid = prepared.star_sensor, prepared.grid
     if prepared.scenario["star_sensor"]["fidelity"] == "image":
         return star_run.start_image(sensor, seed, grid.n_frames, filt, prepared.observers, prepared.attitude_jumps)
-    if "star_noise" not in prepared.truth_off:
-        return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I), [], None
-    if isinstance(sensor, AttitudeFixSensor):
-        quiet, kept = dataclasses.replace(sensor, sigma_cross=0.0, sigma_roll=0.0), {"R_S": sensor.R_S}
-    else:
-        quiet, kept = dataclasses.replace(sensor, sigma=0.0), {"sigma": sensor.sigma}
-    record = quiet.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I).record()
-    return VectorRun(dataclasses.replace(record, **kept)), [], None
+    return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I, noise="star_noise" not in prepared.truth_off), [], None
 
 
 def _start(truth, P0, seed, zero=False, fixed=None):

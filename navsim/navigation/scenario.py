@@ -14,12 +14,12 @@ import dataclasses
 
 import numpy as np
 
-from navsim.earth.frames import utc_epoch
+from navsim.earth.frames import julian_year, utc_epoch
 from navsim.estimation.treatments import TREATMENTS
 from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
-from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor, mounting
+from navsim.scenario.star_sensor_fields import FAULTS, PHOTOMETRY, STAR_SENSOR, check_faults, check_star_sensor, mounting
 from navsim.truth import segments, trajectory
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -141,6 +141,7 @@ SCHEMA = Table(
                                         doc="no frame while the Moon is within this angle of the boresight (0: none)"),
             "min_elevation_deg": Value("float", default=-90.0, minimum=-90.0, maximum=90.0,
                                        doc="no frame while the boresight is lower above the local horizon (-90: none)"),
+            "photometry": PHOTOMETRY,
         }, optional=True, doc="a star sensor aiding the INS (SINS/CNS) at its rate, vector or image fidelity"),
         "faults": Table(dict(FAULTS), doc="outages, dropped frames, false-star storms and attitude jumps of the star "
                                           "sensor; gyro bias steps"),
@@ -202,6 +203,10 @@ SCHEMA = Table(
 )
 
 
+#: The years [Julian year] the star sensor's ephemerides serve (erfa.epv00: 1900-2100).
+EPHEMERIS_YEARS = (1900, 2100)
+
+
 def validate(data, source):
     """The checked dictionary of a navigation scenario: :data:`SCHEMA` and the cross-key rules (derived
     defaults filled: ``duration_s``, ``settle_s``); one InputError naming the key otherwise."""
@@ -226,6 +231,7 @@ def validate(data, source):
                              f"vertical channel diverges, e-folding time 570 s; at most {MAX_FREE_VERTICAL_S:g} s without)")
     _check_gravity(checked.get("gravity"), source)
     _check_star_sensor(checked, source)
+    _check_ephemeris(checked, source)
     _check_baro_states(checked, source)
     if checked["settle_s"] is None:
         checked["settle_s"] = 0.1 * checked["duration_s"]
@@ -329,6 +335,18 @@ def _check_star_sensor(checked, source):
     if highest < 0.0:
         raise InputError(f"{source}: star_sensor.mounting_rotvec_deg: the boresight points below the horizon for the whole "
                          f"flight (highest elevation {np.degrees(highest):.1f} deg): the star sensor would see the ground")
+
+
+def _check_ephemeris(checked, source):
+    """A star sensor's sky (the Sun, the Moon, the Earth's motion: erfa.epv00, moon98) is computed from 1900 to 2100
+    only: the run must lie in it."""
+    if "star_sensor" not in checked:
+        return
+    first = julian_year(checked["epoch_utc"])
+    last = first + checked["duration_s"] / (365.25 * 86400.0)
+    if not (EPHEMERIS_YEARS[0] <= first and last < EPHEMERIS_YEARS[1]):
+        raise InputError(f"{source}: epoch_utc: {checked['epoch_utc']} (to {last:.2f}) is outside the ephemeris' validity "
+                         f"({EPHEMERIS_YEARS[0]}-{EPHEMERIS_YEARS[1]}: the Sun and the Earth's motion of erfa.epv00)")
 
 
 def _covered_until(outages):

@@ -5,6 +5,8 @@ from navsim.scenario.inertial_fields import MAX_ARCSEC, MAX_BIAS
 from navsim.scenario.schema import ListOfTables, Table, Value
 from startrack import rotation as rot
 from startrack import units
+from startrack.bands import BANDS
+from startrack.detectors import DETECTORS
 from startrack.errors import InputError
 
 #: The star sensor's keys: fidelity, measurement, rate, field, noise, mounting and the image table.
@@ -16,7 +18,10 @@ STAR_SENSOR = {
     "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e3),
     "fov_deg": Value("float", exclusive_minimum=0.0, maximum=120.0,
                      doc="full cone angle of the circular field"),
-    "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0),
+    "band": Value("str", default="V", choices=tuple(BANDS),
+                  doc="the sensor's photometric band: every magnitude key and the catalog's stars are in it"),
+    "mag_limit": Value("float", default=6.0, minimum=-2.0, maximum=12.0,
+                       doc="the catalog's depth in the band (with a light budget: the faintest star it may report)"),
     "max_stars": Value("int", default=10, minimum=1, maximum=1000),
     "star_sigma_arcsec": Value("float", default=5.0, exclusive_minimum=0.0, maximum=MAX_ARCSEC,
                                doc="1σ direction error per star and tangent axis"),
@@ -34,8 +39,11 @@ STAR_SENSOR = {
                            doc="circular: the circle of diameter fov_deg inscribed in the width"),
             "psf_sigma_px": Value("float", default=0.671, exclusive_minimum=0.0, maximum=10.0),
             "exposure_s": Value("float", default=0.1, exclusive_minimum=0.0, maximum=10.0),
-            "zero_point_e_per_s": Value("float", default=5.0e6, exclusive_minimum=0.0, maximum=1e15),
-            "read_noise_e": Value("float", default=20.0, minimum=0.0, maximum=1e6),
+            "zero_point_e_per_s": Value("float", default=None, exclusive_minimum=0.0, maximum=1e15,
+                                        doc="photoelectrons per second of a magnitude-0 star (default 5e6; with "
+                                            "star_sensor.photometry: its aperture, optics and detector's)"),
+            "read_noise_e": Value("float", default=None, minimum=0.0, maximum=1e6,
+                                  doc="default 20 e-; with star_sensor.photometry: its detector's"),
             "render_mag_limit": Value("float", default=7.0, minimum=-2.0, maximum=12.0,
                                       doc="faintest star drawn into the frames"),
             "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
@@ -68,6 +76,31 @@ STAR_SENSOR = {
         optional=True,
     ),
 }
+
+#: The light budget of a star sensor that sees a real sky (a navigation run): with it the sky's brightness in the
+#: band, the extinction along each star's line of sight and the detector decide which stars a frame shows and
+#: how well each is placed (navsim.sensors.frame_sky); its exposure, PSF, detection threshold and pixel scale
+#: are the image table's.
+PHOTOMETRY = Table(
+    {
+        "aperture_mm": Value("float", exclusive_minimum=0.0, maximum=2000.0, doc="the entrance pupil's diameter"),
+        "transmission": Value("float", default=0.8, exclusive_minimum=0.0, maximum=1.0,
+                              doc="of the optics and filter in the band"),
+        "detector": Value("str", default="silicon_cmos", choices=tuple(DETECTORS),
+                          doc="the detector preset (startrack.detectors); the keys below override its values"),
+        "qe": Value("float", default=None, exclusive_minimum=0.0, maximum=1.0,
+                    doc="quantum efficiency in the band (default: the preset's at the band's centre)"),
+        "read_noise_e": Value("float", default=None, minimum=0.0, maximum=1e5),
+        "dark_e_per_px_s": Value("float", default=None, minimum=0.0, maximum=1e9),
+        "full_well_e": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
+        "relative_humidity_percent": Value("float", default=40.0, minimum=1.0, maximum=95.0,
+                                           doc="of the ground air: its aerosols and water vapour (Schaefer 1998)"),
+        "ground_temperature_c": Value("float", default=15.0, minimum=-60.0, maximum=50.0),
+    },
+    optional=True,
+    doc="the sensor's light budget: with it the sky decides which stars each frame shows (night, Moon, twilight, "
+        "day) and each star's σ follows its SNR",
+)
 
 #: The faults both kinds of run take: outages, attitude jumps, false-star storms, gyro bias steps and
 #: dropped frames; and the tracking-failure probes of 000 §5 (a per-frame observer, :mod:`navsim.studies`).
@@ -107,15 +140,32 @@ def mounting(sensor):
     return q_BS, q_BS_true
 
 
+#: The image table's detector values without a light budget.
+LEGACY_DETECTOR = {"zero_point_e_per_s": 5.0e6, "read_noise_e": 20.0}
+
+
 def check_star_sensor(sensor, source):
     """Cross-key rules of a checked ``star_sensor`` table: image fidelity measures stars, gets its
-    image table's defaults when absent and reads its camera file now."""
-    if sensor["fidelity"] == "image":
+    image table's defaults when absent and reads its camera file now; a light budget (``photometry``)
+    measures stars, takes the image table's camera at either fidelity and sets its detector's values
+    (which the image table then must not give)."""
+    photometry = sensor.get("photometry")
+    if sensor["fidelity"] == "image" or photometry is not None:
         if sensor["measurement"] != "stars":
-            raise InputError(f"{source}: star_sensor.measurement: image fidelity measures stars, not {sensor['measurement']!r}")
+            what = "image fidelity" if photometry is None else "a sensor with a light budget (star_sensor.photometry)"
+            raise InputError(f"{source}: star_sensor.measurement: {what} measures stars, not {sensor['measurement']!r}")
         if "image" not in sensor:
             sensor["image"] = STAR_SENSOR["image"].check("star_sensor.image", {})
         _apply_camera_file(sensor["image"], source)
+    image = sensor.get("image")
+    if image is None:
+        return
+    for key, legacy in LEGACY_DETECTOR.items():
+        if photometry is not None and image[key] is not None:
+            raise InputError(f"{source}: star_sensor.image.{key}: set by star_sensor.photometry (aperture, optics and "
+                             "detector); leave it out")
+        if image[key] is None and photometry is None:
+            image[key] = legacy
 
 
 def check_faults(faults, fidelity, source):

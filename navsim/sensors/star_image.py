@@ -25,9 +25,12 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    identification's attitude for a re-initialisation when it came from the sub-catalog or full sky.
 
 Faults acting on the sensor (outages, dropped frames, false-star storms) are applied here; the
-tracking state follows the filter's verdict (:meth:`ImageRun.after_update`).
+tracking state follows the filter's verdict (:meth:`ImageRun.after_update`). A sensor with a light budget
+sees each frame's sky (:class:`navsim.sensors.frame_sky.FrameSky`): its level in every pixel, with its shot
+noise, and each star extinguished along its own line of sight (none through the ground).
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,9 +67,9 @@ class ImageStarSensor:
     camera and detector model, the identifier over the navigation catalog, the stars drawn into the
     frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n,
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
-    tracked (004's set-up), the true mounting and the faults. Each fused star's direction and its
-    covariance come from its position fit (:mod:`startrack.psf_fit`); the drawn stars are also the catalog
-    the fit's neighbours come from."""
+    tracked (004's set-up), the true mounting and the faults; with a light budget (``photometry``) the frames'
+    sky (``sky``). Each fused star's direction and its covariance come from its position fit
+    (:mod:`startrack.psf_fit`); the drawn stars are also the catalog the fit's neighbours come from."""
 
     camera: object
     model: object
@@ -80,6 +83,8 @@ class ImageStarSensor:
     start_tracking: bool
     q_BS_true: np.ndarray
     faults: object
+    photometry: object = None
+    sky: object = None
 
     @property
     def catalog(self):
@@ -92,15 +97,25 @@ class ImageStarSensor:
         c = self.camera
         return float(np.arctan(0.5 * np.hypot(c.width, c.height) / c.focal_px) + np.radians(1.0))
 
-    def sky(self, q_IS_true, v_I):
-        """(directions (N, 3), V magnitudes (N,)) of the stars drawn into a frame of true attitude
+    def drawn_stars(self, q_IS_true, v_I, frame):
+        """(directions (N, 3), magnitudes (N,)) of the stars drawn into frame ``frame`` of true attitude
         q_IS_true: the catalog's, or near the boresight their apparent directions for the observer
-        velocity ``v_I`` [m/s] (None: no aberration)."""
+        velocity ``v_I`` [m/s] (None: no aberration); seen through the frame's air when it has a sky."""
         if v_I is None:
-            return self.stars_I, self.stars_mag
-        index, apparent = field_stars(self.stars_I, rot.rotate(q_IS_true, np.array([0.0, 0.0, 1.0])),
-                                      self.field_radius, v_I)
-        return apparent, self.stars_mag[index]
+            directions, mags = self.stars_I, self.stars_mag
+        else:
+            index, directions = field_stars(self.stars_I, rot.rotate(q_IS_true, np.array([0.0, 0.0, 1.0])),
+                                            self.field_radius, v_I)
+            mags = self.stars_mag[index]
+        if self.sky is None:
+            return directions, mags
+        return directions, self.sky.extinguished(np.full(len(mags), frame), mags, directions)
+
+    def frame_model(self, frame):
+        """The detector model of frame ``frame``: with a sky, its level in every pixel."""
+        if self.sky is None:
+            return self.model
+        return dataclasses.replace(self.model, sky_e_per_px_s=float(self.sky.sky_e_per_px_s[frame]))
 
     def start(self, storm_rng, render_rng, n_frames, full_frames=frozenset()):
         """A run's sensor; ``full_frames``: frame indices read in full whatever the mode (observers')."""
@@ -161,7 +176,8 @@ class ImageRun:
                        "centroids_004": {"obs_S": s.camera.unproject(found.uv[centroided]),
                                          "sigma": np.hypot(found.sigma_u[centroided], found.sigma_v[centroided])
                                          / np.sqrt(2.0) / s.camera.focal_px}}
-        stacked = self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I)) if self._stacks(predicted) else None
+        stacked = (self._stack(image, windows, found, uv_pred, predicted, full, len(ref_I), request.index)
+                   if self._stacks(predicted) else None)
         if stacked is not None:
             stacked["uv_true"] = s.camera.project(q_IS_true, s.stars_I[stacked["index"]][None])[0][0]
             diagnostics["stacked"] = stacked
@@ -196,13 +212,13 @@ class ImageRun:
     def _read(self, request, q_IS_true, uv_predicted, full):
         """(image, windows or None, detections) of the frame: rendered from the truth, read in full
         or in windows around the predicted stars sized to the smear the predicted rate implies."""
-        s, camera, model = self.sensor, self.sensor.camera, self.sensor.model
+        s, camera, model = self.sensor, self.sensor.camera, self.sensor.frame_model(request.index)
         windows = None
         if not full:
             smear_px = np.hypot(request.omega_S_pred[0], request.omega_S_pred[1]) * model.exposure_s * camera.focal_px
             half = max(s.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
             windows = Windows.around(uv_predicted, half, camera.height, camera.width)
-        stars_I, stars_mag = s.sky(q_IS_true, request.truth.v_I)
+        stars_I, stars_mag = s.drawn_stars(q_IS_true, request.truth.v_I, request.index)
         frame = render_star_field(camera, model, q_IS_true, stars_I, stars_mag, self._render_rng,
                                   omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
                                   extra_sources=self._false_stars(request.t))
@@ -219,7 +235,7 @@ class ImageRun:
         """The PSF fits (:func:`startrack.psf_fit.fit_stars`) of the identified stars' detections ``uv`` (N, 2)
         in the full frame or in the readout window holding each, with the smear the predicted attitude and
         rate give each star over the exposure: positions at the Cramér-Rao bound with their covariance."""
-        s, model = self.sensor, self.sensor.model
+        s, model = self.sensor, self.sensor.frame_model(request.index)
         half_exposure = 0.5 * model.exposure_s
         track = s.camera.angular_velocity_track(request.q_IS_pred, request.omega_S_pred, (-half_exposure, half_exposure),
                                                 ref_I)
@@ -281,7 +297,7 @@ class ImageRun:
     def _stacks(self, predicted):
         return self.sensor.stacking and self._tracking and len(predicted) > 0
 
-    def _stack(self, image, windows, found, uv_pred, predicted, full, n_identified):
+    def _stack(self, image, windows, found, uv_pred, predicted, full, n_identified, frame):
         """004 §3: push the brightest undetected predicted star's window into the 4-frame cache and,
         with fewer than 3 stars identified and a full cache, stack it (eq. 13-18 of 004). Returns the
         stacked star (its catalog and measured vectors, σ, centroid and true position, HIP) or None."""
@@ -294,7 +310,8 @@ class ImageRun:
         self._push(image, windows, uv_pred[candidate], int(candidate), full, predicted)
         if n_identified >= 3 or not self._cache.full:
             return None
-        stacked = self._cache.stack(s.model.background_dn, s.model.noise_dn, a=s.detection_sigmas)
+        model = s.frame_model(frame)
+        stacked = self._cache.stack(model.background_dn, model.noise_dn, a=s.detection_sigmas)
         if not stacked.detected:
             return None
         uv = np.array([[stacked.u_corrected, stacked.v_corrected]])

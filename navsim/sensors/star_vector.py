@@ -38,26 +38,36 @@ def tangent_basis(s):
 
 @dataclass(frozen=True)
 class StarFrames:
-    """Star measurements of many frames, concatenated: frame f owns rows offsets[f]:offsets[f+1]."""
+    """Star measurements of many frames, concatenated: frame f owns rows offsets[f]:offsets[f+1]; each star's
+    direction σ [rad] per tangent axis (the filter's R) in ``sigma``."""
 
     offsets: np.ndarray
     ref_I: np.ndarray
     obs_S: np.ndarray
     ids: np.ndarray
+    sigma: np.ndarray
 
     def frame(self, f):
-        """(ref_I (N, 3), obs_S (N, 3), ids (N,)) of frame f."""
+        """(ref_I (N, 3), obs_S (N, 3), ids (N,), σ (N,)) of frame f."""
         rows = slice(self.offsets[f], self.offsets[f + 1])
-        return self.ref_I[rows], self.obs_S[rows], self.ids[rows]
+        return self.ref_I[rows], self.obs_S[rows], self.ids[rows], self.sigma[rows]
+
+    @property
+    def counts(self):
+        """(F,) the number of stars of each frame."""
+        return np.diff(self.offsets)
 
 
 @dataclass(frozen=True)
 class StarVectorSensor:
     """Stars brighter than the catalog cut inside the cone of half-angle fov/2 around +z_S.
 
-    ``star_vectors`` (M, 3) unit vectors in I, ``star_ids`` (M,), ``star_mags`` (M,);
-    ``fov`` full cone angle [rad]; ``sigma`` 1σ direction error per tangent axis [rad];
-    ``max_stars`` the most (brightest) stars reported; ``q_BS_true`` true mounting.
+    ``star_vectors`` (M, 3) unit vectors in I, ``star_ids`` (M,), ``star_mags`` (M,) in the sensor's band;
+    ``fov`` full cone angle [rad]; ``sigma`` 1σ direction error per tangent axis [rad]; ``max_stars`` the
+    most (brightest) stars reported; ``q_BS_true`` true mounting. With a light budget (``photometry``, a
+    :class:`startrack.sensor_photometry.SensorPhotometry`) and the frames' sky (``sky``, a
+    :class:`navsim.sensors.frame_sky.FrameSky`) a star is reported when the frame's sky lets the sensor detect
+    it, with the σ of its own SNR, instead of every star with ``sigma``.
     """
 
     star_vectors: np.ndarray
@@ -68,45 +78,66 @@ class StarVectorSensor:
     max_stars: int
     q_BS_true: np.ndarray
     faults: object  # navsim.sensors.faults.SensorFaults
+    photometry: object = None
+    sky: object = None
 
-    def start(self, seed, q_IB_frames, t_frames, v_I=None):
+    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True):
         """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames
-        (and observer velocities ``v_I`` (F, 3) [m/s], None: no aberration)."""
-        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I)
-        return VectorRun(Record(available=self.faults.available(t_frames), stars=stars, sigma=self.sigma))
+        (and observer velocities ``v_I`` (F, 3) [m/s], None: no aberration); ``noise`` False measures every
+        star exactly (its σ kept for the filter)."""
+        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I, noise)
+        return VectorRun(Record(available=self.faults.available(t_frames), stars=stars))
 
-    def observe_frames(self, q_IB_true, rng, v_I=None, chunk=512):
+    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True):
         """Noisy star vectors for every true attitude q_IB_true (F, 4) -> :class:`StarFrames`.
 
-        A star is seen when its angle from the boresight is at most fov/2; the ``max_stars``
-        brightest are reported, brightest first; each is measured at its apparent direction for the
-        frame's observer velocity ``v_I`` (F, 3) (None: its catalog direction) with a direction noise
-        isotropic in the plane perpendicular to it.
+        A star is seen when its angle from the boresight is at most fov/2 and, with a light budget, when the
+        frame's sky lets the sensor detect it; the ``max_stars`` brightest (as seen) are reported, brightest
+        first; each is measured at its apparent direction for the frame's observer velocity ``v_I`` (F, 3)
+        (None: its catalog direction) with a direction noise isotropic in the plane perpendicular to it.
         """
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
-        order = np.argsort(self.star_mags, kind="stable")
-        catalog = self.star_vectors[order]
-        boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
-        cos_half = np.cos(0.5 * self.fov)
-        frames, stars = [], []
-        for start in range(0, len(q_IS), chunk):
-            axes = boresight[start : start + chunk]
-            near = _near(catalog, axes, 0.5 * self.fov)
-            inside = axes @ catalog[near].T >= cos_half
-            inside &= np.cumsum(inside, axis=1) <= self.max_stars
-            f, k = np.nonzero(inside)
-            frames.append(f + start)
-            stars.append(near[k])
-        frame = np.concatenate(frames)
-        index = order[np.concatenate(stars)]
+        frame, index = self._in_field(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])))
         ref_I = self.star_vectors[index]
         seen_I = ref_I if v_I is None else aberrate(ref_I, np.asarray(v_I)[frame])
+        sigma = np.full(len(index), self.sigma)
+        mag = self.star_mags[index]
+        if self.sky is not None:
+            detected, sigma, _ = self.sky.measure(frame, mag, seen_I)
+            mag = self.sky.extinguished(frame, mag, seen_I)
+            frame, index, ref_I, seen_I, sigma, mag = (a[detected] for a in (frame, index, ref_I, seen_I, sigma, mag))
+        order = np.lexsort((mag, frame))  # per frame, brightest as seen first
+        keep = order[_rank_in_frame(frame[order]) < self.max_stars]
+        frame, index, ref_I, seen_I, sigma = frame[keep], index[keep], ref_I[keep], seen_I[keep], sigma[keep]
         s_true = rot.rotate(rot.conjugate(q_IS[frame]), seen_I)
-        noise = np.einsum("nij,ni->nj", tangent_basis(s_true), self.sigma * rng.standard_normal((len(index), 2)))
-        obs = s_true + noise
+        draws = rng.standard_normal((len(index), 2)) * (sigma if noise else np.zeros_like(sigma))[:, None]
+        obs = s_true + np.einsum("nij,ni->nj", tangent_basis(s_true), draws)
         obs /= np.linalg.norm(obs, axis=1, keepdims=True)
         offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=len(q_IS)))])
-        return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index])
+        return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index], sigma=sigma)
+
+    def _in_field(self, boresight, chunk=512):
+        """(frame (K,), catalog index (K,)) of every star inside the cone of each boresight (F, 3), frame by
+        frame, brightest in the catalog first."""
+        order = np.argsort(self.star_mags, kind="stable")
+        catalog = self.star_vectors[order]
+        cos_half = np.cos(0.5 * self.fov)
+        frames, stars = [], []
+        for start in range(0, len(boresight), chunk):
+            axes = boresight[start : start + chunk]
+            near = _near(catalog, axes, 0.5 * self.fov)
+            f, k = np.nonzero(axes @ catalog[near].T >= cos_half)
+            frames.append(f + start)
+            stars.append(near[k])
+        return np.concatenate(frames), order[np.concatenate(stars)]
+
+
+def _rank_in_frame(sorted_frames):
+    """Each row's rank (0, 1, ...) among the rows of its frame in ``sorted_frames`` (ascending)."""
+    if not len(sorted_frames):
+        return np.zeros(0, dtype=np.int64)
+    first = np.flatnonzero(np.r_[True, sorted_frames[1:] != sorted_frames[:-1]])
+    return np.arange(len(sorted_frames)) - np.repeat(first, np.diff(np.r_[first, len(sorted_frames)]))
 
 
 #: Margin [rad] of :func:`_near`'s cap over the rounding of its cosines.
@@ -135,44 +166,44 @@ class AttitudeFixSensor:
     q_BS_true: np.ndarray
     faults: object  # navsim.sensors.faults.SensorFaults
 
-    def start(self, seed, q_IB_frames, t_frames, v_I=None):
+    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True):
         """A run's sensor: every frame's fix drawn from ``seed`` for the true attitudes q_IB_frames (and
-        observer velocities ``v_I`` (F, 3) [m/s], None: no aberration)."""
-        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I)
+        observer velocities ``v_I`` (F, 3) [m/s], None: no aberration); ``noise`` False: exact fixes
+        (``R_S`` kept for the filter)."""
+        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I, noise)
         return VectorRun(Record(available=self.faults.available(t_frames), fixes=fixes, R_S=self.R_S))
 
     @property
     def R_S(self):
         return np.diag([self.sigma_cross**2, self.sigma_cross**2, self.sigma_roll**2])
 
-    def observe_frames(self, q_IB_true, rng, v_I=None):
-        """Measured q_IS = q_R⁻¹ ⊗ q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes, for q_IB_true
-        (F, 4): q_R the aberration rotation of the boresight for the observer velocities ``v_I`` (F, 3)
+    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True):
+        """Measured q_IS = q_R⁻¹ ⊗ q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes (0 without ``noise``), for
+        q_IB_true (F, 4): q_R the aberration rotation of the boresight for the observer velocities ``v_I`` (F, 3)
         (:func:`navsim.earth.apparent.fix_rotation`; None: no aberration)."""
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         if v_I is not None:
             q_R = fix_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])), np.asarray(v_I))
             q_IS = rot.multiply(rot.conjugate(q_R), q_IS)
         sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
-        nu = sigma * rng.standard_normal((len(q_IS), 3))
+        nu = sigma * rng.standard_normal((len(q_IS), 3)) * (1.0 if noise else 0.0)
         return rot.multiply(q_IS, rot.from_rotation_vector(nu))
 
 
 @dataclass(frozen=True)
 class Record:
     """Every frame's measurements of a vector-fidelity run: attitude ``fixes`` (F, 4) with ``R_S``,
-    or ``stars`` (:class:`StarFrames`) with their direction σ [rad]; ``available`` (F,) False for
+    or ``stars`` (:class:`StarFrames`, each with its direction σ [rad]); ``available`` (F,) False for
     frames lost to an outage or dropped."""
 
     available: np.ndarray
     fixes: np.ndarray | None = None
     R_S: np.ndarray | None = None
     stars: StarFrames | None = None
-    sigma: float = 0.0
 
     def covariances(self):
-        """The covariance of every star of every frame (M, 3, 3) [rad², S]: isotropic, σ on each tangent axis."""
-        return isotropic_covariance(self.stars.obs_S, self.sigma)
+        """The covariance of every star of every frame (M, 3, 3) [rad², S]: isotropic, its σ on each tangent axis."""
+        return isotropic_covariance(self.stars.obs_S, self.stars.sigma)
 
 
 class VectorRun(RecordedRun):
@@ -185,7 +216,7 @@ class VectorRun(RecordedRun):
             return StarFrame(mode="no_fix")
         if r.fixes is not None:
             return StarFrame(mode="tracking", q_IS=r.fixes[j], R_S=r.R_S)
-        ref_I, obs_S, _ = r.stars.frame(j)
+        ref_I, obs_S, _, sigma = r.stars.frame(j)
         if not len(ref_I):
             return StarFrame(mode="no_fix")
-        return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, cov_S=isotropic_covariance(obs_S, r.sigma))
+        return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, cov_S=isotropic_covariance(obs_S, sigma))

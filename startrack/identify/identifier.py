@@ -170,7 +170,7 @@ class StarIdentifier:
             from startrack.star_catalog import load_star_catalog
 
             field_stars = FieldStars.from_star_catalog(
-                catalog, camera, load_star_catalog(catalog.params.epoch),
+                catalog, camera, load_star_catalog(catalog.params.epoch).in_band(catalog.params.band),
                 catalog.params.mag_limit if field_mag_limit is None else _positive("field_mag_limit", field_mag_limit, 20.0))
         self.field = field_stars
         window_px = _positive("tracking_window_px", tracking_window_px, 1e4)

@@ -301,16 +301,16 @@ class FieldStars:
 
     @classmethod
     def from_star_catalog(cls, catalog, camera, stars, mag_limit: float, resolution_px: float = 3.0):
-        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) with V <= mag_limit.
+        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) to ``mag_limit`` in its band.
 
         Stars closer than ``resolution_px`` [px] to another such star are left out: their images merge
         into one centroid that matches neither, and a match to either would be a guess.
         """
-        keep = np.flatnonzero(stars.v_mag <= mag_limit)
+        keep = np.flatnonzero(stars.mag <= mag_limit)
         vectors = stars.vectors[keep]
         close = cKDTree(vectors).query_pairs(float(chord(resolution_px / camera.focal_px)), output_type="ndarray")
         keep = np.delete(keep, np.unique(close))
-        return cls(catalog, camera, stars.vectors[keep], stars.hip[keep], stars.v_mag[keep])
+        return cls(catalog, camera, stars.vectors[keep], stars.hip[keep], stars.mag[keep])
 
     def __len__(self):
         return int(self.hip.size)

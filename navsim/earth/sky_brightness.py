@@ -1,0 +1,205 @@
+"""The brightness of the sky in a band [mag arcsec⁻², Vega] for an observer anywhere in the atmosphere: the
+night sky, the Moon's scattered light, twilight and daylight.
+
+The model is Schaefer's (1993 §4; the program VISLIMIT.BAS of Schaefer 1998, lines 2130-2420) with the
+moonlight of Krisciunas & Schaefer (1991, "KS91"), both empirical fits at ground sites, carried to other
+bands and to the observer's height through the extinction components of :mod:`navsim.earth.atmosphere`:
+
+- **night** (airglow, zodiacal light, starlight): the band's dark zenith brightness above the atmosphere
+  μ0 at mean solar activity, brighter by (1 + 0.3 cos(2π (year − 1992)/11)) with the solar cycle, by the
+  van Rhijn factor 0.4 + 0.6 (1 − 0.96 sin²Z)^(−1/2) towards the horizon (60 % airglow in a thin shell),
+  extinguished along the line of sight (Schaefer 1998 lines 2140-2160). μ0(V) = 21.45 is Schaefer's
+  B0 = 1e-13 (his unit: 1.11e-15 per nL); R and I take the night sky's V − R = 0.74 and V − I = 1.90
+  measured at Paranal (Patat 2003, quoted in Patat et al. 2006 Fig. 8).
+- **moonlight** (KS91 eq. 15-21): B = f(ρ) I* 10^(−0.4 k X_m) [1 − 10^(−0.4 k X)] [nL] with
+  f(ρ) = 10^5.36 (1.06 + cos²ρ) + 10^(6.15 − ρ/40) (ρ in degrees; 6.2e7 ρ⁻² instead of the second term
+  below 10°), I* = 10^(−0.4 (m + 16.57)) the Moon's illuminance of magnitude m = −12.73 + 0.026 |α| +
+  4e-9 α⁴ (α the phase angle in degrees, eq. 9), X = (1 − 0.96 sin²Z)^(−1/2) (eq. 3), and the nL to
+  mag arcsec⁻² conversion of eq. 1, B = 34.08 exp(20.7233 − 0.92104 μ). No light from a Moon below the
+  horizon.
+- **daylight** (Schaefer 1998 lines 2310-2360): the same scattering with the Sun's magnitude and his
+  constant (43.27, 0.36 mag fainter than KS91's), plus a multiply scattered term 440 000 (1 − C) that
+  takes over as the Sun's own transmission C = 10^(−0.4 k X_s) falls.
+- **twilight** (lines 2270-2290): 10^(−0.4 (m_sun + 32.5 − h_s − Z/(360 k))) (100/ρ_s) [1 − 10^(−0.4 k X)]
+  with h_s the Sun's elevation and ρ_s its angle from the line of sight [deg]; the sky takes the lesser of
+  daylight and twilight (line 2380), plus the night sky and the moonlight.
+
+**Other bands and heights.** KS91's f(ρ) was fitted in V at 2800 m on Mauna Kea with k = 0.172; its first
+term is molecular (Rayleigh) scattering, its second the aerosols'. Single scattering is proportional to
+each scatterer's extinction, so the model scales the two terms by the band's and the height's Rayleigh
+k_R and aerosol k_A + k_S against their values at KS91's site (k_R = 0.0785 by eq. 1 of the atmosphere
+module, the rest of 0.172 taken as aerosol), and the path factor [1 − 10^(−0.4 K X)] by k_KS91/K with K
+the band's total extinction at the observer (eq. G):
+
+    f(ρ) → f_R(ρ) k_R/k_R,KS91 + f_M(ρ) (k_A + k_S)/k_M,KS91,   [1 − 10^(−0.4KX)] → [1 − 10^(−0.4KX)] k_KS91/K
+
+which is KS91 itself at KS91's site and band. The multiple-scattering and twilight terms (molecules and the
+stratosphere's aerosols above the boundary layer) scale by (k_R + k_S) against KS91's. So the sky darkens
+with height as the air above the observer thins (the daylight sky at 12 km: a fifth of the sea level's
+molecular scattering and almost none of the boundary layer's aerosol), and with wavelength as λ⁻⁴ and
+λ⁻¹·³. The Sun's and the Moon's band magnitudes take the Sun's colours (the Vega absolute magnitudes of
+FSPS's filter table, Conroy, Gunn & White 2009: V 4.81, R_C 4.41, I_C 4.10, J 3.67, H 3.34) and, for the
+Moon, Schaefer's lunar reddening against the Sun (0.24 mag at 0.70 µm, 0.36 at 0.90 µm: his CM − MS
+colours) interpolated linearly in λ and extrapolated to J (0.56) and H (0.82). The twilight term's
+horizon brightening Z/(360 k) takes the band's k at sea level (the term is a property of the lit layers,
+not of the observer's thinning air, where it would grow without bound).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim.earth.atmosphere import extinction
+from startrack.bands import band as photometric_band
+from startrack.errors import InputError
+
+#: KS91 eq. 1: B [nL] = 34.08 exp(20.7233 − 0.92104 μ), i.e. μ = NL_ZERO − 2.5 log10(B).
+NL_ZERO = 20.7233 / 0.92104 + 2.5 * np.log10(34.08)
+#: KS91 eq. 8: I* = 10^(−0.4 (m + MOON_ILLUMINANCE_ZERO)) foot-candles; their extinction and height.
+MOON_ILLUMINANCE_ZERO = 16.57
+KS91_EXTINCTION = 0.172
+KS91_HEIGHT = 2800.0
+#: Schaefer 1998's daylight (line 2340) and twilight (line 2280) constants [mag].
+DAYLIGHT_ZERO = 43.27
+TWILIGHT_ZERO = 32.5
+#: Distance modulus of 1 au [mag]: m = M + 5 log10(1 au / 10 pc).
+AU_MODULUS = 5.0 * np.log10(1.495978707e11 / 3.0856775814913673e17)
+
+
+@dataclass(frozen=True)
+class SkyBand:
+    """What the sky model needs of a band: its name, the Sun's Vega absolute magnitude in it, the Moon's
+    reddening against the Sun [mag] and the moonless zenith sky above the atmosphere [mag arcsec⁻²]."""
+
+    name: str
+    sun_absolute: float
+    moon_reddening: float
+    night_zenith: float
+
+    @property
+    def sun_mag(self):
+        """The Sun's apparent magnitude in the band at 1 au."""
+        return self.sun_absolute + AU_MODULUS
+
+    def moon_mag(self, phase_angle_deg):
+        """The Moon's magnitude in the band at phase angle α [deg] (KS91 eq. 9 in V, then the colours)."""
+        alpha = np.abs(np.asarray(phase_angle_deg, dtype=float))
+        v = -12.73 + 0.026 * alpha + 4e-9 * alpha**4
+        return v - (SKY_BANDS["V"].sun_absolute - self.sun_absolute) - self.moon_reddening
+
+
+#: Schaefer's night zenith in V, and R, I from Patat's V − R, V − I.
+_NIGHT_V = 21.45
+SKY_BANDS = {
+    "V": SkyBand("V", 4.81, 0.0, _NIGHT_V),
+    "R": SkyBand("R", 4.41, 0.146, _NIGHT_V - 0.74),
+    "I": SkyBand("I", 4.10, 0.299, _NIGHT_V - 1.90),
+    "J": SkyBand("J", 3.67, 0.561, 16.0),
+    "H": SkyBand("H", 3.34, 0.817, 14.0),
+}
+
+
+def sky_band(name):
+    """The :class:`SkyBand` called ``name``; InputError naming the known ones otherwise."""
+    try:
+        return SKY_BANDS[name]
+    except (KeyError, TypeError):
+        raise InputError(f"the sky model has no band {name!r}; choose from {', '.join(SKY_BANDS)}") from None
+
+
+@dataclass(frozen=True)
+class Sightline:
+    """Where the sky is looked at, per frame (arrays broadcast together), angles in radians: the line of sight's
+    zenith distance, the Sun's zenith distance and angle from it, the Moon's zenith distance, angle from it and
+    phase angle; the observer's height [m] and the date as a Julian year (the solar cycle)."""
+
+    zenith: np.ndarray
+    sun_zenith: np.ndarray
+    sun_angle: np.ndarray
+    moon_zenith: np.ndarray
+    moon_angle: np.ndarray
+    moon_phase_angle: np.ndarray
+    height: np.ndarray
+    year: np.ndarray
+
+
+@dataclass(frozen=True)
+class SkyBrightness:
+    """The sky's components and total [mag arcsec⁻²] (inf: none of that light)."""
+
+    night: np.ndarray
+    moon: np.ndarray
+    day: np.ndarray
+    twilight: np.ndarray
+
+    @property
+    def total(self):
+        """The sky: night + the lesser of daylight and twilight + moonlight (Schaefer 1998 line 2380)."""
+        sun = np.maximum(self.day, self.twilight)
+        return _magnitude(_flux(self.night) + _flux(sun) + _flux(self.moon))
+
+
+def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.0, air=None):
+    """The :class:`SkyBrightness` of ``band_name`` (a :class:`startrack.bands.Band`'s name) for the
+    :class:`Sightline` ``geometry``; the ground air's humidity (0-1) and temperature [°C] set its aerosols
+    and water vapour (:func:`navsim.earth.atmosphere.extinction`), or ``air`` gives the observer's
+    :class:`~navsim.earth.atmosphere.Extinction` itself."""
+    g, sky = geometry, sky_band(band_name)
+    band = photometric_band(band_name)
+    site = {"relative_humidity": relative_humidity, "temperature_c": temperature_c}
+    air = extinction(band, g.height, **site) if air is None else air
+    ref = extinction(photometric_band("V"), KS91_HEIGHT, **site)
+    K = air.total
+    ref_rayleigh = float(ref.rayleigh)
+    ref_aerosol = KS91_EXTINCTION - ref_rayleigh
+    ref_upper = ref_rayleigh + float(ref.stratospheric)
+    X = _scattering_airmass(g.zenith)
+    path = (1.0 - 10.0 ** (-0.4 * K * X)) * KS91_EXTINCTION / K
+    upper = (air.rayleigh + air.stratospheric) / ref_upper
+
+    def scattered(angle):
+        rayleigh, mie = _scattering_function(np.degrees(angle))
+        return rayleigh * air.rayleigh / ref_rayleigh + mie * (air.aerosol + air.stratospheric) / ref_aerosol
+
+    moon_up = g.moon_zenith < 0.5 * np.pi
+    t_moon = 10.0 ** (-0.4 * K * _scattering_airmass(np.minimum(g.moon_zenith, 0.5 * np.pi)))
+    moon_nl = scattered(g.moon_angle) * _illuminance(sky.moon_mag(np.degrees(g.moon_phase_angle))) * t_moon * path
+    t_sun = np.where(g.sun_zenith < 0.5 * np.pi, 10.0 ** (-0.4 * K * _scattering_airmass(np.minimum(g.sun_zenith, 0.5 * np.pi))), 0.0)
+    day = sky.sun_mag + DAYLIGHT_ZERO - 2.5 * np.log10(path * (scattered(g.sun_angle) * t_sun + 440000.0 * (1.0 - t_sun) * upper))
+    sun_elevation, rho_s = 90.0 - np.degrees(g.sun_zenith), np.maximum(np.degrees(g.sun_angle), 0.25)
+    k_sea = extinction(band, 0.0, **site).total
+    twilight = (sky.sun_mag + TWILIGHT_ZERO - sun_elevation - np.degrees(g.zenith) / (360.0 * k_sea)
+                - 2.5 * np.log10(100.0 / rho_s * path * upper))
+    cycle = 1.0 + 0.3 * np.cos(2.0 * np.pi * (g.year - 1992.0) / 11.0)
+    van_rhijn = 0.4 + 0.6 / np.sqrt(1.0 - 0.96 * np.sin(g.zenith) ** 2)
+    night = sky.night_zenith - 2.5 * np.log10(cycle * van_rhijn) + air.along(g.zenith)
+    moon = np.where(moon_up, NL_ZERO - 2.5 * np.log10(np.maximum(moon_nl, 1e-300)), np.inf)
+    return SkyBrightness(night=np.asarray(night, dtype=float), moon=np.asarray(moon, dtype=float),
+                         day=np.asarray(day, dtype=float), twilight=np.asarray(twilight, dtype=float))
+
+
+def _scattering_function(rho_deg):
+    """(molecular, aerosol) terms of KS91's f(ρ) (eq. 21) [nL per foot-candle] at ρ [deg]."""
+    rho = np.maximum(np.asarray(rho_deg, dtype=float), 0.25)
+    molecular = 10.0**5.36 * (1.06 + np.cos(np.radians(rho)) ** 2)
+    aerosol = np.where(rho < 10.0, 6.2e7 / rho**2, 10.0 ** (6.15 - rho / 40.0))
+    return molecular, aerosol
+
+
+def _scattering_airmass(zenith):
+    """KS91 eq. 3: X = (1 − 0.96 sin²Z)^(−1/2), the airmass of the scattered light's path."""
+    return 1.0 / np.sqrt(1.0 - 0.96 * np.sin(zenith) ** 2)
+
+
+def _illuminance(mag):
+    """KS91 eq. 8: the illuminance I* [foot-candles] of a body of magnitude ``mag``."""
+    return 10.0 ** (-0.4 * (np.asarray(mag, dtype=float) + MOON_ILLUMINANCE_ZERO))
+
+
+def _flux(mu):
+    return 10.0 ** (-0.4 * np.asarray(mu, dtype=float))
+
+
+def _magnitude(flux):
+    with np.errstate(divide="ignore"):
+        return -2.5 * np.log10(flux)
