@@ -16,15 +16,19 @@ Schaefer (1998, VISLIMIT.BAS lines 1150-1200; Schaefer 1993 §3) with their heig
 
 Schaefer's Rayleigh term falls as e^(−h/8200 m); (1) takes the pressure itself (at 12 km e^(−h/8200)
 overstates the air above by 20 %). His seasonal aerosol factor is left out (no date/latitude climate).
-(3) is the volcanically quiet stratosphere's background aerosol, τ_S = 0.005 at 550 nm spread evenly
-between the tropopause (12 km) and 30 km (s(h) the fraction above h): nothing next to the boundary layer
-on the ground, but what scatters most above it. OZ and WT are Schaefer's UBVRI values (V 0.031 and
+(3) is the volcanically quiet stratosphere's background aerosol, τ_S = 0.005 at 550 nm (SAGE II's 525 nm
+optical depth rose from about 0.004 to 0.008 over 2000-2010: Vernier et al. 2011), spread evenly between the
+tropopause (12 km) and 30 km (s(h) the fraction above h): nothing next to the boundary layer on the ground,
+but what scatters most above it. OZ and WT are Schaefer's UBVRI values (V 0.031 and
 0.031; his Johnson R at 0.70 µm 0.008 and 0.020, I at 0.90 µm 0 and 0.015) interpolated in λ to the
 bands' centres; most of the ozone column lies between 15 and 35 km (o(h) = 1 below 10 km, 0 above
 40 km, linear between); water vapour falls with its own ~2 km scale height (Schaefer's 8.2 km keeps a
 quarter of the sea-level water at 12 km where there is a few thousandths). In J and H the water vapour
-of the band edges dominates: WT(J) = 0.12, WT(H) = 0.06 give 0.19 and 0.09 mag per airmass at sea level
-and 0.06 and 0.03 at Mauna Kea (4.2 km).
+of the band edges dominates; Schaefer gives no values there, and WT(J) = 0.12, WT(H) = 0.06 are this
+module's assumption, for totals of 0.18 and 0.10 mag per airmass at sea level (0.02 and 0.01 at 4.2 km,
+where measured J and H extinctions are several times larger: the band edges' saturated water lines do
+not fall with the column as the linear law has them) -- uncertain by a factor 2, and 0.1 mag or less of a
+star's light at any height but the lowest elevations.
 
 **Airmass** of each component (relative to the zenith, from the observer's height): the Chapman function of
 an exponential layer of scale height H_j seen from radius r = R + h, Ch(r/H, z) ≈ √(πx/2) erfcx(√(x/2) cos z)

@@ -7,6 +7,9 @@ in c axes. Compiled functions of vectors return component tuples (see :mod:`navs
 
 from datetime import datetime, timedelta
 
+import contextlib
+import warnings
+
 import erfa
 import numpy as np
 
@@ -66,7 +69,18 @@ def utc_epoch(text):
     if when.utcoffset() not in (None, timedelta(0)):
         raise InputError(f"epoch_utc: must be UTC (no offset or Z), got {text!r}")
     seconds = when.second + when.microsecond * 1e-6
-    return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
+    with utc_offsets_extrapolated():
+        return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
+
+
+@contextlib.contextmanager
+def utc_offsets_extrapolated():
+    """A context in which erfa's "dubious year" (a UTC before 1960 or years past its leap-second table: it takes the
+    table's nearest UTC − TAI, within seconds) is no warning on the user's terminal: a sky needs the epoch to
+    seconds, and a star sensor's epoch is checked against the ephemerides' span instead."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*dubious year.*", category=erfa.ErfaWarning)
+        yield
 
 
 def _utc(epoch_utc, t):
@@ -78,7 +92,8 @@ def _utc(epoch_utc, t):
 def tt_epoch(epoch_utc, t=0.0):
     """Two-part TT Julian date (tt1, tt2) of ``t`` [s] after the UTC epoch ``epoch_utc`` (TT is TDB
     within 2 ms: what :func:`startrack.aberration.earth_barycentric_velocity` takes)."""
-    return erfa.taitt(*erfa.utctai(*_utc(epoch_utc, t)))
+    with utc_offsets_extrapolated():
+        return erfa.taitt(*erfa.utctai(*_utc(epoch_utc, t)))
 
 
 def julian_year(epoch_utc):
@@ -97,8 +112,9 @@ def c_ei(epoch_utc, t=0.0, dut1=0.0):
     UTC as uniform seconds (a leap second inside the span is not inserted).
     """
     utc1, utc2 = _utc(epoch_utc, t)
-    tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
-    ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
+    with utc_offsets_extrapolated():
+        tt1, tt2 = erfa.taitt(*erfa.utctai(utc1, utc2))
+        ut11, ut12 = erfa.utcut1(utc1, utc2, dut1)
     c2i = slowly(lambda s: erfa.c2i06a(*tt_epoch(epoch_utc, s)), t)
     return erfa.c2tcio(c2i, erfa.era00(ut11, ut12), erfa.pom00(0.0, 0.0, erfa.sp00(tt1, tt2)))
 

@@ -10,7 +10,8 @@ bands and to the observer's height through the extinction components of :mod:`na
   van Rhijn factor 0.4 + 0.6 (1 − 0.96 sin²Z)^(−1/2) towards the horizon (60 % airglow in a thin shell),
   extinguished along the line of sight (Schaefer 1998 lines 2140-2160). μ0(V) = 21.45 is Schaefer's
   B0 = 1e-13 (his unit: 1.11e-15 per nL); R and I take the night sky's V − R = 0.74 and V − I = 1.90
-  measured at Paranal (Patat 2003, quoted in Patat et al. 2006 Fig. 8).
+  measured at Paranal (Patat 2003, quoted in Patat et al. 2006 Fig. 8); J and H (the OH airglow) the
+  median moonless zenith of Calar Alto, J 15.95 and H 13.99 (Sánchez et al. 2008).
 - **moonlight** (KS91 eq. 15-21): B = f(ρ) I* 10^(−0.4 k X_m) [1 − 10^(−0.4 k X)] [nL] with
   f(ρ) = 10^5.36 (1.06 + cos²ρ) + 10^(6.15 − ρ/40) (ρ in degrees; 6.2e7 ρ⁻² instead of the second term
   below 10°), I* = 10^(−0.4 (m + 16.57)) the Moon's illuminance of magnitude m = −12.73 + 0.026 |α| +
@@ -94,8 +95,8 @@ SKY_BANDS = {
     "V": SkyBand("V", 4.81, 0.0, _NIGHT_V),
     "R": SkyBand("R", 4.41, 0.146, _NIGHT_V - 0.74),
     "I": SkyBand("I", 4.10, 0.299, _NIGHT_V - 1.90),
-    "J": SkyBand("J", 3.67, 0.561, 16.0),
-    "H": SkyBand("H", 3.34, 0.817, 14.0),
+    "J": SkyBand("J", 3.67, 0.561, 15.95),
+    "H": SkyBand("H", 3.34, 0.817, 13.99),
 }
 
 

@@ -59,10 +59,10 @@ def sky_summary(geometry, series, sensor):
     """The Sun, the Moon and the horizon over the frames: the least angles of the Sun and the Moon from the
     boresight, the boresight's lowest elevation [deg], the frames with the Sun above the horizon, the Moon's mean
     illuminated fraction and the frames each exclusion took (:mod:`navsim.navigation.exclusion`); the hours with
-    stars measured and the stars per frame; with a light budget the band and the range of the sky's brightness
+    stars measured and the stars per frame (an attitude fix counts as one); with a light budget the band and the range of the sky's brightness
     [mag arcsec⁻²] and of the limiting magnitude at the boresight (:mod:`navsim.navigation.sky_background`)."""
     degrees = np.degrees
-    stars = series["n_measurements"]
+    stars = series["n_stars"]
     out = {"sun_angle_min_deg": float(degrees(geometry.sun_angle.min())),
            "moon_angle_min_deg": float(degrees(geometry.moon_angle.min())),
            "boresight_elevation_min_deg": float(degrees(geometry.boresight_elevation.min())),

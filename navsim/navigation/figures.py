@@ -247,7 +247,7 @@ def sky_stars(run):
     s = run.series
     hours = s["t"] / 3600.0
     fig, axes = new_figure(4.0, 2, 1)
-    axes[0, 0].plot(hours, s["n_measurements"], color="k", lw=0.6)
+    axes[0, 0].plot(hours, s["n_stars"], color="k", lw=0.6)
     axes[0, 0].set(ylabel="stars per frame")
     ax = axes[1, 0]
     ax.plot(hours, s["sky_background_mag"], color="tab:blue", lw=0.9, label="sky [mag/arcsec²]")

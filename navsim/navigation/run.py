@@ -195,6 +195,7 @@ def simulate(prepared, seed, compiled=True):
         series["mounting_estimate"] = rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),
                                                                           series["q_bs"]))
         series.update(exclusion.series(p.sky_geometry))
+        series["n_stars"] = _stars_per_frame(stars, series)
         if getattr(p.star_sensor, "sky", None) is not None:
             series.update(p.star_sensor.sky.series())
     summary = summarize(scenario, seed, series, grid)
@@ -240,6 +241,18 @@ def _star_run(prepared, sky, seed, filt):
     if prepared.scenario["star_sensor"]["fidelity"] == "image":
         return star_run.start_image(sensor, seed, grid.n_frames, filt, prepared.observers, prepared.attitude_jumps)
     return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I, noise="star_noise" not in prepared.truth_off), [], None
+
+
+def _stars_per_frame(stars, series):
+    """(F,) the stars the star sensor measured at each frame: its record's where it drew them before the run (an
+    attitude fix counts as one, as in ``navsim sky``), else the identified and stacked stars of its log (image
+    fidelity)."""
+    record = stars.record()
+    if record is None:
+        return (series["n_identified"] + series["n_stacked"]).astype(np.int32)
+    if record.stars is None:
+        return record.available.astype(np.int32)
+    return np.where(record.available, record.stars.counts, 0).astype(np.int32)
 
 
 def _start(truth, P0, seed, zero=False, fixed=None):
