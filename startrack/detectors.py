@@ -40,6 +40,9 @@ class Detector:
     def with_overrides(self, **values):
         """This detector with the given fields replaced (``qe`` a constant QE over its sampled range)."""
         qe = values.pop("qe", None)
+        unknown = sorted(set(values) - {"read_noise_e", "dark_e_per_px_s", "full_well_e", "pixel_pitch"})
+        if unknown:
+            raise InputError(f"detector {self.name}: unknown value(s) {', '.join(unknown)}")
         detector = replace(self, **{key: float(value) for key, value in values.items()})
         if qe is not None:
             detector = replace(detector, qe_samples=tuple(float(qe) for _ in self.wavelengths))

@@ -7,9 +7,13 @@ of magnitude m (already extinguished by the air) gives N = Z 10^(−0.4 m) t_exp
 :func:`startrack.bands.zero_point`); a sky of rate S [e⁻ s⁻¹ px⁻¹] (:func:`startrack.bands.sky_rate`) leaves
 a pixel without a star the variance v = (S + D) t_exp + σ_r² [e⁻²]. Then, as the image chain does it:
 
-- **detection** (eq. 1 and 4 of 004): the star's brightest pixel N f_peak (:func:`startrack.photometry.peak_fraction`,
-  for its trail of L px) reaches a √v above the background: N f_peak ≥ a √v; none while the sky and dark
-  charge alone fill the well;
+- **detection** (eq. 1 and 4 of 004): a pixel of the star's image reaches a √v above the background. Its
+  brightest pixel holds N f_peak on average (:func:`startrack.photometry.peak_fraction`, for its trail of L px),
+  and a trail offers about n = 2 (1 + L) pixels near that level (two rows of it, L + 1 along): the star is
+  detected half the time when the highest of n such pixels' noises, whose median is z_n = Φ⁻¹(2^(−1/n)) σ, makes
+  up the rest: N f_peak ≥ (a − z_n) √v (:func:`detection_threshold`). Against the image chain on rendered
+  frames the 50 % point lies within 0.15 mag of this for trails of 0-20 px (tested); none while the sky and
+  dark charge alone fill the well;
 - **saturation**: a star whose centred peak N f_0 + (S + D) t_exp exceeds W is placed as well as a star
   just at the well (the fit leaves its saturated pixels out): its N taken as (W − (S + D) t_exp)/f_0;
 - **position**: the Cramér-Rao bound on its centroid (:func:`startrack.psf_fit.centroid_variance`), σ [rad]
@@ -19,6 +23,7 @@ a pixel without a star the variance v = (S + D) t_exp + σ_r² [e⁻²]. Then, a
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import norm
 
 from startrack.bands import Band, sky_rate, zero_point
 from startrack.detectors import Detector
@@ -84,7 +89,8 @@ class SensorPhotometry:
         background = self.background_e(sky_e_per_px_s)
         v = self.pixel_variance(sky_e_per_px_s)
         well = self.detector.full_well_e
-        detected = (n * peak_fraction(self.psf_sigma_px, smear_px) >= self.detection_sigmas * np.sqrt(v)) & (background < well)
+        threshold = detection_threshold(self.detection_sigmas, smear_px)
+        detected = (n * peak_fraction(self.psf_sigma_px, smear_px) >= threshold * np.sqrt(v)) & (background < well)
         top = _centred_peak(self.psf_sigma_px, smear_px)
         saturated = n * top + background > well
         placed = np.where(saturated, np.maximum(well - background, 1.0) / top, n)
@@ -94,9 +100,16 @@ class SensorPhotometry:
     def limiting_magnitude(self, sky_e_per_px_s, smear_px=0.0):
         """The faintest (extinguished) magnitude detected on a sky of ``sky_e_per_px_s`` [mag] (inf: none)."""
         v = self.pixel_variance(sky_e_per_px_s)
-        n = self.detection_sigmas * np.sqrt(v) / peak_fraction(self.psf_sigma_px, smear_px)
+        n = detection_threshold(self.detection_sigmas, smear_px) * np.sqrt(v) / peak_fraction(self.psf_sigma_px, smear_px)
         mag = -2.5 * np.log10(n / (self.zero_point_e_per_s * self.exposure_s))
         return np.where(self.background_e(sky_e_per_px_s) < self.detector.full_well_e, mag, -np.inf)
+
+
+def detection_threshold(a, smear_px):
+    """a − z_n [σ of a pixel]: the mean brightest pixel a star needs to be detected half the time by a threshold of
+    a σ, its trail of ``smear_px`` [px] offering n = 2 (1 + L) pixels near that level (module docstring)."""
+    n = 2.0 * (1.0 + np.abs(np.asarray(smear_px, dtype=float)))
+    return a - norm.ppf(0.5 ** (1.0 / n))
 
 
 def _centred_peak(sigma_px, smear_px):

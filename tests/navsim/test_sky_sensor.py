@@ -71,8 +71,8 @@ def test_the_run_the_covariance_analysis_and_navsim_sky_see_the_same_stars():
 
 def test_a_twilight_shows_fewer_stars_than_the_night():
     """The same sensor (the catalog to V = 8) in the twilight, the Sun 5.5 deg below the horizon, sees fewer than half
-    the stars of the night (measured 34 against 260) and its limiting magnitude is a magnitude brighter (6.2 against
-    8.8); 15 min earlier, the Sun 3 deg down, the sky still fills its pixels."""
+    the stars of the night (measured 37 against 260) and its limiting magnitude is a magnitude brighter (6.3 against
+    8.9); 15 min earlier, the Sun 3 deg down, the sky still fills its pixels."""
     dusk = navigation_run.prepare(scenario("2024-01-15T16:45:00", mag_limit=8.0, max_stars=500))
     night = navigation_run.prepare(scenario(mag_limit=8.0, max_stars=500))
     assert observed(dusk).counts.mean() < 0.5 * observed(night).counts.mean()
