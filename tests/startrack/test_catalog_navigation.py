@@ -206,3 +206,17 @@ def test_sub_catalog_pairs_chunking_does_not_change_the_result(catalog):
     offsets, index = sub_catalog_pairs(catalog.sub_star_offsets, catalog.sub_star_index, catalog.pair_i,
                                        catalog.pair_j, catalog.n_guide, chunk_pairs=20_000)  # fmt: skip
     assert np.array_equal(offsets, catalog.sub_pair_offsets) and np.array_equal(index, catalog.sub_pair_index)
+
+
+def test_a_catalog_in_the_sensors_band_takes_the_stars_brightest_there():
+    """A J-band navigation catalog's candidates are the stars to the limit in J (red giants that V leaves out come
+    in): its guide stars all have J <= the limit, the V and J catalogs differ, and the star catalog's V stays V."""
+    stars = load_star_catalog()
+    in_j = stars.in_band("J")
+    assert in_j.band == "J" and np.array_equal(in_j.v_mag, stars.v_mag) and not np.array_equal(in_j.mag, stars.mag)
+    assert len(in_j.brighter_than(4.0)) > 4 * len(stars.brighter_than(4.0))  # J - V of -1 to -4 for K and M stars
+    j_catalog = build_navigation_catalog(NavigationCatalogParams(mag_limit=4.0, band="J"))
+    v_catalog = build_navigation_catalog(NavigationCatalogParams(mag_limit=4.0))
+    assert j_catalog.guide_v_mag.max() <= 4.0 and not np.array_equal(j_catalog.guide_hip, v_catalog.guide_hip)
+    j_of_guides = in_j.mag[np.searchsorted(in_j.hip, j_catalog.guide_hip)]
+    assert np.allclose(j_of_guides, j_catalog.guide_v_mag)
