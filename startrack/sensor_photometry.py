@@ -28,7 +28,8 @@ from scipy.stats import norm
 from startrack.bands import Band, sky_rate, zero_point
 from startrack.detectors import Detector
 from startrack.errors import InputError
-from startrack.photometry import peak_fraction, pixel_fraction, trail_peak_fraction
+from startrack.photometry import (magnitude_for_electrons, peak_fraction, pixel_fraction, star_electrons,
+                                  trail_peak_fraction)
 from startrack.psf_fit import centroid_variance
 from startrack.units import ARCSEC
 
@@ -66,8 +67,8 @@ class SensorPhotometry:
         return (self.pixel_scale / ARCSEC) ** 2
 
     def star_electrons(self, mag):
-        """N [e⁻] per exposure of stars of (extinguished) magnitude ``mag`` in the band."""
-        return self.zero_point_e_per_s * self.exposure_s * 10.0 ** (-0.4 * np.asarray(mag, dtype=float))
+        """N [e⁻] per exposure of stars of (extinguished) magnitude ``mag`` in the band (Pogson's law)."""
+        return star_electrons(mag, self.zero_point_e_per_s, self.exposure_s)
 
     def sky_e_per_px_s(self, surface_brightness):
         """S [e⁻ s⁻¹ px⁻¹] of a sky of ``surface_brightness`` [mag arcsec⁻²] in the band."""
@@ -101,7 +102,7 @@ class SensorPhotometry:
         """The faintest (extinguished) magnitude detected on a sky of ``sky_e_per_px_s`` [mag] (inf: none)."""
         v = self.pixel_variance(sky_e_per_px_s)
         n = detection_threshold(self.detection_sigmas, smear_px) * np.sqrt(v) / peak_fraction(self.psf_sigma_px, smear_px)
-        mag = -2.5 * np.log10(n / (self.zero_point_e_per_s * self.exposure_s))
+        mag = magnitude_for_electrons(n, self.zero_point_e_per_s, self.exposure_s)
         return np.where(self.background_e(sky_e_per_px_s) < self.detector.full_well_e, mag, -np.inf)
 
 

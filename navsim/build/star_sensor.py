@@ -69,26 +69,28 @@ def camera(sensor):
     return Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
 
 
-def photometry(sensor):
+def photometry(sensor, sensor_camera=None):
     """The :class:`startrack.sensor_photometry.SensorPhotometry` of a ``star_sensor`` table's light budget, or None
-    (no ``photometry`` table): its band, detector (the preset with the table's overrides), aperture and optics, and
-    the image table's exposure, PSF, detection threshold and pixel scale."""
+    (no ``photometry`` table): its band, detector (the preset with the table's overrides), aperture and optics, the
+    image table's exposure, PSF and detection threshold, and the pixel scale of ``sensor_camera`` (default:
+    :func:`camera`)."""
     table = sensor.get("photometry")
     if table is None:
         return None
+    sensor_camera = sensor_camera or camera(sensor)
     overrides = {key: table[key] for key in ("qe", "read_noise_e", "dark_e_per_px_s", "full_well_e") if table[key] is not None}
     image = sensor["image"]
     return SensorPhotometry(band=band(sensor["band"]), detector=detector(table["detector"]).with_overrides(**overrides),
                             aperture_area=np.pi * (0.5e-3 * table["aperture_mm"]) ** 2, transmission=table["transmission"],
                             exposure_s=image["exposure_s"], psf_sigma_px=image["psf_sigma_px"],
-                            pixel_scale=1.0 / camera(sensor).focal_px, detection_sigmas=image["detection_sigmas"])
+                            pixel_scale=1.0 / sensor_camera.focal_px, detection_sigmas=image["detection_sigmas"])
 
 
-def sensor_model(sensor):
+def sensor_model(sensor, budget):
     """The renderer's :class:`startrack.render.SensorModel` of a ``star_sensor`` table's image table: with a light
-    budget its detector's zero point, read noise, dark current and full well (16 bits over the well); otherwise the
-    image table's zero point and read noise."""
-    image, budget = sensor["image"], photometry(sensor)
+    budget (``budget``, :func:`photometry`) its detector's zero point, read noise, dark current and full well (16 bits
+    over the well); otherwise (None) the image table's zero point and read noise."""
+    image = sensor["image"]
     common = {"psf_sigma_px": image["psf_sigma_px"], "exposure_s": image["exposure_s"]}
     if budget is None:
         return SensorModel(zero_point_e_per_s=image["zero_point_e_per_s"], read_noise_e=image["read_noise_e"], **common)
@@ -109,8 +111,9 @@ def vector_equivalent(scenario, star_catalog, frame_interval, epoch):
         return dataclasses.replace(star_sensor(scenario, star_catalog, frame_interval, epoch), q_BS_true=q_BS), None
     image, fov = table["image"], float(units.deg_to_rad(table["fov_deg"]))
     stars = star_catalog.in_band(table["band"]).brighter_than(table["mag_limit"])
-    sigma = image["centroid_sigma_px"] / camera(table).focal_px
-    budget = photometry(table)
+    sensor_camera = camera(table)
+    sigma = image["centroid_sigma_px"] / sensor_camera.focal_px
+    budget = photometry(table, sensor_camera)
     sensor = StarVectorSensor(star_vectors=np.asarray(stars.vectors), star_ids=np.asarray(stars.hip),
                               star_mags=np.asarray(stars.mag), fov=fov, sigma=float(sigma),
                               max_stars=image["max_identified_stars"], q_BS_true=q_BS,
@@ -133,13 +136,15 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes=()
                                      epoch=epoch, band=sensor["band"])
     stars = _rendered_stars(star_catalog, image)
     compile_ahead(lanes)  # the scenario checked: the identifier's kernels and the rest of the run's
-    identifier = StarIdentifier(load_navigation_catalog(params, progress=False), camera(sensor),
+    sensor_camera = camera(sensor)
+    budget = photometry(sensor, sensor_camera)
+    identifier = StarIdentifier(load_navigation_catalog(params, progress=False), sensor_camera,
                                 centroid_sigma_px=image["centroid_sigma_px"], max_stars=image["max_identified_stars"])
-    return ImageStarSensor(camera=camera(sensor), model=sensor_model(sensor), identifier=identifier,
+    return ImageStarSensor(camera=sensor_camera, model=sensor_model(sensor, budget), identifier=identifier,
                            stars_I=np.asarray(stars.vectors), stars_mag=np.asarray(stars.mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
                            stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true,
-                           faults=faults, photometry=photometry(sensor))
+                           faults=faults, photometry=budget)
 
 
 def _rendered_stars(star_catalog, image):

@@ -163,9 +163,8 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
         return rayleigh * air.rayleigh / ref_rayleigh + mie * (air.aerosol + air.stratospheric) / ref_aerosol
 
     moon_up = g.moon_zenith < 0.5 * np.pi
-    t_moon = 10.0 ** (-0.4 * K * _scattering_airmass(np.minimum(g.moon_zenith, 0.5 * np.pi)))
+    t_moon, t_sun = _transmission(K, g.moon_zenith), _transmission(K, g.sun_zenith)
     moon_nl = scattered(g.moon_angle) * _illuminance(sky.moon_mag(np.degrees(g.moon_phase_angle))) * t_moon * path
-    t_sun = np.where(g.sun_zenith < 0.5 * np.pi, 10.0 ** (-0.4 * K * _scattering_airmass(np.minimum(g.sun_zenith, 0.5 * np.pi))), 0.0)
     day = sky.sun_mag + DAYLIGHT_ZERO - 2.5 * np.log10(path * (scattered(g.sun_angle) * t_sun + 440000.0 * (1.0 - t_sun) * upper))
     sun_elevation, rho_s = 90.0 - np.degrees(g.sun_zenith), np.maximum(np.degrees(g.sun_angle), 0.25)
     k_sea = extinction(band, 0.0, **site).total
@@ -190,6 +189,11 @@ def _scattering_function(rho_deg):
 def _scattering_airmass(zenith):
     """KS91 eq. 3: X = (1 − 0.96 sin²Z)^(−1/2), the airmass of the scattered light's path."""
     return 1.0 / np.sqrt(1.0 - 0.96 * np.sin(zenith) ** 2)
+
+
+def _transmission(k, zenith):
+    """10^(−0.4 k X(Z)) of a source at zenith distance Z [rad] (KS91's X, eq. 3), 0 below the horizon."""
+    return np.where(zenith < 0.5 * np.pi, 10.0 ** (-0.4 * k * _scattering_airmass(np.minimum(zenith, 0.5 * np.pi))), 0.0)
 
 
 def _illuminance(mag):

@@ -28,11 +28,11 @@ def frame_sky(scenario, geometry, path, frame_k, photometry, q_BS_true):
                       sun_angle=geometry.sun_angle, moon_zenith=0.5 * np.pi - geometry.moon_elevation,
                       moon_angle=geometry.moon_angle, moon_phase_angle=geometry.moon_phase_angle, height=h,
                       year=julian_year(scenario["epoch_utc"]) + path.t[frame_k] / JULIAN_YEAR_S)
-    air = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"]}
-    background = sky_brightness(photometry.band.name, sight, **air).total
+    ground = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"]}
+    extinguishing = extinction(photometry.band, h, **ground)
+    background = sky_brightness(photometry.band.name, sight, **ground, air=extinguishing).total
     omega_S = rot.rotate(rot.conjugate(q_BS_true), path.dtheta[frame_k - 1] * path.rate_hz)
     smear = np.hypot(omega_S[:, 0], omega_S[:, 1]) * photometry.exposure_s / photometry.pixel_scale
-    extinguishing = extinction(photometry.band, h, **air)
     return FrameSky(photometry=photometry, background_mag=background, sky_e_per_px_s=photometry.sky_e_per_px_s(background),
                     smear_px=smear, boresight_extinction=extinguishing.along(sight.zenith), up_I=geometry.up_I,
                     air=extinguishing)

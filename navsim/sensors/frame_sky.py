@@ -8,8 +8,7 @@ and how well it places them, at vector fidelity (:mod:`navsim.sensors.star_vecto
 (:mod:`navsim.sensors.star_image`: the frame's sky level and the stars' extinguished magnitudes drawn). The
 sky is one level across the field (its gradient over a star sensor's field is a few tenths of a magnitude
 by day and is left out); each star's extinction is its own, along its own line of sight; a line of sight
-that meets the ground shows no star. In space (no ``air``) the sky is the band's night sky above the
-atmosphere and nothing dims the stars.
+that meets the ground shows no star.
 """
 
 from dataclasses import dataclass
@@ -21,31 +20,28 @@ import numpy as np
 class FrameSky:
     """Per frame F: the sky's surface brightness at the boresight ``background_mag`` [mag arcsec⁻²] and its
     photoelectrons ``sky_e_per_px_s`` [e⁻ s⁻¹ px⁻¹], the trail of a star near the boresight ``smear_px`` [px],
-    the extinction along the boresight ``boresight_extinction`` [mag]; for an observer in the atmosphere its
-    local vertical ``up_I`` (F, 3) in ICRS axes and the extinction ``air`` (a
-    :class:`navsim.earth.atmosphere.Extinction` of (F,) arrays), both None in space."""
+    the extinction along the boresight ``boresight_extinction`` [mag], the observer's local vertical ``up_I``
+    (F, 3) in ICRS axes and the air's extinction ``air`` (a :class:`navsim.earth.atmosphere.Extinction` of (F,)
+    arrays)."""
 
     photometry: object
     background_mag: np.ndarray
     sky_e_per_px_s: np.ndarray
     smear_px: np.ndarray
     boresight_extinction: np.ndarray
-    up_I: np.ndarray | None = None
-    air: object = None
+    up_I: np.ndarray
+    air: object
 
     def extinguished(self, frames, mag, directions_I):
         """The magnitudes [mag] of stars of band magnitude ``mag`` (M,) seen along ``directions_I`` (M, 3) at the
         frames ``frames`` (M,): plus their extinction (inf where the line of sight meets the ground)."""
         mag = np.asarray(mag, dtype=float)
-        if self.air is None:
-            return mag
         cos_z = np.clip(np.einsum("mi,mi->m", directions_I, self.up_I[frames]), -1.0, 1.0)
         return mag + self.air.at(frames).along(np.arccos(cos_z))
 
-    def measure(self, frames, mag, directions_I):
-        """(detected (M,), σ (M,) [rad], saturated (M,)) of stars of band magnitude ``mag`` along ``directions_I``
-        at the frames ``frames`` (:meth:`startrack.sensor_photometry.SensorPhotometry.measure`)."""
-        seen = self.extinguished(frames, mag, directions_I)
+    def measure(self, frames, seen):
+        """(detected (M,), σ (M,) [rad], saturated (M,)) of stars of magnitudes ``seen`` through the air
+        (:meth:`extinguished`) at the frames ``frames`` (:meth:`startrack.sensor_photometry.SensorPhotometry.measure`)."""
         with np.errstate(over="ignore"):
             detected, sigma, saturated = self.photometry.measure(seen, self.sky_e_per_px_s[frames], self.smear_px[frames])
         return detected & np.isfinite(seen), sigma, saturated

@@ -103,8 +103,8 @@ class StarVectorSensor:
         sigma = np.full(len(index), self.sigma)
         mag = self.star_mags[index]
         if self.sky is not None:
-            detected, sigma, _ = self.sky.measure(frame, mag, seen_I)
             mag = self.sky.extinguished(frame, mag, seen_I)
+            detected, sigma, _ = self.sky.measure(frame, mag)
             frame, index, ref_I, seen_I, sigma, mag = (a[detected] for a in (frame, index, ref_I, seen_I, sigma, mag))
         order = np.lexsort((mag, frame))  # per frame, brightest as seen first
         keep = order[_rank_in_frame(frame[order]) < self.max_stars]
