@@ -98,6 +98,15 @@ class SensorPhotometry:
         sigma = np.sqrt(centroid_variance(placed, v, self.psf_sigma_px, smear_px)) * self.pixel_scale
         return detected, sigma, detected & saturated
 
+    def magnitude_sigma(self, mag, sky_e_per_px_s):
+        """σ_m [mag] of the measured magnitude of stars of (extinguished) magnitude ``mag`` on a sky of
+        ``sky_e_per_px_s``: 2.5/ln 10 · √(N + 4π σ_psf² v)/N, the flux noise of a PSF fit whose noise-equivalent
+        area is 4π σ_psf² (King 1983) for a star of N e⁻ over pixels of variance v."""
+        n = self.star_electrons(mag)
+        v = self.pixel_variance(sky_e_per_px_s)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 2.5 / np.log(10.0) * np.sqrt(n + 4.0 * np.pi * self.psf_sigma_px**2 * v) / n
+
     def limiting_magnitude(self, sky_e_per_px_s, smear_px=0.0):
         """The faintest (extinguished) magnitude detected on a sky of ``sky_e_per_px_s`` [mag] (inf: none)."""
         v = self.pixel_variance(sky_e_per_px_s)

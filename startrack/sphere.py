@@ -44,3 +44,12 @@ def local_frame(ra, dec):
     east = np.stack([-sin_a, cos_a, np.zeros_like(ra)], axis=-1)
     north = np.stack([-sin_d * cos_a, -sin_d * sin_a, cos_d], axis=-1)
     return u, east, north
+
+
+def tangent_basis(s):
+    """Two orthonormal rows (N, 2, 3) spanning the plane perpendicular to each unit vector s (N, 3)."""
+    helper = np.zeros_like(s)
+    helper[np.arange(len(s)), np.argmin(np.abs(s), axis=1)] = 1.0
+    e1 = np.cross(s, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    return np.stack([e1, np.cross(s, e1)], axis=1)

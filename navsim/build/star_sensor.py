@@ -9,6 +9,7 @@ import numpy as np
 from navsim.build.faults import sensor_faults
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.star_image import ImageStarSensor
+from navsim.sensors.star_prior import PriorIdentification
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
 from navsim.studies import observers as observer_kinds
 from startrack import units
@@ -17,6 +18,7 @@ from startrack.camera import Camera
 from startrack.detectors import detector
 from startrack.errors import InputError
 from startrack.identify.identifier import StarIdentifier
+from startrack.identify.prior_match import PriorMatch
 from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
 from startrack.precompile import compile_ahead
 from startrack.render import SensorModel
@@ -57,7 +59,22 @@ def star_sensor(scenario, star_catalog, frame_interval, epoch, lanes=()):
         q_BS_true=q_BS_true,
         faults=faults,
         photometry=photometry(sensor),
+        identification=prior_identification(sensor, stars),
     )
+
+
+def prior_identification(sensor, stars):
+    """The :class:`~navsim.sensors.star_prior.PriorIdentification` of a ``star_sensor`` table whose
+    ``identification.method`` is "prior", over the sensor's catalog ``stars``, or None."""
+    table = sensor.get("identification")
+    if table is None or table["method"] != "prior":
+        return None
+    matcher = PriorMatch(np.asarray(stars.vectors), np.asarray(stars.mag), 0.5 * float(units.deg_to_rad(sensor["fov_deg"])),
+                         gate_probability=table["gate_probability"], mag_sigmas=table["mag_window_sigmas"],
+                         catalog_mag_sigma=table["colour_sigma_mag"], false_per_frame=table["false_stars_per_frame"],
+                         max_wrong=table["max_wrong_probability"])
+    return PriorIdentification(matcher=matcher, false_per_frame=table["false_stars_per_frame"],
+                               colour_sigma=table["colour_sigma_mag"])
 
 
 def camera(sensor):

@@ -101,7 +101,7 @@ def compare_budget(scenario, directory):
         runs = finished_series(directory / "parts" / part.key, part.scenario, "--compare", part.truth_off)
         total = part.key == "total"
         analysis = kind.covariance_analysis(part.scenario, split=not total)
-        out[part.key] = {"label": part.label, **(analysis if total else analysis.only(part.key)).compare(runs)}
+        out[part.key] = {"label": part.label, **(analysis if total else analysis.only(part.covariance)).compare(runs)}
     if not out:
         raise InputError(f"--compare {directory}: no part of the budget has run")
     return out

@@ -9,24 +9,42 @@ the displacement is a rotation (about b × v for the boresight b) plus a differe
 the catalog is turned by the rotation that takes b to a(b), :func:`fix_rotation`. The processing of
 a real CNS removes it: it aberrates the catalog directions with the INS's own velocity and the
 ephemeris before fusing stars, or turns a fix back by :func:`fix_rotation` of its own boresight.
+
+Inside the air the stars are also refracted (:mod:`navsim.earth.refraction`): ``air`` = (up_I, A, B), the
+local vertical in ICRS axes and the coefficients of its eq. (1) for each direction (None: no air). The
+refraction acts on the aberrated direction (the light's direction at the observer, which the air bends).
 """
 
 import numpy as np
 
 from startrack import rotation as rot
+from navsim.earth.refraction import refract
 from startrack.aberration import aberrate
 
 
-def fix_rotation(boresight_I, v_I):
+def apparent(u_I, v_I, air=None):
+    """Apparent unit directions (N, 3) of the catalog directions ``u_I`` (N, 3): aberrated for the observer
+    velocities ``v_I`` (N, 3) or (3,) [m/s], then refracted by ``air`` (module docstring; None: no air)."""
+    seen = aberrate(u_I, v_I)
+    return seen if air is None else refract(seen, *air)
+
+
+def fix_rotation(boresight_I, v_I, air=None):
     """q_R (..., 4): the rotation taking the boresight direction ``boresight_I`` (..., 3) to its apparent
-    direction for the observer velocity ``v_I`` (..., 3) [m/s]. A fix solved from apparent stars is
-    q_IS,apparent = q_R⁻¹ ⊗ q_IS (the sensor believes it points at the catalog star it sees at its
-    centre, displaced away from the apex)."""
-    return rot.from_two_vectors(boresight_I, aberrate(boresight_I, v_I))
+    direction for the observer velocity ``v_I`` (..., 3) [m/s] (and the ``air``). A fix solved from apparent
+    stars is q_IS,apparent = q_R⁻¹ ⊗ q_IS (the sensor believes it points at the catalog star it sees at its
+    centre, displaced away from the apex and raised towards the zenith)."""
+    seen = aberrate(boresight_I, v_I)
+    if air is not None:
+        seen = refract(np.reshape(seen, (-1, 3)), *air).reshape(np.shape(seen))
+    return rot.from_two_vectors(boresight_I, seen)
 
 
-def field_stars(stars_I, boresight_I, radius, v_I):
+def field_stars(stars_I, boresight_I, radius, v_I, air=None):
     """(index, apparent directions (N, 3)) of the stars of ``stars_I`` (M, 3) within ``radius`` [rad] of
-    the boresight, aberrated for the observer velocity ``v_I`` (3,) [m/s]."""
+    the boresight, seen by the observer of velocity ``v_I`` (3,) [m/s] through ``air`` (a frame's (up_I (3,),
+    A, B); None: no air)."""
     index = np.flatnonzero(stars_I @ boresight_I >= np.cos(radius))
-    return index, aberrate(stars_I[index], v_I)
+    rows = None if air is None else tuple(np.broadcast_to(x, (index.size, 3) if k == 0 else (index.size,))
+                                          for k, x in enumerate(air))
+    return index, apparent(stars_I[index], v_I, rows)

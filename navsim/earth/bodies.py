@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import erfa
 import numpy as np
 
-from navsim.earth.frames import c_en, tt_epoch
+from navsim.earth.frames import local_up, tt_epoch
 from navsim.earth.wgs84 import geodetic_to_ecef
 from startrack.sphere import angular_distance
 
@@ -47,7 +47,7 @@ class SunMoon:
         sun = -erfa.epv00(*tt)[0]["p"] * AU
         moon = erfa.moon98(*tt)["p"] * AU
         r_I = np.einsum("fij,fj->fi", orientation.c_ie, np.stack(geodetic_to_ecef(lat, lon, h), axis=-1))
-        up_I = np.einsum("fij,fj->fi", orientation.c_ie, -c_en(lat, lon)[..., 2])
+        up_I = local_up(orientation.c_ie, lat, lon)
         to_sun, to_moon = sun - r_I, moon - r_I
         distance = np.linalg.norm(to_moon, axis=-1)
         phase = angular_distance(sun - moon, r_I - moon)

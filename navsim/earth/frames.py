@@ -31,6 +31,12 @@ def c_en(lat, lon):
     return np.stack([north, east, down], axis=-1)
 
 
+def local_up(c_ie, lat, lon):
+    """The local vertical (..., 3) in ICRS axes at geodetic (L, λ) (...,) [rad] for C_ie (..., 3, 3): C_ie C_en
+    [0, 0, −1] (the ellipsoid's normal, up)."""
+    return np.einsum("...ij,...j->...i", c_ie, -c_en(lat, lon)[..., 2])
+
+
 @njit
 def q_en(lat, lon):
     """The quaternion of :func:`c_en` as components (x, y, z, w) (scalars or arrays alike; compiled):

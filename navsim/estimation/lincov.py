@@ -67,10 +67,12 @@ def true_update(P, mean, W, K, H_t, R_t, d, source, offset_source):
 
 @njit
 def update(P, mean, P_f, W, H_t, R_t, R_f, d, estimated, source, offset_source):
-    """One measurement through the filter (eq. 2) and the truth (eq. 3); H_f = H_t W."""
+    """One measurement through the filter (eq. 2) and the truth (eq. 3); H_f = H_t W. Returns W K, the gain
+    in the truth's coordinates (a second source's offset d' moves its mean by −W K d')."""
     H_f = np.ascontiguousarray(H_t @ W)
     K = filter_update(P_f, H_f, R_f, estimated)
     true_update(P, mean, W, K, H_t, R_t, d, source, offset_source)
+    return W @ K
 
 
 @njit

@@ -27,13 +27,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.apparent import fix_rotation
-from navsim.earth.frames import q_en
+from navsim.earth.frames import local_up, q_en
+from navsim.earth.refraction import refract
 from navsim.earth.orientation import observer_velocity
 from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
 from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult, star_covariances
+from navsim.sensors.star_sensor import SensorPrior
 from navsim.ins import strapdown
 from startrack import rotation as rot
 from startrack.aberration import aberrate
@@ -70,13 +72,16 @@ class ImuNoise:
 class StarSensorModel:
     """What the filter knows of its star sensor: the nominal mounting ``q_BS`` (S -> B), how it treats
     the mounting error μ (``mounting``: estimate, consider or ignore), the Earth's orientation at the
-    frames (:class:`~navsim.earth.orientation.EarthOrientation`) and whether its processing
-    corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.earth.apparent`)."""
+    frames (:class:`~navsim.earth.orientation.EarthOrientation`), whether its processing
+    corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.earth.apparent`) and the air
+    it corrects their refraction with at the INS's height (``refraction``, a
+    :class:`navsim.earth.refraction.Air`; None: no correction)."""
 
     q_BS: np.ndarray
     mounting: str
     orientation: object
     correct_aberration: bool = True
+    refraction: object = None
 
 
 @dataclass(frozen=True)
@@ -232,11 +237,10 @@ class NavFilter:
         """Update with identified stars: catalog unit vectors ``ref_I`` (N, 3) in ICRS, measured unit
         vectors ``obs_S`` (N, 3) in S and their covariances ``cov_S`` (N, 3, 3) [rad², S]; each star a 2-dof
         residual gated alone (:func:`celestial_kernels.stars_update`). The catalog directions are made
-        apparent with the filter's own velocity and the ephemeris when the processing corrects aberration."""
+        apparent with the filter's own velocity and the ephemeris when the processing corrects aberration, and
+        refracted by its model air at the INS's position when it corrects refraction."""
         j = self._frame()
-        ref_I = np.ascontiguousarray(ref_I, dtype=float)
-        if self.star_sensor.correct_aberration:
-            ref_I = np.ascontiguousarray(aberrate(ref_I, self._observer_velocity(j)))
+        ref_I = self._apparent(j)(np.asarray(ref_I, dtype=float))
         z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                           self.star_sensor.orientation.q_ie[j], ref_I,
                                                           np.ascontiguousarray(obs_S, dtype=float),
@@ -279,11 +283,55 @@ class NavFilter:
         o = self.star_sensor.orientation
         return observer_velocity(o.c_ie[j], o.v_earth[j], self._nav[0], self._nav[1], self._nav[2], self._nav[3:6])
 
+    def sensor_prior(self):
+        """The star sensor's :class:`~navsim.sensors.star_sensor.SensorPrior` at this frame: q̂_IS (as
+        :meth:`sensor_prediction`), the covariance of its error in sensor axes, δθ_S = R_SB A x + μ (A of eq. 1 of
+        :mod:`navsim.estimation.celestial_kernels`, μ when the mounting is a state), and the processing that makes
+        catalog stars apparent (:meth:`update_stars`'s)."""
+        j = self._frame()
+        nav_kernels.flush(self._nav, self._P, self._acc, self.model)
+        R_SB = rot.to_matrix(self._calib[12:16]).T
+        G = R_SB @ celestial_kernels.attitude_jacobian(self._nav, self.layout.n)
+        if self.layout.mounting >= 0:
+            G[:, self.layout.mounting:self.layout.mounting + 3] += np.eye(3)
+        q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
+        return SensorPrior(q_IS=rot.multiply(q_IB, self._calib[12:16]), P_theta=G @ self._P @ G.T,
+                           apparent=self._apparent(j))
+
+    def _apparent(self, j):
+        """The processing's map of catalog unit vectors (N, 3) to their apparent directions at frame ``j`` (contiguous):
+        aberrated with the INS's velocity when it corrects aberration, refracted by its model air at the INS's
+        position when it corrects refraction (the state of now, held)."""
+        v = self._observer_velocity(j) if self.star_sensor.correct_aberration else None
+        air = self._air(j)
+
+        def apparent(u):
+            seen = u if v is None else aberrate(u, v)
+            if air is not None:
+                n = seen.shape[0]
+                seen = refract(seen, np.broadcast_to(air[0], (n, 3)), np.full(n, air[1]), np.full(n, air[2]))
+            return np.ascontiguousarray(seen)
+
+        return apparent
+
+    def _air(self, j):
+        """(up_I (3,), A, B) of the processing's refraction correction at frame ``j`` and the INS's position, or None."""
+        air = self.star_sensor.refraction
+        if air is None:
+            return None
+        a, b = air.coefficients(self._nav[2])
+        return local_up(self.star_sensor.orientation.c_ie[j], self._nav[0], self._nav[1]), a, b
+
     def _corrected_fix(self, q_IS, j):
-        if not self.star_sensor.correct_aberration:
+        """The fix turned back by the rotation of its boresight to its apparent direction, as far as the processing
+        corrects it (aberration with the INS's velocity, refraction with its model air)."""
+        correct, air = self.star_sensor.correct_aberration, self._air(j)
+        if not correct and air is None:
             return q_IS
         boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
-        return rot.normalize(rot.multiply(fix_rotation(boresight, self._observer_velocity(j)), q_IS))
+        v = self._observer_velocity(j) if correct else np.zeros(3)
+        rows = None if air is None else (air[0][None, :], np.atleast_1d(air[1]), np.atleast_1d(air[2]))
+        return rot.normalize(rot.multiply(fix_rotation(boresight, v, rows), q_IS))
 
     def process_record(self, samples, ratio, dt, record):
         """The compiled fast path: the whole :class:`~navsim.sensors.aiding.AidingRecord` at once

@@ -18,11 +18,13 @@ the given mounting error) is the same vector in every run and two of them add li
 draws each source from the same seeded sub-stream whatever is switched off, so the parts share the
 other sources' draws exactly.
 
-The aberration is another thing: the truth's stars are always apparent, and its part is what skipping
-the correction costs — the filter without the correction on a truth without any other source. When
-the scenario corrects the aberration (the default) that part is left out of the root-sum-square and
-the superposition; when it does not, the other parts run with the correction (their filter otherwise
-the scenario's) and the aberration part is one of the sources. At image fidelity the star noise
+The aberration and the refraction's correction are another thing: the truth's stars are always apparent
+and refracted, and such a part is what skipping the correction costs — the filter without the correction
+on a truth without any other source. When the scenario corrects (the default) that part is left out of the
+root-sum-square and the superposition; when it does not, the other parts run with the correction (their
+filter otherwise the scenario's) and the part is one of the sources. The refraction's residual — the real
+air's pressure and temperature against the model the processing corrects with — is a source like the
+others (``truth_off`` "refraction": the truth's air is the model's). At image fidelity the star noise
 comes from the pixels: it is not isolable and stays in every part. A source the scenario does not
 have is listed as absent and not run.
 
@@ -56,13 +58,25 @@ ACCEL_TERMS = ("vrw", "scale_factor_sigma", "misalignment_sigma", "quantization"
 
 @dataclass(frozen=True)
 class Source:
-    """An error source: its key (the part's directory and, but for the aberration, its name in
-    ``truth_off``), label, and where eq. (1) or the aberration's R·r_h predicts its metres in a run's
-    ``celestial`` summary."""
+    """An error source: its key (the part's directory and, but for a correction's cost, its name in
+    ``truth_off``), label, where eq. (1) or R·r_h predicts its metres in a run's ``celestial`` summary, and
+    for the cost of skipping a correction the scenario key that switches it (``correction``, dotted); ``covariance``
+    the covariance analysis' source that is this part (default: the key)."""
 
     key: str
     label: str
     prediction: tuple | None = None
+    correction: str | None = None
+    covariance: str | None = None
+
+    def corrected(self, scenario):
+        """Whether ``scenario`` applies this source's correction (None: not a correction)."""
+        if self.correction is None:
+            return None
+        value = scenario.data
+        for name in self.correction.split("."):
+            value = value[name]
+        return bool(value)
 
 
 SOURCES = (
@@ -70,11 +84,16 @@ SOURCES = (
     Source("gravity", "gravity disturbance (deflection)", ("horizon_floor", "gravity_m")),
     Source("star_noise", "star-sensor noise"),
     Source("mounting", "star-sensor mounting error"),
-    Source("aberration", "aberration, cost of not correcting", ("aberration", "uncorrected_position_m")),
+    Source("aberration", "aberration, cost of not correcting", ("aberration", "uncorrected_position_m"),
+           "star_sensor.aberration_correction"),
+    Source("refraction", "refraction residual (real air vs model)", ("refraction", "residual_position_m")),
+    Source("refraction_correction", "refraction, cost of not correcting", ("refraction", "uncorrected_position_m"),
+           "star_sensor.refraction.correction", "refraction"),
     Source("inertial", "gyro errors and IMU noise"),
     Source("initial", "filter's initial errors"),
     Source("aiding", "baro and position-fix errors"),
 )
+CORRECTIONS = tuple(s for s in SOURCES if s.correction is not None)
 #: The prediction of the whole scenario: the floor of eq. (1) (∇ and gravity together).
 TOTAL_PREDICTION = ("horizon_floor", "floor_m")
 
@@ -82,8 +101,9 @@ TOTAL_PREDICTION = ("horizon_floor", "floor_m")
 @dataclass(frozen=True)
 class Part:
     """A part of the budget: its key (its campaign's directory ``parts/<key>``), label, the scenario it
-    runs and the truth sources it switches off (None when it is not run, and ``reason`` says why), and
-    where eq. (1) or the aberration's R·r_h predicts its metres in a run's ``celestial`` summary."""
+    runs and the truth sources it switches off (None when it is not run, and ``reason`` says why),
+    where eq. (1) or the aberration's R·r_h predicts its metres in a run's ``celestial`` summary, and the
+    covariance analysis' source it is (``covariance``)."""
 
     key: str
     label: str
@@ -91,6 +111,11 @@ class Part:
     truth_off: tuple | None
     reason: str | None
     prediction: tuple | None
+    covariance: str | None = None
+
+    def __post_init__(self):
+        if self.covariance is None:
+            object.__setattr__(self, "covariance", self.key)
 
 
 def absent_reason(scenario, key):
@@ -105,6 +130,8 @@ def absent_reason(scenario, key):
         return "not isolable: at image fidelity the star noise comes from the pixels and is in every part"
     if key == "mounting" and not any(sensor["misalignment_arcsec"]):
         return "absent: star_sensor.misalignment_arcsec is zero"
+    if key == "refraction" and not (sensor["refraction"]["pressure_error_percent"] or sensor["refraction"]["temperature_error_k"]):
+        return "absent: the real air is the model's (star_sensor.refraction's errors are zero)"
     if key == "aiding" and not (data.get("baro") or data["aiding"].get("position")):
         return "absent: neither a baro nor position fixes"
     if key == "inertial" and not (any(getattr(gyro, name) for name in GYRO_TERMS)
@@ -125,13 +152,14 @@ def budget_parts(scenario):
     for source in SOURCES:
         reason = absent_reason(scenario, source.key)
         if reason is not None:
-            parts.append(Part(source.key, source.label, None, None, reason, source.prediction))
+            parts.append(Part(source.key, source.label, None, None, reason, source.prediction, source.covariance))
             continue
         overrides = {"name": f"{scenario.name}.{source.key}"}
-        if source.key == "aberration" or not sensor["aberration_correction"]:
-            overrides["star_sensor.aberration_correction"] = source.key != "aberration"
+        for correction in CORRECTIONS:
+            if correction is source or not correction.corrected(scenario):
+                overrides[correction.correction] = correction is not source
         parts.append(Part(source.key, source.label, _variant(scenario, overrides), tuple(sorted(switchable - {source.key})),
-                          None, source.prediction))
+                          None, source.prediction, source.covariance))
     parts.append(Part("total", "all sources", _variant(scenario, {"name": f"{scenario.name}.total"}), (), None,
                       TOTAL_PREDICTION))
     return tuple(parts)
@@ -149,10 +177,11 @@ def summarize_budget(scenario, directory, parts, runs, seed):
     rows = [{**_part(directory, p.key, p.label, p.reason, p.prediction),
              "truth_off": None if p.scenario is None else list(p.truth_off)} for p in parts if p.key != "total"]
     total = _part(directory, "total", "all sources", None, TOTAL_PREDICTION)
-    corrected = bool(scenario["star_sensor"]["aberration_correction"])
+    corrected = {c.key: c.corrected(scenario) for c in CORRECTIONS}
     rss = _root_sum_square(rows, corrected, total)
     return {"format": FORMAT, "scenario": scenario.name, "source": scenario.source, "runs": runs, "base_seed": seed,
-            "aberration_corrected": corrected, "parts": rows, "total": total, "root_sum_square": rss,
+            "aberration_corrected": corrected["aberration"], "corrected": corrected, "parts": rows, "total": total,
+            "root_sum_square": rss,
             "superposition": _superposition(rows, total, rss["parts"]), "in_every_part": _in_every_part(scenario)}
 
 
@@ -191,11 +220,11 @@ def _in_every_part(scenario):
     return "nothing"
 
 
-def _root_sum_square(rows, aberration_corrected, total):
-    """The RSS of the parts that were run, per metric, and its ratio to the total; the aberration part
-    only when the scenario itself leaves the aberration uncorrected (otherwise the total has it
+def _root_sum_square(rows, corrected, total):
+    """The RSS of the parts that were run, per metric, and its ratio to the total; a correction's part
+    only when the scenario itself does not correct (``corrected``: {key: bool}; otherwise the total has it
     corrected and that part is the cost of not correcting)."""
-    included = [r for r in rows if r["status"] == "run" and not (r["key"] == "aberration" and aberration_corrected)]
+    included = [r for r in rows if r["status"] == "run" and not corrected.get(r["key"], False)]
     rss = {m: float(np.sqrt(sum(r[m] ** 2 for r in included))) for m in METRICS}
     ratio = {m: rss[m] / total[m] if total.get(m) else None for m in METRICS}
     return {"parts": [r["key"] for r in included], **rss, "ratio_to_total": ratio}

@@ -9,6 +9,7 @@ from navsim.build import star_sensor as star_sensors
 from navsim.build.inertial import accelerometer_model, gyro_model
 from navsim.earth.frames import julian_year
 from navsim.earth.gravity import GravityDisturbance, normal_gravity
+from navsim.earth.refraction import Air
 from navsim.earth.wgs84 import OMEGA_IE, radii
 from navsim.estimation.nav_filter import GravityUncertainty, ImuNoise, NavFilterConfig, StarSensorModel
 from navsim.scenario.star_sensor_fields import mounting
@@ -16,6 +17,7 @@ from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel
 from navsim.truth.segments import Profile
 from startrack import units
+from startrack.bands import band
 
 #: Floors of the default initial σ, so that P0 stays positive definite with perfect sensors:
 #: tilt [rad], heading [rad], gyro bias [rad/s], accelerometer bias [m/s²], scale factor [-].
@@ -86,13 +88,34 @@ def star_sensor(scenario, star_catalog, lanes=()):
 
 def star_sensor_model(scenario, orientation):
     """The filter's :class:`~navsim.estimation.nav_filter.StarSensorModel` (nominal mounting, treatment
-    of its error, the Earth's orientation at the frames, aberration correction), or None."""
+    of its error, the Earth's orientation at the frames, aberration and refraction correction), or None."""
     if "star_sensor" not in scenario.data:
         return None
     sensor = scenario["star_sensor"]
     q_BS, _ = mounting(sensor)
     return StarSensorModel(q_BS=q_BS, mounting=scenario["filter"]["mounting"], orientation=orientation,
-                           correct_aberration=sensor["aberration_correction"])
+                           correct_aberration=sensor["aberration_correction"], refraction=modelled_air(scenario))
+
+
+def real_air(scenario, truth_off=()):
+    """The :class:`~navsim.earth.refraction.Air` the truth's stars are refracted by: the standard atmosphere with
+    the scenario's pressure and temperature errors (none when ``truth_off`` has "refraction")."""
+    sensor = scenario["star_sensor"]
+    refraction = sensor["refraction"]
+    air = Air(band(sensor["band"]).centre_um, refraction["pressure_error_percent"] / 100.0,
+              refraction["temperature_error_k"])
+    return air.modelled() if "refraction" in truth_off else air
+
+
+def refraction_residual(scenario):
+    """Whether refraction leaves an error in the stars the filter fuses: uncorrected, or the real air not the model's."""
+    refraction = scenario["star_sensor"]["refraction"]
+    return not refraction["correction"] or bool(refraction["pressure_error_percent"] or refraction["temperature_error_k"])
+
+
+def modelled_air(scenario):
+    """The air the processing corrects the refraction with (the standard atmosphere), or None when it does not."""
+    return real_air(scenario).modelled() if scenario["star_sensor"]["refraction"]["correction"] else None
 
 
 def gravity_uncertainty(scenario, lat, h):

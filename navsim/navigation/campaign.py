@@ -42,7 +42,18 @@ def pool(finished, settle):
         "nees": averaged_nees(finished, settle),
         "divergent_runs": divergent,
         "imu_calibration": calibration([s.imu_calibration for s in summaries]),
+        "star_identification": identification([(s.celestial or {}).get("star_identification") for s in summaries]),
     }
+
+
+def identification(per_run):
+    """The runs' ``celestial.star_identification`` summed (None when the runs have none): frames and stars detected
+    and identified, wrong identifications, and the largest stated wrong-match probability."""
+    if not per_run or any(r is None for r in per_run):
+        return None
+    total = {key: int(sum(r[key] for r in per_run)) for key in ("frames_detected", "frames_identified", "stars_detected",
+                                                                 "stars_identified", "wrong")}
+    return {"runs": len(per_run), **total, "wrong_probability_max": max(r["wrong_probability_max"] for r in per_run)}
 
 
 def cep(radial):

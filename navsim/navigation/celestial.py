@@ -21,6 +21,10 @@ Aberration. An attitude from apparent stars is turned by the rotation r of the b
 aberration (:func:`navsim.earth.apparent.fix_rotation`); uncorrected, the filter takes its
 horizontal part r_h (navigation axes) for a tilt and settles R·r_h away (20" -> ~600 m).
 
+Refraction. The air raises the boresight towards the zenith by ΔZ (eq. 1 of :mod:`navsim.earth.refraction`), a
+rotation about a horizontal axis: uncorrected it costs R·ΔZ (58" at 45° at sea level: 1.8 km; 15" at 12 km), and
+the real air's departure from the processing's model leaves R·δΔZ.
+
 Observability. Per state the ratio of the filter's σ at the end to its initial σ, and the
 eigen-decomposition of the final covariance normalised by the initial σ (Ham & Brown 1983): an
 eigenvalue near 1 is a direction the measurements left as it was, one near 0 is observed.
@@ -32,6 +36,7 @@ from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import q_en
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import radii
+from navsim.navigation import build
 from startrack import rotation as rot
 from startrack import units
 
@@ -52,7 +57,21 @@ def summary(scenario, series, sky, orientation, q_BS_true, geometry):
             "sky": sky_summary(geometry, series, sensor),
             "horizon_floor": horizon_floor(series, steady),
             "aberration": aberration(series, sky, orientation, q_BS_true, sensor["aberration_correction"], steady),
-            "observability": observability(series)}
+            "refraction": refraction(series, sky, orientation, q_BS_true, sensor["refraction"],
+                                     build.real_air(scenario).modelled(), steady),
+            "observability": observability(series),
+            **({"star_identification": star_identification(series)} if "n_wrong" in series else {})}
+
+
+def star_identification(series):
+    """What identifying the detections with the INS's prior did (:mod:`navsim.sensors.star_prior`): frames with
+    detections and with stars identified, stars detected and identified, the identifications the truth finds wrong
+    and the largest wrong-match probability the matcher stated."""
+    identified = series["n_identified"]
+    return {"frames_detected": int(np.count_nonzero(series["n_detected"])),
+            "frames_identified": int(np.count_nonzero(identified)), "stars_detected": int(series["n_detected"].sum()),
+            "stars_identified": int(identified.sum()), "wrong": int(series["n_wrong"].sum()),
+            "wrong_probability_max": float(series["wrong_probability"].max(initial=0.0))}
 
 
 def sky_summary(geometry, series, sensor):
@@ -76,6 +95,27 @@ def sky_summary(geometry, series, sensor):
         out["band"] = sensor["band"]
         out["sky_background_mag"] = _range(series["sky_background_mag"])
         out["limiting_mag"] = _range(series["limiting_mag"])
+    out["frames_without_stars"] = without_stars(geometry, series)
+    return out
+
+
+def without_stars(geometry, series):
+    """Why the frames without a measured star had none, {reason: frames}: an exclusion (the Sun, the Moon, the
+    horizon), the sky's light filling the pixels (no star detectable: the limiting magnitude is −inf), no star of the
+    field above the limiting magnitude, or (a light budget's frames with detections) none identified."""
+    none = series["n_stars"] == 0
+    excluded = geometry.reason >= 0
+    out = {"excluded": int(np.count_nonzero(none & excluded))}
+    rest = none & ~excluded
+    if "limiting_mag" in series:
+        blind = rest & ~np.isfinite(series["limiting_mag"])
+        out["sky fills the pixels"] = int(np.count_nonzero(blind))
+        rest &= ~blind
+    if "n_detected" in series:
+        unnamed = rest & (series["n_detected"] > 0)
+        out["detections not identified"] = int(np.count_nonzero(unnamed))
+        rest &= ~unnamed
+    out["no star above the limit"] = int(np.count_nonzero(rest))
     return out
 
 
@@ -115,23 +155,57 @@ def aberration(series, sky, orientation, q_BS_true, corrected, steady):
     Earth's rotation and the vehicle's ground velocity) and the whole [arcsec, mean and max], the
     whole's horizontal part in the navigation frame, and the position error R·r_h that skipping the
     correction costs [m] (module docstring)."""
-    boresight = rot.rotate(rot.multiply(sky.q_IB, q_BS_true), np.array([0.0, 0.0, 1.0]))
+    boresight = _boresight(sky, q_BS_true)
     annual = rot.to_rotation_vector(fix_rotation(boresight, orientation.v_earth))
     vehicle = rot.to_rotation_vector(fix_rotation(boresight, sky.v_I - orientation.v_earth))
     total = rot.to_rotation_vector(fix_rotation(boresight, sky.v_I))
+    total_n = _in_navigation_axes(total, series, orientation)
+    return {"corrected": bool(corrected), "annual_arcsec": _arcsec(annual, steady), "vehicle_arcsec": _arcsec(vehicle, steady),
+            "total_arcsec": _arcsec(total, steady),
+            "horizontal_arcsec": _arcsec(total_n[:, :2], steady),
+            "uncorrected_position_m": _position_cost(total_n, series, steady)}
+
+
+def refraction(series, sky, orientation, q_BS_true, keys, modelled, steady):
+    """The refraction of the true boresight by the real air [arcsec, mean and max over the steady frames], its
+    residual against the processing's model air at the true height, and their position costs R·ΔZ [m] (module
+    docstring); ``keys`` the scenario's ``star_sensor.refraction`` table."""
+    boresight = _boresight(sky, q_BS_true)
+    at_rest = np.zeros_like(boresight)
+    real = rot.to_rotation_vector(fix_rotation(boresight, at_rest, sky.air(slice(None))))
+    a, b = modelled.coefficients(series["h_true"])
+    model = rot.to_rotation_vector(fix_rotation(boresight, at_rest, (sky.up_I, a, b)))
+    residual = real - model if keys["correction"] else real
+    return {"corrected": bool(keys["correction"]), "pressure_error_percent": keys["pressure_error_percent"],
+            "temperature_error_k": keys["temperature_error_k"], "total_arcsec": _arcsec(real, steady),
+            "residual_arcsec": _arcsec(residual, steady),
+            "residual_position_m": _position_cost(_in_navigation_axes(residual, series, orientation), series, steady),
+            "uncorrected_position_m": _position_cost(_in_navigation_axes(real, series, orientation), series, steady)}
+
+
+def _boresight(sky, q_BS_true):
+    """The true boresight (F, 3) in I."""
+    return rot.rotate(rot.multiply(sky.q_IB, q_BS_true), np.array([0.0, 0.0, 1.0]))
+
+
+def _in_navigation_axes(rotation_vector_I, series, orientation):
+    """Rotation vectors (F, 3) in I resolved in the true NED axes."""
     q_in = rot.multiply(orientation.q_ie, np.stack(q_en(series["lat_true"], series["lon_true"]), axis=-1))
-    total_n = rot.rotate(rot.conjugate(q_in), total)
-    r_m, r_n = radii(series["lat_true"])
-    cost = np.stack([-total_n[:, 1] * (r_m + series["h_true"]), total_n[:, 0] * (r_n + series["h_true"])], axis=-1)
+    return rot.rotate(rot.conjugate(q_in), rotation_vector_I)
 
-    def arcsec(v):
-        size = np.linalg.norm(v[steady], axis=-1) / units.ARCSEC
-        return {"mean": float(size.mean()), "max": float(size.max())}
 
-    return {"corrected": bool(corrected), "annual_arcsec": arcsec(annual), "vehicle_arcsec": arcsec(vehicle),
-            "total_arcsec": arcsec(total),
-            "horizontal_arcsec": arcsec(total_n[:, :2]),
-            "uncorrected_position_m": float(np.hypot(*cost[steady].mean(axis=0)))}
+def _position_cost(r_n, series, steady):
+    """R·r_h [m]: the position error a filter settles at when it takes the horizontal part of the attitude offsets
+    r_n (F, 3) (NED) for a tilt, the size of its mean over the steady frames."""
+    r_m, r_n_radius = radii(series["lat_true"])
+    cost = np.stack([-r_n[:, 1] * (r_m + series["h_true"]), r_n[:, 0] * (r_n_radius + series["h_true"])], axis=-1)
+    return float(np.hypot(*cost[steady].mean(axis=0)))
+
+
+def _arcsec(v, steady):
+    """{mean, max} [arcsec] of the sizes of the rotation vectors v (F, 3) over the steady frames."""
+    size = np.linalg.norm(v[steady], axis=-1) / units.ARCSEC
+    return {"mean": float(size.mean()), "max": float(size.max())}
 
 
 def observability(series):

@@ -7,7 +7,7 @@ def run_lines(summary):
     nav, position = summary["navigation"], summary["position_error_m"]
     horizontal, vertical, nmi = position["horizontal"], position["vertical"], summary["position_error_nmi"]["horizontal"]
     velocity = summary["velocity_error_m_per_s"]
-    return [
+    lines = [
         f"scenario            {summary['scenario']}  (seed {summary['seed']}, {summary['duration_s']:g} s, INS at "
         f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
         f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
@@ -18,6 +18,12 @@ def run_lines(summary):
         "final bias error    gyro " + "  ".join(f"{v:+.4f}" for v in summary["bias_error_final_deg_per_h"]) + " deg/h, "
         "accelerometer " + "  ".join(f"{v:+.1f}" for v in summary["accel_bias_error_final_micro_g"]) + " µg",
     ]
+    ident = (summary.get("celestial") or {}).get("star_identification")
+    if ident:
+        lines.append(f"star identification {ident['stars_identified']} of {ident['stars_detected']} detections identified "
+                     f"with the prior in {ident['frames_identified']} of {ident['frames_detected']} frames, "
+                     f"{ident['wrong']} wrong (truth)")
+    return lines
 
 
 def campaign_lines(summary):
@@ -29,6 +35,11 @@ def campaign_lines(summary):
         lines.append(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 "
                      f"{horizontal['cep95']:.2f} m ({nmi['cep95']:.3f} nmi)   vertical p95 "
                      f"{summary['position_error_m']['vertical']['p95']:.2f} m")
+    ident = summary.get("star_identification")
+    if ident:
+        lines.append(f"star identification {ident['stars_identified']} of {ident['stars_detected']} detections identified "
+                     f"with the prior in {ident['frames_identified']} frames of {ident['runs']} runs, {ident['wrong']} wrong "
+                     f"(largest stated wrong-match probability {ident['wrong_probability_max']:.1e})")
     accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
     if accel:
         lines.append(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "

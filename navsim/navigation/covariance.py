@@ -30,7 +30,7 @@ import numpy as np
 from navsim.analysis import Analysis, Quantity
 from navsim.build.faults import bias_steps
 from navsim.build.star_sensor import vector_equivalent
-from navsim.earth.apparent import fix_rotation
+from navsim.earth.apparent import apparent, fix_rotation
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.orientation import EarthOrientation
 from navsim.earth.wgs84 import radii
@@ -48,12 +48,11 @@ from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
 from startrack import rotation as rot
 from startrack import units
-from startrack.aberration import aberrate
 from startrack.star_catalog import load_star_catalog
 
 #: The error sources of the budget, in order, with their labels (those of :data:`navsim.navigation.budget.SOURCES`).
 COVARIANCE_SOURCES = {key: {s.key: s.label for s in BUDGET_SOURCES}[key] for key in ("initial", "inertial", "accel_bias", "gravity", "mounting", "star_noise",
-                                                   "aberration", "aiding")}
+                                                   "aberration", "refraction", "aiding")}
 SOURCES = tuple(COVARIANCE_SOURCES)
 #: The nominal is sampled at the IMU rate coarsened by a whole factor to no less than this [Hz] (:func:`_coarsening`).
 MIN_RATE_HZ = 10.0
@@ -219,7 +218,7 @@ def nominal(scenario):
     if "star_sensor" in scenario.data:
         k = (np.arange(frames) + 1) * ratio
         orientation = EarthOrientation.compute(scenario["epoch_utc"], k / rate)
-        sky = SkyTruth.of(path, orientation, k)
+        sky = SkyTruth.of(path, orientation, k, build.real_air(scenario))
     return Nominal(trajectory=path, dt=1.0 / rate, ratio=ratio, frames=frames, every=int(scenario["filter"]["covariance_interval"]) // step,
                    orientation=orientation, sky=sky)
 
@@ -238,8 +237,8 @@ def measurements(scenario, nom, filt, star_catalog, src):
     None) of the scenario's sensors along the nominal; ``src`` the stack index of each source."""
     F, dt = nom.frames, nom.dt
     empty3, note = np.zeros((0, 3)), None
-    offsets, ref, obs, cov = np.zeros(F + 1, np.int64), empty3, empty3, np.zeros((0, 3, 3))
-    fix_mask, fix_q, fix_R = np.zeros(F, np.bool_), np.zeros((F, 4)), np.zeros((3, 3))
+    offsets, ref, ref_real, obs, cov = np.zeros(F + 1, np.int64), empty3, empty3, empty3, np.zeros((0, 3, 3))
+    fix_mask, fix_q, fix_q_real, fix_R = np.zeros(F, np.bool_), np.zeros((F, 4)), np.zeros((F, 4)), np.zeros((3, 3))
     if nom.sky is not None:
         catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
         sensor, note = vector_equivalent(scenario, catalog, 1.0 / scenario["star_sensor"]["rate_hz"], build.catalog_epoch(scenario))
@@ -247,22 +246,19 @@ def measurements(scenario, nom, filt, star_catalog, src):
         sensor = sky_background.seeing(exclusion.excluding(sensor, geometry, nom.frame_k * dt), scenario, geometry,
                                        nom.trajectory, nom.frame_k)
         available = sensor.faults.available(nom.frame_k * dt)
-        correct = scenario["star_sensor"]["aberration_correction"]
+        real, modelled = nom.sky.air(slice(None)), processed_air(scenario, nom)
         if isinstance(sensor, AttitudeFixSensor):
             fix_R = sensor.R_S
-            fix_q = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False)
-            if correct:
-                boresight = rot.rotate(fix_q, np.array([0.0, 0.0, 1.0]))
-                fix_q = rot.multiply(fix_rotation(boresight, nom.sky.v_I), fix_q)
+            seen = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
+            fix_q, fix_q_real = (_processed_fixes(scenario, nom, seen, air) for air in (modelled, real))
             fix_mask = available
         else:
-            stars = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False)
+            stars = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
             frame = np.repeat(np.arange(F), np.diff(stars.offsets))
             keep = available[frame]
-            frame, ref, obs = frame[keep], stars.ref_I[keep], stars.obs_S[keep]
+            frame, catalog, obs = frame[keep], stars.ref_I[keep], stars.obs_S[keep]
             offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=F))])
-            if correct:
-                ref = aberrate(ref, nom.sky.v_I[frame])
+            ref, ref_real = (_processed_stars(scenario, nom, catalog, frame, air) for air in (modelled, real))
             cov = isotropic_covariance(obs, stars.sigma[keep])
     position, baro = build.position_sensor(scenario, 1.0 / (nom.ratio * dt)), build.baro(scenario)
     position_mask, position_sigma = np.zeros(F, np.bool_), np.zeros(3)
@@ -277,14 +273,44 @@ def measurements(scenario, nom, filt, star_catalog, src):
         lagged = dataclasses.replace(baro, noise_sigma=0.0, bias_sigma=0.0, bias_rw=0.0).measure(h, 0).h
         baro_offset[every - 1::every] = h - lagged
         baro_var, baro_filter_var = baro.noise_sigma**2, float(np.hypot(baro.noise_sigma, baro.bias_sigma)) ** 2
-    meas = Measurements(star_offsets=offsets, star_ref=np.ascontiguousarray(ref), star_obs=np.ascontiguousarray(obs),
+    meas = Measurements(star_offsets=offsets, star_ref=np.ascontiguousarray(ref),
+                        star_ref_real=np.ascontiguousarray(ref_real), star_obs=np.ascontiguousarray(obs),
                         star_cov=np.ascontiguousarray(cov), fix_mask=fix_mask, fix_q=np.ascontiguousarray(fix_q),
-                        fix_R=np.ascontiguousarray(fix_R, dtype=float), position_mask=position_mask,
+                        fix_q_real=np.ascontiguousarray(fix_q_real), fix_R=np.ascontiguousarray(fix_R, dtype=float),
+                        position_mask=position_mask,
                         position_sigma=position_sigma, baro_mask=baro_mask, baro_var=float(baro_var),
                         baro_filter_var=float(baro_filter_var), baro_offset=baro_offset,
                         r_scale2=float(scenario["filter"]["measurement_noise_scale"]) ** 2,
-                        star_source=src("star_noise"), aiding_source=src("aiding"), offset_source=src("aberration"))
+                        star_source=src("star_noise"), aiding_source=src("aiding"), offset_source=src("aberration"),
+                        refraction_source=src("refraction"))
     return meas, note
+
+
+def processed_air(scenario, nom):
+    """The refraction the processing corrects along the nominal (its model air at the nominal heights, the frames'
+    (up_I, A, B)), or None when it does not correct it."""
+    air = build.modelled_air(scenario)
+    if air is None:
+        return None
+    a, b = air.coefficients(nom.trajectory.h[nom.frame_k])
+    return nom.sky.up_I, a, b
+
+
+def _processed_stars(scenario, nom, catalog, frame, air):
+    """The catalog directions ``catalog`` (M, 3) of the frames ``frame`` (M,) as the processing makes them apparent
+    along the nominal: aberrated when it corrects aberration, refracted by ``air`` (the frames' (up_I, A, B); None:
+    not)."""
+    v = nom.sky.v_I[frame] if scenario["star_sensor"]["aberration_correction"] else np.zeros((frame.size, 3))
+    return apparent(catalog, v, None if air is None else tuple(x[frame] for x in air))
+
+
+def _processed_fixes(scenario, nom, fixes, air):
+    """The noise-free fixes (F, 4) as the processing turns them back along the nominal (:func:`_processed_stars`)."""
+    correct = scenario["star_sensor"]["aberration_correction"]
+    if not correct and air is None:
+        return fixes
+    v = nom.sky.v_I if correct else np.zeros_like(nom.sky.v_I)
+    return rot.multiply(fix_rotation(rot.rotate(fixes, np.array([0.0, 0.0, 1.0])), v, air), fixes)
 
 
 def covariance_analysis(scenario, split=False, star_catalog=None):
@@ -341,6 +367,8 @@ def _present(mod, i, scenario, name):
         return "star_sensor" in scenario.data
     if name == "aberration":
         return "star_sensor" in scenario.data and not scenario["star_sensor"]["aberration_correction"]
+    if name == "refraction":
+        return "star_sensor" in scenario.data and build.refraction_residual(scenario)
     if name == "aiding":
         return "baro" in scenario.data or "position" in scenario["aiding"]
     return bool(np.any(mod.P0[i]) or np.any(mod.m0[i]) or np.any(mod.q[i])) or (

@@ -52,7 +52,8 @@ class CampaignSummary(records.CampaignSummary):
     vertical}, ``tilt_error_arcsec`` and ``heading_error_arcsec``: the spread {mean, p50, p95, max} of
     the runs' RMS errors; the run-averaged NEES against its band (``nees``), the accepted and rejected
     updates, the divergent runs; ``imu_calibration`` pools the IMU error states (normalised error RMS
-    per state, expected 1, and the share within 3σ); besides, what every kind's campaign record has."""
+    per state, expected 1, and the share within 3σ); ``star_identification`` the stars identified with the INS's
+    prior over all runs and the wrong ones (None without); besides, what every kind's campaign record has."""
 
     position_error_m: dict | None = None
     position_error_nmi: dict | None = None
@@ -63,3 +64,4 @@ class CampaignSummary(records.CampaignSummary):
     updates: dict | None = None
     divergent_runs: list | None = None
     imu_calibration: dict | None = None
+    star_identification: dict | None = None

@@ -150,6 +150,12 @@ def _star_sensor_section(doc, run):
     doc.paragraph(markup(
         f"The aberration of the star directions is {corrected} by the processing; left uncorrected, its horizontal part "
         f"would move the position by {number(aberration['uncorrected_position_m'])} m."))
+    refraction = celestial.get("refraction")
+    if refraction is not None:
+        doc.paragraph(markup(_refraction_text(refraction)))
+    identification = celestial.get("star_identification")
+    if identification is not None:
+        doc.paragraph(markup(_identification_text(identification)))
     doc.add(table(("Quantity", "Value", "Unit"), _horizon_rows(floor) + _aberration_rows(aberration),
                   ("left", "right", "left")))
     calibration = run.summary.get("imu_calibration") or {}
@@ -182,6 +188,9 @@ def _sky_section(doc, run, sky):
                      f"the sky is {number(background['min'])} to {number(background['max'])} mag/arcsec² and the limiting "
                      f"magnitude {number(limit['min'])} to {number(limit['max'])} (median {number(limit['median'])}) when "
                      "the sky leaves the detector any room.")
+        reasons = {k: v for k, v in sky.get("frames_without_stars", {}).items() if v}
+        if reasons:
+            text += " Frames without a star: " + ", ".join(f"{v} ({k})" for k, v in reasons.items()) + "."
         doc.paragraph(markup(text))
     if "limiting_mag" in run.series:
         doc.figure(nav_figures.sky_stars(run), "Stars measured per frame (top); the sky's brightness at the boresight "
@@ -200,6 +209,24 @@ def _horizon_rows(floor):
             ("floor: accelerometer-bias part", number(floor["accel_bias_m"]), "m"),
             ("floor: gravity-disturbance part", number(floor["gravity_m"]), "m"),
             ("Schuler periods averaged", number(floor["schuler_periods"]), "")]
+
+
+def _refraction_text(refraction):
+    """The refraction of the boresight, what the processing does with it and what is left."""
+    corrected = "corrects it with the standard atmosphere at the INS's height" if refraction["corrected"] else "does not correct it"
+    return (f"The air raises the boresight by {number(refraction['total_arcsec']['mean'])}\" on average (at most "
+            f"{number(refraction['total_arcsec']['max'])}\"); the processing {corrected}. The real air departs from that "
+            f"model by {number(refraction['pressure_error_percent'])} % in pressure and {number(refraction['temperature_error_k'])} K, "
+            f"leaving {number(refraction['residual_arcsec']['mean'])}\" ({number(refraction['residual_position_m'])} m of "
+            f"position); left uncorrected the refraction would cost {number(refraction['uncorrected_position_m'])} m.")
+
+
+def _identification_text(ident):
+    """What naming the detections with the INS's prior did."""
+    return (f"The sensor named its detections with the INS's prior: {ident['stars_identified']} of "
+            f"{ident['stars_detected']} detections identified in {ident['frames_identified']} of "
+            f"{ident['frames_detected']} frames with detections, {ident['wrong']} wrongly (checked against the truth); the "
+            f"largest stated probability of a wrong match was {ident['wrong_probability_max']:.1e}.")
 
 
 def _aberration_rows(aberration):

@@ -93,6 +93,7 @@ TRUTH_SOURCES = {
     "gravity": "the gravity disturbance (deflections of the vertical, anomaly)",
     "star_noise": "the star sensor's measurement noise (vector fidelity)",
     "mounting": "the star sensor's mounting error (its true mounting is the nominal one)",
+    "refraction": "the real air's departure from the standard atmosphere the refraction correction models",
     "initial": "the filter's initial error x0 (the filter starts at the truth)",
     "aiding": "the baro's noise, bias and lag and the position fixes' noise",
 }
@@ -111,8 +112,8 @@ def check_truth_off(scenario, truth_off):
     if unknown:
         raise InputError(f"truth_off: unknown source(s) {', '.join(unknown)}; choose from {', '.join(TRUTH_SOURCES)}")
     sensor = scenario.data.get("star_sensor")
-    if sensor is None and truth_off & {"star_noise", "mounting"}:
-        raise InputError("truth_off: star_noise and mounting need a star sensor")
+    if sensor is None and truth_off & {"star_noise", "mounting", "refraction"}:
+        raise InputError("truth_off: star_noise, mounting and refraction need a star sensor")
     if "star_noise" in truth_off and sensor["fidelity"] == "image":
         raise InputError("truth_off: the star noise cannot be switched off at image fidelity (it comes from the pixels)")
     return truth_off
@@ -181,7 +182,7 @@ def simulate(prepared, seed, compiled=True):
     record = _aiding_record(p, truth, position_ss, baro_ss)
     sensor_run, loop_truth, jumps, sky, observer_runs = AidingRun(record), truth, None, None, []
     if p.star_sensor is not None:
-        sky = SkyTruth.of(truth, p.orientation, grid.frame_k)
+        sky = SkyTruth.of(truth, p.orientation, grid.frame_k, build.real_air(scenario, p.truth_off))
         stars, observer_runs, jumps = _star_run(p, sky, star_ss, filt)
         sensor_run, loop_truth = CelestialAidingRun(stars, sensor_run), sky
     log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, observer_runs,
@@ -240,7 +241,8 @@ def _star_run(prepared, sky, seed, filt):
     sensor, grid = prepared.star_sensor, prepared.grid
     if prepared.scenario["star_sensor"]["fidelity"] == "image":
         return star_run.start_image(sensor, seed, grid.n_frames, filt, prepared.observers, prepared.attitude_jumps)
-    return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I, noise="star_noise" not in prepared.truth_off), [], None
+    return sensor.start(seed, sky.q_IB, grid.frame_k * grid.dt, sky.v_I, noise="star_noise" not in prepared.truth_off,
+                        air=sky.air(slice(None))), [], None
 
 
 def _stars_per_frame(stars, series):
@@ -249,7 +251,7 @@ def _stars_per_frame(stars, series):
     fidelity)."""
     record = stars.record()
     if record is None:
-        return (series["n_identified"] + series["n_stacked"]).astype(np.int32)
+        return (series["n_identified"] + series["n_stacked"]).astype(np.int32)  # image fidelity, prior identification
     if record.stars is None:
         return record.available.astype(np.int32)
     return np.where(record.available, record.stars.counts, 0).astype(np.int32)

@@ -19,7 +19,7 @@ from navsim.estimation.treatments import TREATMENTS
 from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
-from navsim.scenario.star_sensor_fields import FAULTS, PHOTOMETRY, STAR_SENSOR, check_faults, check_star_sensor, mounting
+from navsim.scenario.star_sensor_fields import FAULTS, IDENTIFICATION, PHOTOMETRY, REFRACTION, STAR_SENSOR, check_faults, check_star_sensor, mounting
 from navsim.truth import segments, trajectory
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -142,6 +142,8 @@ SCHEMA = Table(
             "min_elevation_deg": Value("float", default=-90.0, minimum=-90.0, maximum=90.0,
                                        doc="no frame while the boresight is lower above the local horizon (-90: none)"),
             "photometry": PHOTOMETRY,
+            "refraction": REFRACTION,
+            "identification": IDENTIFICATION,
         }, optional=True, doc="a star sensor aiding the INS (SINS/CNS) at its rate, vector or image fidelity"),
         "faults": Table(dict(FAULTS), doc="outages, dropped frames, false-star storms and attitude jumps of the star "
                                           "sensor; gyro bias steps"),
@@ -317,6 +319,9 @@ def _check_star_sensor(checked, source):
                 raise InputError(f"{source}: faults.{kind}: needs a [star_sensor] (it acts on the star sensor)")
         return
     check_star_sensor(sensor, source)
+    if sensor["identification"]["method"] == "prior" and (sensor["fidelity"] != "vector" or "photometry" not in sensor):
+        raise InputError(f"{source}: star_sensor.identification.method: 'prior' identifies the detections of a "
+                         "vector-fidelity sensor with a light budget ([star_sensor.photometry]: their magnitudes)")
     if sensor.get("image", {}).get("compare_without_stacking"):
         raise InputError(f"{source}: star_sensor.image.compare_without_stacking: the shadow filter of 004 §3 is the "
                          "attitude filter's; a navigation run compares the attitude solvers of the stacked frames only "

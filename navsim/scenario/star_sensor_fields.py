@@ -102,6 +102,44 @@ PHOTOMETRY = Table(
         "day) and each star's σ follows its SNR",
 )
 
+#: The refraction of a star sensor inside the air (a navigation run; navsim.earth.refraction): the truth sees every
+#: star raised by the real air at the vehicle, the processing corrects it with the standard atmosphere at the INS's
+#: height; the real air's departure from it is left in every star.
+REFRACTION = Table(
+    {
+        "correction": Value("bool", default=True,
+                            doc="the processing refracts the catalog stars by the standard atmosphere at the INS's "
+                                "height (the truth always sees refracted stars)"),
+        "pressure_error_percent": Value("float", default=0.0, minimum=-50.0, maximum=50.0,
+                                        doc="the real air's pressure at the vehicle against the standard atmosphere's"),
+        "temperature_error_k": Value("float", default=0.0, minimum=-60.0, maximum=60.0,
+                                     doc="the real air's temperature at the vehicle against the standard atmosphere's"),
+    },
+    doc="atmospheric refraction of the stars and its correction",
+)
+
+#: How a navigation run's star sensor names its stars (vector fidelity, issue 30): every detected star as the
+#: catalog star it is (the pattern identification of a field with enough stars, taken to succeed), or each detection
+#: with the INS's prior (navsim.sensors.star_prior: 1-3 stars by day, false detections, a wrong-match ceiling).
+IDENTIFICATION = Table(
+    {
+        "method": Value("str", default="catalog", choices=("catalog", "prior"),
+                        doc="catalog: every detected star identified; prior: each detection matched to the star the "
+                            "INS predicts (startrack.identify.prior_match)"),
+        "gate_probability": Value("float", default=0.9999, minimum=0.9, maximum=0.999999,
+                                  doc="the chi-square gate's probability of holding the true star"),
+        "max_wrong_probability": Value("float", default=1e-3, exclusive_minimum=0.0, maximum=0.1,
+                                       doc="a match is kept when its chance of being a coincidence is below this"),
+        "false_stars_per_frame": Value("float", default=0.0, minimum=0.0, maximum=100.0,
+                                       doc="mean false detections per frame (drawn, and expected by the matcher)"),
+        "mag_window_sigmas": Value("float", default=3.0, exclusive_minimum=0.0, maximum=10.0,
+                                   doc="half-width of the magnitude window in σ of the measured and catalog magnitudes"),
+        "colour_sigma_mag": Value("float", default=0.12, minimum=0.0, maximum=1.0,
+                                  doc="the error of the catalog's band magnitudes from the colours (one draw per star)"),
+    },
+    doc="how the star sensor identifies its stars",
+)
+
 #: The faults both kinds of run take: outages, attitude jumps, false-star storms, gyro bias steps and
 #: dropped frames; and the tracking-failure probes of 000 §5 (a per-frame observer, :mod:`navsim.studies`).
 FAULTS = {

@@ -15,7 +15,7 @@ class CelestialAidingRun:
     def __init__(self, star_run, aiding_run):
         self.star_run, self.aiding_run = star_run, aiding_run
         self.log_fields, self.timing_fields = star_run.log_fields, star_run.timing_fields
-        self.uses_prediction = star_run.uses_prediction
+        self.uses_prediction, self.uses_prior = star_run.uses_prediction, star_run.uses_prior
         self._star_measured = False
 
     @property

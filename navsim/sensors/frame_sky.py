@@ -46,6 +46,12 @@ class FrameSky:
             detected, sigma, saturated = self.photometry.measure(seen, self.sky_e_per_px_s[frames], self.smear_px[frames])
         return detected & np.isfinite(seen), sigma, saturated
 
+    def magnitude_sigma(self, frames, seen):
+        """σ_m (M,) [mag] of the measured magnitudes of stars of magnitudes ``seen`` through the air at the frames
+        ``frames`` (:meth:`startrack.sensor_photometry.SensorPhotometry.magnitude_sigma`)."""
+        with np.errstate(over="ignore"):
+            return self.photometry.magnitude_sigma(seen, self.sky_e_per_px_s[frames])
+
     def limiting_magnitude(self):
         """(F,) [mag]: the faintest catalog magnitude detected at the boresight, its extinction included (−inf:
         the sky fills the well)."""

@@ -12,6 +12,7 @@ class RecordedRun:
     timing_fields = {}
     sample = None
     uses_prediction = False
+    uses_prior = False
 
     def __init__(self, record):
         self._record = record

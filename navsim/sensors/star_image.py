@@ -97,15 +97,16 @@ class ImageStarSensor:
         c = self.camera
         return float(np.arctan(0.5 * np.hypot(c.width, c.height) / c.focal_px) + np.radians(1.0))
 
-    def drawn_stars(self, q_IS_true, v_I, frame):
+    def drawn_stars(self, q_IS_true, v_I, frame, air=None):
         """(directions (N, 3), magnitudes (N,)) of the stars drawn into frame ``frame`` of true attitude
         q_IS_true: the catalog's, or near the boresight their apparent directions for the observer
-        velocity ``v_I`` [m/s] (None: no aberration); seen through the frame's air when it has a sky."""
+        velocity ``v_I`` [m/s] (None: no aberration) refracted by the frame's ``air`` (up_I, A, B) (None: none);
+        extinguished by the frame's air when it has a sky."""
         if v_I is None:
             directions, mags = self.stars_I, self.stars_mag
         else:
             index, directions = field_stars(self.stars_I, rot.rotate(q_IS_true, np.array([0.0, 0.0, 1.0])),
-                                            self.field_radius, v_I)
+                                            self.field_radius, v_I, air)
             mags = self.stars_mag[index]
         if self.sky is None:
             return directions, mags
@@ -129,6 +130,7 @@ class ImageRun:
     log_fields = LOG_FIELDS
     timing_fields = TIMING_FIELDS
     uses_prediction = True
+    uses_prior = False
 
     def __init__(self, sensor, storm_rng, render_rng, n_frames, full_frames):
         self.sensor = sensor
@@ -218,7 +220,7 @@ class ImageRun:
             smear_px = np.hypot(request.omega_S_pred[0], request.omega_S_pred[1]) * model.exposure_s * camera.focal_px
             half = max(s.window_half_px, int(np.ceil(0.5 * smear_px + 3.0 * model.psf_sigma_px)) + 1)
             windows = Windows.around(uv_predicted, half, camera.height, camera.width)
-        stars_I, stars_mag = s.drawn_stars(q_IS_true, request.truth.v_I, request.index)
+        stars_I, stars_mag = s.drawn_stars(q_IS_true, request.truth.v_I, request.index, request.truth.air)
         frame = render_star_field(camera, model, q_IS_true, stars_I, stars_mag, self._render_rng,
                                   omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
                                   extra_sources=self._false_stars(request.t))

@@ -12,7 +12,8 @@ which answers three calls:
 - ``lose_track()``: the estimate was knocked off (attitude-jump fault), start acquiring again.
 
 ``uses_prediction`` says whether the run points itself with the filter's predicted attitude and rate
-(the image-fidelity sensor does; pre-drawn vector-fidelity frames do not).
+(the image-fidelity sensor does; pre-drawn vector-fidelity frames do not); ``uses_prior`` whether it identifies
+its stars with the filter's prior and its covariance (:mod:`navsim.sensors.star_prior`).
 
 ``record()`` returns the measurements of every frame when they are known before the run (vector
 fidelity: they do not depend on the filter), which lets the filter take its compiled fast path;
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 #: Frame modes, in the order of their integer codes in the time series.
-MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped", "excluded")
+MODES = ("tracking", "subcatalog", "lost_in_space", "stacked", "no_fix", "outage", "dropped", "excluded", "prior")
 MODE_CODE = {name: code for code, name in enumerate(MODES)}
 
 
@@ -42,13 +43,26 @@ class FrameRequest:
     """What the loop knows at a frame: its index and time [s], the truth record of the frame (for
     the star sensor :class:`~navsim.truth.profiles.FrameTruth`: q_IB and the body rate over the last
     gyro interval [rad/s], from which the sky is seen) and, for a sensor run that ``uses_prediction``,
-    the filter's prediction of the sensor attitude q_IS and of the rate in sensor axes [rad/s]."""
+    the filter's prediction of the sensor attitude q_IS and of the rate in sensor axes [rad/s]; for one that
+    ``uses_prior``, the filter's :class:`SensorPrior`."""
 
     index: int
     t: float
     truth: object
     q_IS_pred: np.ndarray | None = None
     omega_S_pred: np.ndarray | None = None
+    prior: object = None
+
+
+@dataclass(frozen=True)
+class SensorPrior:
+    """What the filter knows of the sensor's attitude at a frame: its estimate ``q_IS``, the covariance ``P_theta``
+    (3, 3) [rad², sensor axes] of its error, and ``apparent``, its processing's map of catalog unit vectors (K, 3)
+    in I to the apparent directions it predicts them at (aberration and refraction as it corrects them)."""
+
+    q_IS: np.ndarray
+    P_theta: np.ndarray
+    apparent: object
 
 
 @dataclass(frozen=True)

@@ -8,10 +8,10 @@ Two measurement models (docs/design.md, fidelity ``vector``):
   (cross-boresight σ on x and y, roll σ about the boresight z).
 
 Both see the true mounting R_BS,true = R_BS exp([δm×]) (the unknown misalignment δm in S) and, on a
-vehicle near the Earth (``v_I``: the observer's barycentric velocity at each frame), the apparent
-stars (:mod:`navsim.earth.apparent`): the star vectors are the aberrated directions, the fix is
-turned by the aberration rotation of its boresight; the reported catalog directions stay the
-catalog's. Their noise does not depend on the filter, so a run draws every frame's measurements
+vehicle near the Earth (``v_I``: the observer's barycentric velocity at each frame; ``air``: the frames'
+refracting air), the apparent stars (:mod:`navsim.earth.apparent`): the star vectors are the aberrated
+and refracted directions, the fix is turned by the rotation of its boresight; the reported catalog
+directions stay the catalog's. Their noise does not depend on the filter, so a run draws every frame's measurements
 when it starts (:meth:`StarVectorSensor.start`): the loop reads them frame by frame
 (:class:`VectorRun`), or the filter takes the whole :class:`Record` at once on its compiled fast path.
 """
@@ -20,32 +20,28 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.earth.apparent import fix_rotation
+from navsim.earth.apparent import apparent, fix_rotation
 from navsim.sensors.recorded_run import RecordedRun
+from navsim.sensors.star_prior import Detections, PriorIdentifiedRun
 from navsim.sensors.star_sensor import StarFrame, isotropic_covariance
 from startrack import rotation as rot
-from startrack.aberration import aberrate
-
-
-def tangent_basis(s):
-    """Two orthonormal rows (N, 2, 3) spanning the plane perpendicular to each unit vector s (N, 3)."""
-    helper = np.zeros_like(s)
-    helper[np.arange(len(s)), np.argmin(np.abs(s), axis=1)] = 1.0
-    e1 = np.cross(s, helper)
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    return np.stack([e1, np.cross(s, e1)], axis=1)
+from startrack.sphere import tangent_basis
 
 
 @dataclass(frozen=True)
 class StarFrames:
     """Star measurements of many frames, concatenated: frame f owns rows offsets[f]:offsets[f+1]; each star's
-    direction σ [rad] per tangent axis (the filter's R) in ``sigma``."""
+    direction σ [rad] per tangent axis (the filter's R) in ``sigma``, its catalog row ``index``, its band magnitude
+    ``mag`` (the catalog's) and the σ of its measured magnitude ``mag_sigma`` [mag] (NaN without a light budget)."""
 
     offsets: np.ndarray
     ref_I: np.ndarray
     obs_S: np.ndarray
     ids: np.ndarray
     sigma: np.ndarray
+    index: np.ndarray
+    mag: np.ndarray
+    mag_sigma: np.ndarray
 
     def frame(self, f):
         """(ref_I (N, 3), obs_S (N, 3), ids (N,), σ (N,)) of frame f."""
@@ -80,41 +76,79 @@ class StarVectorSensor:
     faults: object  # navsim.sensors.faults.SensorFaults
     photometry: object = None
     sky: object = None
+    identification: object = None  # navsim.sensors.star_prior.PriorIdentification
 
-    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True):
+    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True, air=None):
         """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames
-        (and observer velocities ``v_I`` (F, 3) [m/s], None: no aberration); ``noise`` False measures every
-        star exactly (its σ kept for the filter)."""
-        stars = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I, noise)
-        return VectorRun(Record(available=self.faults.available(t_frames), stars=stars))
+        (and observer velocities ``v_I`` (F, 3) [m/s], None: no aberration; ``air`` the frames' (up_I (F, 3),
+        A (F,), B (F,)), None: no refraction); ``noise`` False measures every star exactly (its σ kept for the
+        filter). With ``identification`` the run names its detections with the filter's prior
+        (:class:`~navsim.sensors.star_prior.PriorIdentifiedRun`), else every star is reported identified."""
+        rng = np.random.default_rng(seed)
+        stars = self.observe_frames(q_IB_frames, rng, v_I, noise, air)
+        available = self.faults.available(t_frames)
+        if self.identification is None:
+            return VectorRun(Record(available=available, stars=stars))
+        detections = self.detections(stars, rng, available, noise)
+        return PriorIdentifiedRun(detections, self.identification.matcher, self.star_vectors)
 
-    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True):
+    def detections(self, stars, rng, available, noise=True):
+        """The :class:`~navsim.sensors.star_prior.Detections` of the measured ``stars`` (:class:`StarFrames`) with
+        the false detections of :attr:`identification` drawn from ``rng`` (module docstring of
+        :mod:`navsim.sensors.star_prior`); ``noise`` False: magnitudes exact, no false detection."""
+        ident, F = self.identification, len(stars.offsets) - 1
+        scale = 1.0 if noise else 0.0
+        colour = ident.colour_sigma * rng.standard_normal(len(self.star_mags))
+        frame = np.repeat(np.arange(F), stars.counts)
+        mag = stars.mag + scale * (colour[stars.index] + stars.mag_sigma * rng.standard_normal(len(frame)))
+        limit = np.asarray(self.sky.limiting_magnitude(), dtype=float)
+        n_false = rng.poisson(scale * ident.false_per_frame * np.isfinite(limit).astype(float))
+        f_frame = np.repeat(np.arange(F), n_false)
+        angle = 0.5 * self.fov * np.sqrt(rng.uniform(size=f_frame.size))
+        azimuth = rng.uniform(0.0, 2.0 * np.pi, f_frame.size)
+        f_obs = np.stack([np.sin(angle) * np.cos(azimuth), np.sin(angle) * np.sin(azimuth), np.cos(angle)], axis=-1)
+        f_mag = limit[f_frame] - rng.uniform(size=f_frame.size)
+        f_sigma = self.sky.measure(f_frame, f_mag)[1]
+        order = np.argsort(np.concatenate([frame, f_frame]), kind="stable")
+        offsets = np.concatenate([[0], np.cumsum(stars.counts + n_false)])
+        return Detections(offsets=offsets, obs_S=np.vstack([stars.obs_S, f_obs])[order],
+                          sigma=np.concatenate([stars.sigma, f_sigma])[order], mag=np.concatenate([mag, f_mag])[order],
+                          mag_sigma=np.concatenate([stars.mag_sigma, self.sky.magnitude_sigma(f_frame, f_mag)])[order],
+                          truth=np.concatenate([stars.index, np.full(f_frame.size, -1)])[order], available=available,
+                          limiting_mag=limit)
+
+    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True, air=None):
         """Noisy star vectors for every true attitude q_IB_true (F, 4) -> :class:`StarFrames`.
 
         A star is seen when its angle from the boresight is at most fov/2 and, with a light budget, when the
         frame's sky lets the sensor detect it; the ``max_stars`` brightest (as seen) are reported, brightest
         first; each is measured at its apparent direction for the frame's observer velocity ``v_I`` (F, 3)
-        (None: its catalog direction) with a direction noise isotropic in the plane perpendicular to it.
+        and ``air`` (:meth:`start`; None: its catalog direction) with a direction noise isotropic in the plane
+        perpendicular to it.
         """
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         frame, index = self._in_field(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])))
         ref_I = self.star_vectors[index]
-        seen_I = ref_I if v_I is None else aberrate(ref_I, np.asarray(v_I)[frame])
+        seen_I = ref_I if v_I is None else apparent(ref_I, np.asarray(v_I)[frame], _rows(air, frame))
         sigma = np.full(len(index), self.sigma)
         mag = self.star_mags[index]
+        mag_sigma = np.full(len(index), np.nan)
         if self.sky is not None:
             mag = self.sky.extinguished(frame, mag, seen_I)
             detected, sigma, _ = self.sky.measure(frame, mag)
-            frame, index, ref_I, seen_I, sigma, mag = (a[detected] for a in (frame, index, ref_I, seen_I, sigma, mag))
+            mag_sigma = self.sky.magnitude_sigma(frame, mag)
+            frame, index, ref_I, seen_I, sigma, mag, mag_sigma = (a[detected] for a in (frame, index, ref_I, seen_I, sigma,
+                                                                                         mag, mag_sigma))
         order = np.lexsort((mag, frame))  # per frame, brightest as seen first
         keep = order[_rank_in_frame(frame[order]) < self.max_stars]
-        frame, index, ref_I, seen_I, sigma = frame[keep], index[keep], ref_I[keep], seen_I[keep], sigma[keep]
+        frame, index, ref_I, seen_I, sigma, mag_sigma = (a[keep] for a in (frame, index, ref_I, seen_I, sigma, mag_sigma))
         s_true = rot.rotate(rot.conjugate(q_IS[frame]), seen_I)
         draws = rng.standard_normal((len(index), 2)) * (sigma if noise else np.zeros_like(sigma))[:, None]
         obs = s_true + np.einsum("nij,ni->nj", tangent_basis(s_true), draws)
         obs /= np.linalg.norm(obs, axis=1, keepdims=True)
         offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=len(q_IS)))])
-        return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index], sigma=sigma)
+        return StarFrames(offsets=offsets, ref_I=ref_I, obs_S=obs, ids=self.star_ids[index], sigma=sigma, index=index,
+                          mag=self.star_mags[index], mag_sigma=mag_sigma)
 
     def _in_field(self, boresight, chunk=512):
         """(frame (K,), catalog index (K,)) of every star inside the cone of each boresight (F, 3), frame by
@@ -130,6 +164,11 @@ class StarVectorSensor:
             frames.append(f + start)
             stars.append(near[k])
         return np.concatenate(frames), order[np.concatenate(stars)]
+
+
+def _rows(air, frame):
+    """The ``air`` (up_I (F, 3), A (F,), B (F,)) of the rows ``frame`` (N,), or None."""
+    return None if air is None else tuple(np.asarray(x)[frame] for x in air)
 
 
 def _rank_in_frame(sorted_frames):
@@ -166,24 +205,24 @@ class AttitudeFixSensor:
     q_BS_true: np.ndarray
     faults: object  # navsim.sensors.faults.SensorFaults
 
-    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True):
+    def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True, air=None):
         """A run's sensor: every frame's fix drawn from ``seed`` for the true attitudes q_IB_frames (and
-        observer velocities ``v_I`` (F, 3) [m/s], None: no aberration); ``noise`` False: exact fixes
-        (``R_S`` kept for the filter)."""
-        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I, noise)
+        observer velocities ``v_I`` (F, 3) [m/s], None: no aberration; ``air`` as the star vectors'); ``noise``
+        False: exact fixes (``R_S`` kept for the filter)."""
+        fixes = self.observe_frames(q_IB_frames, np.random.default_rng(seed), v_I, noise, air)
         return VectorRun(Record(available=self.faults.available(t_frames), fixes=fixes, R_S=self.R_S))
 
     @property
     def R_S(self):
         return np.diag([self.sigma_cross**2, self.sigma_cross**2, self.sigma_roll**2])
 
-    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True):
+    def observe_frames(self, q_IB_true, rng, v_I=None, noise=True, air=None):
         """Measured q_IS = q_R⁻¹ ⊗ q_IS,true ⊗ exp(ν/2), ν ~ N(0, R_S) in sensor axes (0 without ``noise``), for
-        q_IB_true (F, 4): q_R the aberration rotation of the boresight for the observer velocities ``v_I`` (F, 3)
-        (:func:`navsim.earth.apparent.fix_rotation`; None: no aberration)."""
+        q_IB_true (F, 4): q_R the rotation of the boresight to its apparent direction for the observer velocities
+        ``v_I`` (F, 3) and the ``air`` (:func:`navsim.earth.apparent.fix_rotation`; None: no aberration)."""
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         if v_I is not None:
-            q_R = fix_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])), np.asarray(v_I))
+            q_R = fix_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])), np.asarray(v_I), air)
             q_IS = rot.multiply(rot.conjugate(q_R), q_IS)
         sigma = np.array([self.sigma_cross, self.sigma_cross, self.sigma_roll])
         nu = sigma * rng.standard_normal((len(q_IS), 3)) * (1.0 if noise else 0.0)

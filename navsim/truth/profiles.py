@@ -128,11 +128,13 @@ class RigidBody:
 class FrameTruth:
     """The truth at one star-sensor frame: attitude q_IB (4,), the mean body rate over the last
     gyro interval omega_B (3,) [rad/s] and, for a sensor on a vehicle near the Earth, the observer's
-    barycentric velocity v_I (3,) [m/s] that aberrates the stars (None: no aberration)."""
+    barycentric velocity v_I (3,) [m/s] that aberrates the stars (None: no aberration) and the air that
+    refracts them, (up_I (3,), A, B) (:func:`navsim.earth.apparent.apparent`; None: none)."""
 
     q_IB: np.ndarray
     omega_B: np.ndarray
     v_I: np.ndarray | None = None
+    air: tuple | None = None
 
 
 @dataclass(frozen=True)

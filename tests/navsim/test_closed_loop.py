@@ -183,6 +183,7 @@ class _ScriptedSensor:
     timing_fields = {}
     sample = None
     uses_prediction = True
+    uses_prior = False
 
     def __init__(self):
         self.verdicts, self.lost = [], 0

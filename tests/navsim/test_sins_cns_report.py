@@ -128,19 +128,21 @@ def test_budget_parts_add_up_and_follow_eq_1(level, tmp_path, capsys):
     assert status == 0, err
     budget = json.loads((out / "budget.json").read_text())
     parts = {row["key"]: row for row in budget["parts"]}
-    assert set(parts) == {"accel_bias", "gravity", "star_noise", "mounting", "aberration", "inertial", "initial", "aiding"}
-    assert parts["mounting"]["status"] == "absent" and parts["accel_bias"]["truth_off"] == [
-        "aiding", "gravity", "inertial", "initial", "mounting", "star_noise"]
+    assert set(parts) == {"accel_bias", "gravity", "star_noise", "mounting", "aberration", "refraction",
+                          "refraction_correction", "inertial", "initial", "aiding"}
+    assert parts["mounting"]["status"] == "absent" and parts["refraction"]["status"] == "absent"
+    assert parts["accel_bias"]["truth_off"] == ["aiding", "gravity", "inertial", "initial", "mounting", "refraction",
+                                                "star_noise"]
     for key in ("accel_bias", "gravity"):
         assert parts[key]["schuler_mean_m"] == pytest.approx(parts[key]["prediction_m"], rel=0.15), key
     assert parts["accel_bias"]["prediction_m"] > 300.0 and parts["gravity"]["prediction_m"] > 100.0
     rss, total = budget["root_sum_square"], budget["total"]
-    assert total["runs"] == 2 and "aberration" not in rss["parts"]
+    assert total["runs"] == 2 and "aberration" not in rss["parts"] and "refraction_correction" not in rss["parts"]
     assert rss["ratio_to_total"]["schuler_mean_m"] == pytest.approx(1.0, abs=0.15)
     assert rss["ratio_to_total"]["rms_m"] == pytest.approx(1.0, abs=0.15)
     assert budget["superposition"]["residual_m"] < 0.01 * budget["superposition"]["total_m"]
     campaign = json.loads((out / "parts" / "initial" / "campaign.json").read_text())
-    assert campaign["truth_off"] == ["accel_bias", "aiding", "gravity", "inertial", "mounting", "star_noise"]
+    assert campaign["truth_off"] == ["accel_bias", "aiding", "gravity", "inertial", "mounting", "refraction", "star_noise"]
     assert campaign["scenario_data"]["filter"] == json.loads((out / "parts" / "total" / "campaign.json").read_text())[
         "scenario_data"]["filter"]
     text, _ = pdf_text(out / "budget.pdf")

@@ -1,0 +1,180 @@
+"""Few-star identification with an attitude prior: which catalog star each of 1-3 detections is.
+
+A daytime star sensor sees one to three stars -- too few for any pattern (lost-in-space needs 3-4, tracking
+refits an attitude from 3). With the attitude the INS predicts and its covariance, each detection is matched
+to the catalog star predicted where it lies, as aircraft star trackers do (the validation gate and Poisson clutter model of
+target tracking: Bar-Shalom, Li & Kirubarajan).
+
+Prediction. A catalog star of direction u (I) is predicted in the sensor at s = R_IS,priorᵀ u. The prior's
+attitude error δθ (sensor axes, covariance P_θ [rad²]) moves it by δs = [s×] δθ, so a detection of measured
+direction o (covariance C_o) of that star has the tangent-plane residual r = T (o − s) of covariance
+
+    S = T ([s×] P_θ [s×]ᵀ + C_o) Tᵀ,     d² = rᵀ S⁻¹ r,                                          (1)
+
+T the 2x3 tangent basis at s. The gate is d² <= χ²₂(p_gate) = −2 ln(1 − p_gate) (the true star falls outside
+it with probability 1 − p_gate), and the magnitudes must agree: |m_obs − m_cat| <= k_m √(σ_obs² + σ_cat²), σ_cat
+the band magnitudes' own error (:mod:`startrack.colours`: 0.10-0.14 mag RMS in J and H).
+
+Uniqueness. A detection is matched to a star only when that star is the only one in its gate and the detection
+the only one in the star's gate.
+
+Wrong match. A detection that is not the star its gate holds lies where the sky puts it independently of the
+catalog: another star whose own entry fell outside the gate (or an object the catalog lacks), or a false
+detection -- which uniqueness leaves only when the star itself went undetected (else two detections share its
+gate). The chance that the match is such a coincidence is
+
+    P_wrong = 1 − exp(−(ρ_m + ρ_f P_miss) A),   A = π χ²₂(p_gate) √det S   [sr],                   (2)
+
+ρ_m the density [sr⁻¹] of catalog stars inside the detection's magnitude window (counted in a cap around the
+predicted boresight), ρ_f the density of false detections the sensor expects (their magnitudes are not
+trusted to reject them), P_miss = Φ((m − m_lim)/0.3 mag) the chance that the star of magnitude m went undetected
+below the frame's limiting magnitude m_lim (1 when the caller gives none). A match is kept when P_wrong <=
+``max_wrong`` (the ceiling). The ρ_m term supposes the detection unrelated to the star whatever its gate
+probability: (2) bounds the rate of wrong matches from above. Not modelled: the planets (bright, not in the
+catalog: the ρ_m term counts stars only).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import norm
+
+from startrack import rotation as rot
+from startrack.errors import InputError
+from startrack.sphere import tangent_basis
+
+#: Radius [rad] of the cap around the predicted boresight in which ρ_m of eq. (2) is counted (at least).
+DENSITY_RADIUS = np.radians(10.0)
+#: Width [mag] of the detection's fall-off around the limiting magnitude in P_miss of eq. (2).
+LIMIT_WIDTH = 0.3
+
+
+@dataclass(frozen=True)
+class PriorMatches:
+    """What :meth:`PriorMatch.match` found: ``obs_index`` (K,) detections and ``star_index`` (K,) the catalog
+    rows they are, each match's ``wrong_probability`` (K,) (eq. 2) and Mahalanobis ``d2`` (K,) (eq. 1);
+    ``rejected`` (M,) why each detection was left: "" (matched), "no star", "ambiguous", "shared",
+    "chance"."""
+
+    obs_index: np.ndarray
+    star_index: np.ndarray
+    wrong_probability: np.ndarray
+    d2: np.ndarray
+    rejected: tuple
+
+
+@dataclass(frozen=True)
+class PriorMatch:
+    """Few-star identification against ``vectors`` (N, 3) catalog unit vectors in I with their magnitudes ``mags``
+    (N,) in the sensor's band (module docstring).
+
+    field_radius: angle [rad] from the boresight within which a star can be detected; gate_probability: p_gate of
+    eq. (1); mag_sigmas: k_m; catalog_mag_sigma: σ_cat [mag]; false_per_frame: the false detections the sensor
+    expects per frame inside its field (ρ_f = that over the field's solid angle); max_wrong: the ceiling of eq. (2).
+    """
+
+    vectors: np.ndarray
+    mags: np.ndarray
+    field_radius: float
+    gate_probability: float = 0.9999
+    mag_sigmas: float = 3.0
+    catalog_mag_sigma: float = 0.15
+    false_per_frame: float = 1.0
+    max_wrong: float = 1e-3
+
+    def __post_init__(self):
+        if not 0.0 < self.field_radius < 0.5 * np.pi:
+            raise InputError(f"prior match: field radius {self.field_radius!r} rad must be in (0, π/2)")
+        if not 0.0 < self.gate_probability < 1.0:
+            raise InputError(f"prior match: gate probability {self.gate_probability!r} must be in (0, 1)")
+        if not 0.0 < self.max_wrong < 1.0:
+            raise InputError(f"prior match: the wrong-match ceiling {self.max_wrong!r} must be in (0, 1)")
+        if self.false_per_frame < 0.0 or self.mag_sigmas <= 0.0 or self.catalog_mag_sigma < 0.0:
+            raise InputError("prior match: false_per_frame and catalog_mag_sigma must be >= 0, mag_sigmas > 0")
+
+    @property
+    def gate(self):
+        """χ²₂(p_gate) = −2 ln(1 − p_gate)."""
+        return -2.0 * np.log1p(-self.gate_probability)
+
+    @property
+    def false_density(self):
+        """ρ_f [sr⁻¹]: the expected false detections over the field's solid angle."""
+        return self.false_per_frame / (2.0 * np.pi * (1.0 - np.cos(self.field_radius)))
+
+    def match(self, obs_S, obs_mag, obs_mag_sigma, cov_S, q_IS, P_theta, limiting_mag=None, apparent=None):
+        """The matches (:class:`PriorMatches`) of detections ``obs_S`` (M, 3) (unit, sensor axes) of magnitudes
+        ``obs_mag`` (M,) ± ``obs_mag_sigma`` (M,) and direction covariances ``cov_S`` (M, 3, 3) [rad²], for the
+        prior attitude ``q_IS`` (4,) whose error in sensor axes has the covariance ``P_theta`` (3, 3) [rad²], on a
+        frame of limiting magnitude ``limiting_mag`` (None: unknown, any star may have been missed); ``apparent`` maps
+        catalog unit vectors (K, 3) in I to the directions the sensor sees them at (aberration, refraction; None: the
+        catalog's)."""
+        obs_S = np.atleast_2d(np.asarray(obs_S, dtype=float))
+        R_SI = rot.to_matrix(np.asarray(q_IS, dtype=float)).T
+        boresight = R_SI[2]
+        reach = self.field_radius + 5.0 * np.sqrt(max(np.linalg.eigvalsh(P_theta)[-1], 0.0))
+        candidates = np.flatnonzero(self.vectors @ boresight >= np.cos(min(reach, np.pi)))
+        u = self.vectors[candidates]
+        s = (u if apparent is None else apparent(u)) @ R_SI.T  # predicted directions (K, 3) in S
+        d2, area = _mahalanobis(obs_S, np.asarray(cov_S, dtype=float), s, np.asarray(P_theta, dtype=float))
+        window = self.mag_sigmas * np.hypot(np.asarray(obs_mag_sigma, dtype=float), self.catalog_mag_sigma)
+        mag_ok = np.abs(np.asarray(obs_mag, dtype=float)[:, None] - self.mags[candidates][None, :]) <= window[:, None]
+        inside = (d2 <= self.gate) & mag_ok
+        density = self._window_density(boresight, np.asarray(obs_mag, dtype=float), window)
+        miss = (np.ones(candidates.size) if limiting_mag is None
+                else norm.cdf((self.mags[candidates] - limiting_mag) / LIMIT_WIDTH))
+        return self._unique(inside, d2, area, density, miss, candidates)
+
+    def _window_density(self, boresight, obs_mag, window):
+        """ρ_m (M,) [sr⁻¹]: catalog stars within each detection's magnitude window per steradian of the cap of
+        radius max(:data:`DENSITY_RADIUS`, the field radius) around the boresight."""
+        radius = max(DENSITY_RADIUS, self.field_radius)
+        near = self.mags[self.vectors @ boresight >= np.cos(radius)]
+        counts = np.array([np.count_nonzero(np.abs(near - m) <= w) for m, w in zip(obs_mag, window)])
+        return np.maximum(counts, 1) / (2.0 * np.pi * (1.0 - np.cos(radius)))
+
+    def _unique(self, inside, d2, area, density, miss, candidates):
+        """The mutually unique gate pairs, each kept when its eq. (2) is under the ceiling."""
+        per_obs, per_star = inside.sum(axis=1), inside.sum(axis=0)
+        obs_index, star_index, wrong, dist, rejected = [], [], [], [], []
+        for i in range(inside.shape[0]):
+            if per_obs[i] == 0:
+                rejected.append("no star")
+                continue
+            if per_obs[i] > 1:
+                rejected.append("ambiguous")
+                continue
+            k = int(np.flatnonzero(inside[i])[0])
+            if per_star[k] > 1:
+                rejected.append("shared")
+                continue
+            p = -np.expm1(-(density[i] + self.false_density * miss[k]) * self.gate * area[i, k])
+            if p > self.max_wrong:
+                rejected.append("chance")
+                continue
+            rejected.append("")
+            obs_index.append(i)
+            star_index.append(int(candidates[k]))
+            wrong.append(p)
+            dist.append(d2[i, k])
+        return PriorMatches(obs_index=np.array(obs_index, np.int64), star_index=np.array(star_index, np.int64),
+                            wrong_probability=np.array(wrong), d2=np.array(dist), rejected=tuple(rejected))
+
+
+def _mahalanobis(obs_S, cov_S, s, P_theta):
+    """(d² (M, K) of eq. (1), gate-ellipse area per unit χ², π √det S (M, K) [sr]) of every detection against every
+    predicted star s (K, 3)."""
+    T = tangent_basis(s)  # (K, 2, 3)
+    cross = np.zeros((len(s), 3, 3))
+    cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -s[:, 2], s[:, 1], -s[:, 0]
+    cross[:, 1, 0], cross[:, 2, 0], cross[:, 2, 1] = s[:, 2], -s[:, 1], s[:, 0]
+    prior = np.einsum("kab,kbc,kdc->kad", T @ cross, P_theta[None], T @ cross)  # (K, 2, 2)
+    meas = np.einsum("kab,mbc,kdc->mkad", T, cov_S, T)  # (M, K, 2, 2)
+    S = prior[None] + meas
+    r = np.einsum("kab,mkb->mka", T, obs_S[:, None, :] - s[None, :, :])
+    det = S[..., 0, 0] * S[..., 1, 1] - S[..., 0, 1] * S[..., 1, 0]
+    d2 = (S[..., 1, 1] * r[..., 0] ** 2 - 2.0 * S[..., 0, 1] * r[..., 0] * r[..., 1] + S[..., 0, 0] * r[..., 1] ** 2) / det
+    behind = (obs_S @ s.T) <= 0.0
+    return np.where(behind, np.inf, d2), np.pi * np.sqrt(det)
