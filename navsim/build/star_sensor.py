@@ -125,7 +125,12 @@ def vector_equivalent(scenario, star_catalog, frame_interval, epoch):
     table = scenario["star_sensor"]
     q_BS, _ = mounting(table)
     if table["fidelity"] != "image":
-        return dataclasses.replace(star_sensor(scenario, star_catalog, frame_interval, epoch), q_BS_true=q_BS), None
+        sensor = dataclasses.replace(star_sensor(scenario, star_catalog, frame_interval, epoch), q_BS_true=q_BS)
+        if getattr(sensor, "identification", None) is None:
+            return sensor, None
+        return dataclasses.replace(sensor, identification=None), (
+            "the detections named with the INS's prior (star_sensor.identification) taken to be every detected star, "
+            "none false: the runs leave those the wrong-match ceiling rejects")
     image, fov = table["image"], float(units.deg_to_rad(table["fov_deg"]))
     stars = star_catalog.in_band(table["band"]).brighter_than(table["mag_limit"])
     sensor_camera = camera(table)
