@@ -17,8 +17,8 @@ refraction acts on the aberrated direction (the light's direction at the observe
 
 import numpy as np
 
-from startrack import rotation as rot
 from navsim.earth.refraction import refract
+from startrack import rotation as rot
 from startrack.aberration import aberrate
 
 
@@ -45,6 +45,4 @@ def field_stars(stars_I, boresight_I, radius, v_I, air=None):
     the boresight, seen by the observer of velocity ``v_I`` (3,) [m/s] through ``air`` (a frame's (up_I (3,),
     A, B); None: no air)."""
     index = np.flatnonzero(stars_I @ boresight_I >= np.cos(radius))
-    rows = None if air is None else tuple(np.broadcast_to(x, (index.size, 3) if k == 0 else (index.size,))
-                                          for k, x in enumerate(air))
-    return index, apparent(stars_I[index], v_I, rows)
+    return index, apparent(stars_I[index], v_I, air)

@@ -20,7 +20,15 @@ horizon). A star sensor's ``min_elevation_deg`` keeps it above that.
 
 A vehicle's truth sees the stars refracted by the real air, its processing corrects them with the model air
 at the height its INS gives: the difference -- a pressure error ε_p and a temperature error δT of the real
-air against the model -- is left in every star (:class:`Air`).
+air against the model -- is left in every star (:class:`Air`). To first order it is the correction scaled by the
+real air's fractional excess ε = A_real/A_model − 1 (:meth:`Air.fraction`):
+
+    u_real − u_model = ε (u_model − u),                                                              (3)
+
+u the aberrated direction and u_model its refraction by the model air: one number for all the stars of a frame,
+which the navigation filter carries as a consider state of σ :meth:`Air.fraction_sigma`. Exact for a pressure error
+(A and B are both ∝ p); a temperature error changes B unlike A, which leaves 1.3 % of its residual at 15° of
+elevation, 0.3 % at 30° (3 K at 11 km: 0.011" of 0.88" at 15°).
 """
 
 from dataclasses import dataclass
@@ -55,10 +63,28 @@ class Air:
         """This air as the processing models it: the standard atmosphere, no error."""
         return Air(self.wavelength_um)
 
+    def fraction(self, h):
+        """ε (...,) at heights h [m]: this air's refraction as a fraction of the model air's, A/A_76 − 1 of eq. (1). A
+        processing that corrects with the model air leaves ε times its correction in every star (eq. 3)."""
+        return self.coefficients(h)[0] / self.modelled().coefficients(h)[0] - 1.0
+
+    def fraction_sigma(self, h, pressure_sigma, temperature_sigma):
+        """σ_ε (...,) at heights h [m] of an air whose pressure (a fraction) and temperature [K] are uncertain by
+        those σ about this one: the sensitivities of ε by central differences of :meth:`fraction`, in
+        root-sum-square (the two independent)."""
+        dp, dT = 1e-3, 0.1
+        slope_p = (self._shifted(dp, 0.0).fraction(h) - self._shifted(-dp, 0.0).fraction(h)) / (2.0 * dp)
+        slope_T = (self._shifted(0.0, dT).fraction(h) - self._shifted(0.0, -dT).fraction(h)) / (2.0 * dT)
+        return np.hypot(slope_p * pressure_sigma, slope_T * temperature_sigma)
+
+    def _shifted(self, pressure, temperature):
+        return Air(self.wavelength_um, self.pressure_error + pressure, self.temperature_error + temperature)
+
 
 def refract(u, up, a, b):
     """Observed directions (N, 3) of the vacuum unit directions ``u`` (N, 3) for the local vertical ``up``
-    (N, 3) and the coefficients ``a``, ``b`` (N,) [rad] of eq. (1): each turned towards the zenith by eq. (2)."""
+    (N, 3) and the coefficients ``a``, ``b`` (N,) [rad] of eq. (1), or one of each for all: each turned towards the
+    zenith by eq. (2)."""
     u, up = np.atleast_2d(u), np.atleast_2d(up)
     s = np.sum(u * up, axis=-1)
     horizontal = u - s[:, None] * up

@@ -223,6 +223,23 @@ def joseph_update_attitude(P, R, z, estimated):
 
 
 @njit
+def tangent_basis(s):
+    """(e1, e2): the basis of the plane ⟂ the unit vector s of a star residual, e1 = s × (the axis least aligned
+    with s) normalised, e2 = s × e1."""
+    axis = np.zeros(3)
+    ax = np.abs(s)
+    if ax[0] <= ax[1] and ax[0] <= ax[2]:
+        axis[0] = 1.0
+    elif ax[1] <= ax[2]:
+        axis[1] = 1.0
+    else:
+        axis[2] = 1.0
+    e1 = np.cross(s, axis)
+    e1 /= np.sqrt(np.sum(e1 * e1))
+    return e1, np.cross(s, e1)
+
+
+@njit
 def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mounting):
     """Tangent-plane residuals of identified stars against the estimates q_IB, q_BS, their Jacobians and
     their measurement covariances.
@@ -242,18 +259,7 @@ def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mounting):
     for k in range(m):
         b_hat = R_IB.T @ ref_I[k]
         s_hat = R_SB @ b_hat
-        # tangent basis: e1 = s × (axis least aligned with s), e2 = s × e1
-        axis = np.zeros(3)
-        ax = np.abs(s_hat)
-        if ax[0] <= ax[1] and ax[0] <= ax[2]:
-            axis[0] = 1.0
-        elif ax[1] <= ax[2]:
-            axis[1] = 1.0
-        else:
-            axis[2] = 1.0
-        e1 = np.cross(s_hat, axis)
-        e1 /= np.sqrt(np.sum(e1 * e1))
-        e2 = np.cross(s_hat, e1)
+        e1, e2 = tangent_basis(s_hat)
         d = obs_S[k] - s_hat
         z[k, 0] = np.sum(e1 * d)
         z[k, 1] = np.sum(e2 * d)

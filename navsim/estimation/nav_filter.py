@@ -6,10 +6,11 @@ The filter owns the nominal navigation state (the strapdown ``nav`` vector of
 biases, optional scale factors, the star sensor's mounting q̂_BS) and the covariance P of the error
 state (:mod:`navsim.estimation.nav_kernels`, docs/design.md):
 
-    x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg)],   C_nb,est = (I − [φ×]) C_nb,true,
+    x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg) (, ε_r)],   C_nb,est = (I − [φ×]) C_nb,true,
 
-μ the star-sensor mounting error (estimated or a consider state) and δg the gravity disturbance the
-INS does not know (consider states: Schmidt). ``predict(samples, dt)`` mechanizes the corrected IMU
+μ the star-sensor mounting error (estimated or a consider state), δg the gravity disturbance the
+INS does not know and ε_r the fractional error of the air its star processing corrects the refraction with
+(consider states: Schmidt). ``predict(samples, dt)`` mechanizes the corrected IMU
 samples at the IMU rate and propagates P every ``covariance_interval`` intervals (Φ, Q_d by series,
 tested against expm and Van Loan); the updates — ``update_position``, ``update_baro``,
 ``update_attitude`` (a star-sensor fix) and ``update_stars`` (identified stars one by one,
@@ -28,15 +29,15 @@ import numpy as np
 
 from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import local_up, q_en
-from navsim.earth.refraction import refract
 from navsim.earth.orientation import observer_velocity
+from navsim.earth.refraction import refract
 from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
 from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult, star_covariances
-from navsim.sensors.star_sensor import SensorPrior
 from navsim.ins import strapdown
+from navsim.sensors.star_sensor import SensorPrior
 from startrack import rotation as rot
 from startrack.aberration import aberrate
 from startrack.errors import InputError
@@ -75,13 +76,20 @@ class StarSensorModel:
     frames (:class:`~navsim.earth.orientation.EarthOrientation`), whether its processing
     corrects the aberration of the stars (``correct_aberration``, :mod:`navsim.earth.apparent`) and the air
     it corrects their refraction with at the INS's height (``refraction``, a
-    :class:`navsim.earth.refraction.Air`; None: no correction)."""
+    :class:`navsim.earth.refraction.Air`; None: no correction) and the σ of that air's fractional error
+    (``refraction_sigma``, eq. 3 of :mod:`navsim.earth.refraction`; > 0: the consider state ε_r)."""
 
     q_BS: np.ndarray
     mounting: str
     orientation: object
     correct_aberration: bool = True
     refraction: object = None
+    refraction_sigma: float = 0.0
+
+    @property
+    def refraction_state(self):
+        """Whether the filter carries ε_r."""
+        return self.refraction is not None and self.refraction_sigma > 0.0
 
 
 @dataclass(frozen=True)
@@ -146,7 +154,8 @@ class NavFilterConfig:
     @property
     def layout(self):
         """The error state's layout (:func:`navsim.estimation.nav_kernels.layout`)."""
-        return nav_kernels.layout(self.estimate_scale_factors, self.mounting != "ignore", self.gravity is not None)
+        return nav_kernels.layout(self.estimate_scale_factors, self.mounting != "ignore", self.gravity is not None,
+                                  self.star_sensor is not None and self.star_sensor.refraction_state)
 
 
 class NavFilter:
@@ -171,7 +180,9 @@ class NavFilter:
         if config.mounting == "consider":
             self.estimated[self.layout.mounting:self.layout.mounting + 3] = False
         if config.gravity is not None:
-            self.estimated[self.layout.gravity:] = False
+            self.estimated[self.layout.gravity:self.layout.gravity + 3] = False
+        if self.layout.refraction >= 0:
+            self.estimated[self.layout.refraction] = False
         self.baro_estimated = self.estimated.copy()
         if config.baro_states == "vertical":
             self.baro_estimated[:] = False
@@ -226,11 +237,13 @@ class NavFilter:
         at 3 dof (:func:`celestial_kernels.fix_update`); the fix is first turned back by the aberration
         rotation of its boresight when the processing corrects aberration."""
         j = self._frame()
-        q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
+        q_IS = np.asarray(q_IS, dtype=float)
+        rho = self._refraction_rotation(j, q_IS) if self.layout.refraction >= 0 else np.zeros(3)
+        q_IS = self._corrected_fix(q_IS, j)
         R = self.sigma_scale**2 * np.asarray(R_S, dtype=float)
         z, nis, accepted = celestial_kernels.fix_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                         self.star_sensor.orientation.q_ie[j], q_IS, R, self.gates[0],
-                                                        self.estimated)
+                                                        self.estimated, rho)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]))
 
     def update_stars(self, ref_I, obs_S, cov_S):
@@ -240,12 +253,12 @@ class NavFilter:
         apparent with the filter's own velocity and the ephemeris when the processing corrects aberration, and
         refracted by its model air at the INS's position when it corrects refraction."""
         j = self._frame()
-        ref_I = self._apparent(j)(np.asarray(ref_I, dtype=float))
+        aberrated, ref_I = self._seen(j)(np.asarray(ref_I, dtype=float))
         z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                           self.star_sensor.orientation.q_ie[j], ref_I,
                                                           np.ascontiguousarray(obs_S, dtype=float),
                                                           star_covariances(cov_S, ref_I.shape[0], self.sigma_scale**2),
-                                                          self.gates[2], self.estimated)
+                                                          self.gates[2], self.estimated, ref_I - aberrated)
         return UpdateResult(z=z, nis=nis, accepted=accepted, per_row=True)
 
     def sensor_prediction(self, last_sample):
@@ -286,8 +299,9 @@ class NavFilter:
     def sensor_prior(self):
         """The star sensor's :class:`~navsim.sensors.star_sensor.SensorPrior` at this frame: q̂_IS (as
         :meth:`sensor_prediction`), the covariance of its error in sensor axes, δθ_S = R_SB A x + μ (A of eq. 1 of
-        :mod:`navsim.estimation.celestial_kernels`, μ when the mounting is a state), and the processing that makes
-        catalog stars apparent (:meth:`update_stars`'s)."""
+        :mod:`navsim.estimation.celestial_kernels`, μ when the mounting is a state, the turn of the field by the
+        refraction state's −ε_r R_SI ρ when it has one), and the processing that makes catalog stars apparent
+        (:meth:`update_stars`'s)."""
         j = self._frame()
         nav_kernels.flush(self._nav, self._P, self._acc, self.model)
         R_SB = rot.to_matrix(self._calib[12:16]).T
@@ -295,24 +309,35 @@ class NavFilter:
         if self.layout.mounting >= 0:
             G[:, self.layout.mounting:self.layout.mounting + 3] += np.eye(3)
         q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
-        return SensorPrior(q_IS=rot.multiply(q_IB, self._calib[12:16]), P_theta=G @ self._P @ G.T,
-                           apparent=self._apparent(j))
+        q_IS = rot.multiply(q_IB, self._calib[12:16])
+        if self.layout.refraction >= 0:  # the field turned by ε_r ρ: an attitude error −ε_r R_SI ρ (fix_terms)
+            G[:, self.layout.refraction] = -(rot.to_matrix(q_IS).T @ self._refraction_rotation(j, q_IS))
+        return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=self._apparent(j))
+
+    def _refraction_rotation(self, j, q_IS):
+        """ρ (3,) [rad, ICRS axes]: the rotation vector by which the processing's model air raises the (aberrated)
+        boresight of the sensor attitude ``q_IS`` at frame ``j``, b × refract(b) (eq. 3 of :mod:`navsim.earth.refraction`)."""
+        aberrated, refracted = self._seen(j)(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))[None, :])
+        return np.cross(aberrated[0], refracted[0])
 
     def _apparent(self, j):
         """The processing's map of catalog unit vectors (N, 3) to their apparent directions at frame ``j`` (contiguous):
         aberrated with the INS's velocity when it corrects aberration, refracted by its model air at the INS's
         position when it corrects refraction (the state of now, held)."""
+        seen = self._seen(j)
+        return lambda u: seen(u)[1]
+
+    def _seen(self, j):
+        """The processing's map of catalog unit vectors (N, 3) to (aberrated, apparent) directions at frame ``j``
+        (:meth:`_apparent`; their difference is the refraction it corrects)."""
         v = self._observer_velocity(j) if self.star_sensor.correct_aberration else None
         air = self._air(j)
 
-        def apparent(u):
-            seen = u if v is None else aberrate(u, v)
-            if air is not None:
-                n = seen.shape[0]
-                seen = refract(seen, np.broadcast_to(air[0], (n, 3)), np.full(n, air[1]), np.full(n, air[2]))
-            return np.ascontiguousarray(seen)
+        def seen(u):
+            aberrated = np.ascontiguousarray(u if v is None else aberrate(u, v))
+            return aberrated, aberrated if air is None else np.ascontiguousarray(refract(aberrated, *air))
 
-        return apparent
+        return seen
 
     def _air(self, j):
         """(up_I (3,), A, B) of the processing's refraction correction at frame ``j`` and the INS's position, or None."""
@@ -330,8 +355,7 @@ class NavFilter:
             return q_IS
         boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
         v = self._observer_velocity(j) if correct else np.zeros(3)
-        rows = None if air is None else (air[0][None, :], np.atleast_1d(air[1]), np.atleast_1d(air[2]))
-        return rot.normalize(rot.multiply(fix_rotation(boresight, v, rows), q_IS))
+        return rot.normalize(rot.multiply(fix_rotation(boresight, v, air), q_IS))
 
     def process_record(self, samples, ratio, dt, record):
         """The compiled fast path: the whole :class:`~navsim.sensors.aiding.AidingRecord` at once
@@ -414,6 +438,8 @@ def state_names(layout):
         names += ["mu_x", "mu_y", "mu_z"]
     if layout.gravity >= 0:
         names += ["dg_N", "dg_E", "dg_D"]
+    if layout.refraction >= 0:
+        names += ["refraction"]
     return names
 
 

@@ -5,14 +5,16 @@ the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kerne
 Error state x (zero between updates; docs/design.md), each optional group where :class:`Layout`
 puts it:
 
-    [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) | μ (3) | δg (3)]
+    [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) | μ (3) | δg (3) | ε_r]
 
 with C_nb,est = (I − [φ×]) C_nb,true, δv = v_est − v_true, δL = L_est − L_true (…), ε = b_g,true −
 b̂_g and ∇ = b_a,true − b̂_a (the residual biases of the corrected increments), δs = s_true − ŝ, the
 star-sensor mounting error μ (q_BS,true = q̂_BS ⊗ δq(μ), μ in sensor axes) and the gravity
 disturbance of the truth δg = [−ξγ, −ηγ, Δg] (NED) that the INS does not know: a first-order
 Gauss-Markov process in travelled distance (σ, correlation length D: in time, 1/τ = V/D with V the
-horizontal speed; a random constant when D is infinite), kept as consider states (Schmidt).
+horizontal speed; a random constant when D is infinite), kept as consider states (Schmidt), and the fractional
+error ε_r of the air the star sensor's processing corrects the refraction with (eq. 3 of
+:mod:`navsim.earth.refraction`: a random constant, a consider state).
 Corrected increments are (1 − ŝ)(Δθ̃ − b̂_g Δt) and (1 − ŝ_a)(Δṽ − b̂_a Δt).
 
 The filter's estimates beside the strapdown ``nav`` vector are ``calib`` (:data:`CALIB_SIZE`):
@@ -38,17 +40,17 @@ BASE_STATES = 15
 #: Size of the ``calib`` vector: biases, scale factors, mounting quaternion q̂_BS.
 CALIB_SIZE = 16
 #: Where each optional group of the error state starts (−1: absent), and the state count n.
-Layout = namedtuple("Layout", "n scale mounting gravity")
+Layout = namedtuple("Layout", "n scale mounting gravity refraction")
 #: What the kernels need of the filter's model: the constant continuous noise densities ``q_c`` (n,),
 #: the gravity disturbance's ``gm`` = (σ_N², σ_E², σ_D² [m²/s⁴], 1/D [1/m]), the IMU interval ``dt``
 #: [s], the covariance interval ``every`` [IMU intervals] and the :class:`Layout`.
 NavModel = namedtuple("NavModel", "q_c gm dt every layout")
 
 
-def layout(scale_factors=False, mounting=False, gravity=False):
+def layout(scale_factors=False, mounting=False, gravity=False, refraction=False):
     """The :class:`Layout` of an error state with the chosen optional groups, in their fixed order."""
     n, starts = BASE_STATES, []
-    for present, size in ((scale_factors, 6), (mounting, 3), (gravity, 3)):
+    for present, size in ((scale_factors, 6), (mounting, 3), (gravity, 3), (refraction, 1)):
         starts.append(n if present else -1)
         n += size if present else 0
     return Layout(n, *starts)

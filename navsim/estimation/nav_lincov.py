@@ -38,10 +38,14 @@ TruthLayout = namedtuple("TruthLayout", "base gyro_gm accel_gm gyro_mis accel_mi
 #: the refraction's (``refraction_source``: the real air against the processing's model, or all of it
 #: uncorrected) is the difference between the residuals against ``star_ref`` and against ``star_ref_real``
 #: (``fix_q``, ``fix_q_real``: the processing with the real air's refraction), the rest (an uncorrected
-#: aberration: ``offset_source``) the residual against ``star_ref_real``.
-Measurements = namedtuple("Measurements", "star_offsets star_ref star_ref_real star_obs star_cov fix_mask fix_q fix_q_real "
-                                          "fix_R position_mask position_sigma baro_mask baro_var baro_filter_var "
-                                          "baro_offset r_scale2 star_source aiding_source offset_source refraction_source")
+#: aberration: ``offset_source``) the residual against ``star_ref_real``. When the filter carries the refraction
+#: state ε_r (the truth's then holds the real air's as its mean), the refraction is that state's, through the
+#: columns of ``star_shift`` (M, 3) (the refraction of each star the processing corrects) and ``fix_rho`` (F, 3) (the
+#: rotation vector of the fixes' boresights) (:func:`navsim.estimation.celestial_kernels.star_terms`, ``fix_terms``).
+Measurements = namedtuple("Measurements", "star_offsets star_ref star_ref_real star_shift star_obs star_cov fix_mask "
+                                          "fix_q fix_q_real fix_rho fix_R position_mask position_sigma baro_mask baro_var "
+                                          "baro_filter_var baro_offset r_scale2 star_source aiding_source offset_source "
+                                          "refraction_source")
 #: The off-diagonal terms (i, j) of a misalignment matrix M, in the order of its six states.
 MISALIGNMENT_PAIRS = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
 #: The leading block kept in full at every output frame: φ, δv, δL, δλ, δh.
@@ -142,9 +146,9 @@ def _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, span, tl, truth_q, 
 @njit
 def _update_stars(P, mean, P_f, nav, q_ie, q_BS, rows, meas, tl, W, estimated):
     """All stars of a frame as one measurement (the filter fuses the accepted stars together)."""
-    obs, cov = meas.star_obs[rows[0]:rows[1]], meas.star_cov[rows[0]:rows[1]]
-    z, H, R = star_terms(nav, q_BS, q_ie, meas.star_ref[rows[0]:rows[1]], obs, cov, tl.base)
-    z_real = star_terms(nav, q_BS, q_ie, meas.star_ref_real[rows[0]:rows[1]], obs, cov, tl.base)[0]
+    obs, cov, shift = meas.star_obs[rows[0]:rows[1]], meas.star_cov[rows[0]:rows[1]], meas.star_shift[rows[0]:rows[1]]
+    z, H, R = star_terms(nav, q_BS, q_ie, meas.star_ref[rows[0]:rows[1]], obs, cov, tl.base, shift)
+    z_real = star_terms(nav, q_BS, q_ie, meas.star_ref_real[rows[0]:rows[1]], obs, cov, tl.base, shift)[0]
     m = z.shape[0]
     H_t, R_t, d, d_real = np.zeros((2 * m, tl.n)), np.zeros((2 * m, 2 * m)), np.empty(2 * m), np.empty(2 * m)
     for k in range(m):
@@ -153,15 +157,15 @@ def _update_stars(P, mean, P_f, nav, q_ie, q_BS, rows, meas, tl, W, estimated):
             d[2 * k + r], d_real[2 * k + r] = z[k, r], z_real[k, r]
             for c in range(2):
                 R_t[2 * k + r, 2 * k + c] = R[k, r, c]
-    _offset_update(P, mean, P_f, W, H_t, R_t, meas, d, d_real, estimated)
+    _offset_update(P, mean, P_f, W, H_t, R_t, meas, d, d_real, estimated, tl)
 
 
 @njit
-def _offset_update(P, mean, P_f, W, H_t, R_t, meas, d, d_real, estimated):
+def _offset_update(P, mean, P_f, W, H_t, R_t, meas, d, d_real, estimated, tl):
     """A star-sensor measurement whose deterministic offset d splits into the refraction's d − d_real and the
-    rest's d_real (:data:`Measurements`)."""
+    rest's d_real (:data:`Measurements`); the refraction's is the truth's state ε_r when it has one."""
     B = update(P, mean, P_f, W, H_t, R_t, meas.r_scale2 * R_t, d_real, estimated, meas.star_source, meas.offset_source)
-    if meas.refraction_source >= 0:
+    if meas.refraction_source >= 0 and tl.base.refraction < 0:
         mean[meas.refraction_source] -= B @ (d - d_real)
 
 
@@ -223,9 +227,9 @@ def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_
         if rows[1] > rows[0]:
             _update_stars(P, mean, P_f, nav, q_ie[f], q_BS, rows, meas, tl, W, estimated)
         if meas.fix_mask[f]:
-            z, H, R = fix_terms(nav, q_BS, q_ie[f], meas.fix_q[f], meas.fix_R, tl.base)
-            z_real = fix_terms(nav, q_BS, q_ie[f], meas.fix_q_real[f], meas.fix_R, tl.base)[0]
-            _offset_update(P, mean, P_f, W, _embed(H, n_t), R, meas, z, z_real, estimated)
+            z, H, R = fix_terms(nav, q_BS, q_ie[f], meas.fix_q[f], meas.fix_R, tl.base, meas.fix_rho[f])
+            z_real = fix_terms(nav, q_BS, q_ie[f], meas.fix_q_real[f], meas.fix_R, tl.base, meas.fix_rho[f])[0]
+            _offset_update(P, mean, P_f, W, _embed(H, n_t), R, meas, z, z_real, estimated, tl)
         _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
         if (f + 1) % stride == 0 or f == frames - 1:
             keep(log, out, end * dt, P, mean, P_f, T, n_f)

@@ -86,15 +86,17 @@ def star_sensor(scenario, star_catalog, lanes=()):
                                     catalog_epoch(scenario), lanes)
 
 
-def star_sensor_model(scenario, orientation):
+def star_sensor_model(scenario, orientation, h):
     """The filter's :class:`~navsim.estimation.nav_filter.StarSensorModel` (nominal mounting, treatment
-    of its error, the Earth's orientation at the frames, aberration and refraction correction), or None."""
+    of its error, the Earth's orientation at the frames, aberration and refraction correction with the σ of
+    its air at the start height ``h`` [m]), or None."""
     if "star_sensor" not in scenario.data:
         return None
     sensor = scenario["star_sensor"]
     q_BS, _ = mounting(sensor)
     return StarSensorModel(q_BS=q_BS, mounting=scenario["filter"]["mounting"], orientation=orientation,
-                           correct_aberration=sensor["aberration_correction"], refraction=modelled_air(scenario))
+                           correct_aberration=sensor["aberration_correction"], refraction=modelled_air(scenario),
+                           refraction_sigma=refraction_sigma(scenario, h))
 
 
 def real_air(scenario, truth_off=()):
@@ -116,6 +118,24 @@ def refraction_residual(scenario):
 def modelled_air(scenario):
     """The air the processing corrects the refraction with (the standard atmosphere), or None when it does not."""
     return real_air(scenario).modelled() if scenario["star_sensor"]["refraction"]["correction"] else None
+
+
+def refraction_sigma(scenario, h):
+    """σ of the fractional error ε_r of the processing's model air at height ``h`` [m] (its consider state: 0 for
+    none), from ``star_sensor.refraction``'s pressure and temperature σ (:meth:`~navsim.earth.refraction.Air.fraction_sigma`)."""
+    air = modelled_air(scenario)
+    refraction = scenario["star_sensor"]["refraction"]
+    if air is None:
+        return 0.0
+    return float(air.fraction_sigma(h, refraction["pressure_sigma_percent"] / 100.0, refraction["temperature_sigma_k"]))
+
+
+def refraction_fraction(scenario, h, truth_off=()):
+    """The truth's ε_r (...,) at heights ``h`` [m]: the real air's refraction as a fraction of the processing's model
+    (0 without a correction: no model to err)."""
+    if modelled_air(scenario) is None:
+        return np.zeros(np.shape(h))
+    return real_air(scenario, truth_off).fraction(h)
 
 
 def gravity_uncertainty(scenario, lat, h):
@@ -154,7 +174,7 @@ def estimates_scale_factors(scenario, gyro, accel):
 
 
 def initial_covariance(scenario, gyro, accel, lat, h):
-    """P0 (n x n, diagonal) of the error state [φ, δv, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg)] at (L, h).
+    """P0 (n x n, diagonal) of the error state [φ, δv, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg) (, ε_r)] at (L, h).
 
     Defaults from the datasheets: the tilt of levelling, σ_∇/γ, and the heading of gyrocompassing,
     σ_ε/(ω_ie cos L) (at most 10 deg) (Titterton & Weston, 2nd ed., ch. 10), with σ the turn-on and
@@ -180,6 +200,8 @@ def initial_covariance(scenario, gyro, accel, lat, h):
     gravity = gravity_uncertainty(scenario, lat, h)
     if gravity is not None:
         sigma += list(gravity.sigma)
+    if "star_sensor" in scenario.data and refraction_sigma(scenario, h) > 0.0:
+        sigma.append(refraction_sigma(scenario, h))
     return np.diag(np.square(np.array(sigma, dtype=float)))
 
 
@@ -192,7 +214,7 @@ def filter_config(scenario, gyro, accel, lat, h, dt, orientation=None):
     noise = ImuNoise(arw=gyro.arw, vrw=accel.vrw, gyro_bias_rw=gyro.filter_rrw, accel_bias_rw=accel.filter_bias_rw)
     return NavFilterConfig(initial_covariance(scenario, gyro, accel, lat, h), noise, dt,
                            estimate_scale_factors=estimates_scale_factors(scenario, gyro, accel),
-                           star_sensor=star_sensor_model(scenario, orientation), gravity=gravity_uncertainty(scenario, lat, h),
+                           star_sensor=star_sensor_model(scenario, orientation, h), gravity=gravity_uncertainty(scenario, lat, h),
                            covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"],
                            process_noise_scale=f["process_noise_scale"], measurement_noise_scale=f["measurement_noise_scale"],
                            baro_states=f["baro_states"])

@@ -168,8 +168,10 @@ def aberration(series, sky, orientation, q_BS_true, corrected, steady):
 
 def refraction(series, sky, orientation, q_BS_true, keys, modelled, steady):
     """The refraction of the true boresight by the real air [arcsec, mean and max over the steady frames], its
-    residual against the processing's model air at the true height, and their position costs R·ΔZ [m] (module
-    docstring); ``keys`` the scenario's ``star_sensor.refraction`` table."""
+    residual against the processing's model air at the true height, their position costs R·ΔZ [m] (module
+    docstring) and, when the filter carries it, its refraction consider state: the truth's ε_r and the filter's σ
+    (``considered``: {"fraction_true", "fraction_sigma"} of the last frame [-], else None); ``keys`` the scenario's
+    ``star_sensor.refraction`` table."""
     boresight = _boresight(sky, q_BS_true)
     at_rest = np.zeros_like(boresight)
     real = rot.to_rotation_vector(fix_rotation(boresight, at_rest, sky.air(slice(None))))
@@ -180,7 +182,17 @@ def refraction(series, sky, orientation, q_BS_true, keys, modelled, steady):
             "temperature_error_k": keys["temperature_error_k"], "total_arcsec": _arcsec(real, steady),
             "residual_arcsec": _arcsec(residual, steady),
             "residual_position_m": _position_cost(_in_navigation_axes(residual, series, orientation), series, steady),
-            "uncorrected_position_m": _position_cost(_in_navigation_axes(real, series, orientation), series, steady)}
+            "uncorrected_position_m": _position_cost(_in_navigation_axes(real, series, orientation), series, steady),
+            "considered": _considered(series)}
+
+
+def _considered(series):
+    """The refraction consider state at the last frame (truth and σ) or None (:func:`refraction`)."""
+    names = list(series["state_names"])
+    if "refraction" not in names:
+        return None
+    i = names.index("refraction")
+    return {"fraction_true": float(series["error_state"][-1, i]), "fraction_sigma": float(series["error_sigma"][-1, i])}
 
 
 def _boresight(sky, q_BS_true):

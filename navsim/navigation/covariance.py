@@ -68,7 +68,7 @@ STATE_UNITS = (("phi", "arcsec", units.ARCSEC), ("dv", "m/s", 1.0), ("dlat", "m"
                ("ggm", "deg/h", units.DEG / units.HOUR), ("agm", "micro_g", 1e-6 * units.STANDARD_GRAVITY),
                ("dsg", "ppm", units.PPM), ("dsa", "ppm", units.PPM), ("mu", "arcsec", units.ARCSEC),
                ("dg", "mGal", units.MILLIGAL), ("mg", "arcsec", units.ARCSEC), ("ma", "arcsec", units.ARCSEC),
-               ("baro", "m", 1.0))
+               ("baro", "m", 1.0), ("refraction", "%", 0.01))
 
 
 @dataclass(frozen=True)
@@ -97,7 +97,7 @@ def truth_layout(scenario, gyro, accel, baro, filter_layout):
     gravity = build.gravity_disturbance(scenario)
     base = nav_layout(scale_factors=filter_layout.scale >= 0 or gyro.scale_factor_sigma > 0 or accel.scale_factor_sigma > 0,
                       mounting="star_sensor" in scenario.data,
-                      gravity=filter_layout.gravity >= 0 or gravity is not None)
+                      gravity=filter_layout.gravity >= 0 or gravity is not None, refraction=filter_layout.refraction >= 0)
     names, n, starts = list(state_names(base)), base.n, []
     extras = (("ggm", 3, gyro.bias_instability_sigma > 0), ("agm", 3, accel.bias_instability_sigma > 0),
               ("mg", 6, gyro.misalignment_sigma > 0), ("ma", 6, accel.misalignment_sigma > 0),
@@ -176,6 +176,8 @@ def model(scenario, nominal, filt, gyro, accel, baro):
             drive = 2.0 * np.square(scale * np.asarray(gravity.sigma)) * inv_length
         else:
             m0[src["gravity"], g:g + 3] = scale * np.asarray(gravity.value)
+    if tl.base.refraction >= 0:  # the real air's refraction fraction, fixed (eq. 3 of navsim.earth.refraction)
+        m0[src["refraction"], tl.base.refraction] = build.refraction_fraction(scenario, nominal.h[0])
     if tl.baro >= 0:
         var("aiding", tl.baro, baro.bias_sigma, 1)
         q[src["aiding"], tl.baro] = baro.bias_rw**2
@@ -239,6 +241,7 @@ def measurements(scenario, nom, filt, star_catalog, src):
     empty3, note = np.zeros((0, 3)), None
     offsets, ref, ref_real, obs, cov = np.zeros(F + 1, np.int64), empty3, empty3, empty3, np.zeros((0, 3, 3))
     fix_mask, fix_q, fix_q_real, fix_R = np.zeros(F, np.bool_), np.zeros((F, 4)), np.zeros((F, 4)), np.zeros((3, 3))
+    shift, fix_rho = empty3, np.zeros((F, 3))
     if nom.sky is not None:
         catalog = star_catalog or load_star_catalog(epoch=build.catalog_epoch(scenario))
         sensor, note = vector_equivalent(scenario, catalog, 1.0 / scenario["star_sensor"]["rate_hz"], build.catalog_epoch(scenario))
@@ -252,6 +255,10 @@ def measurements(scenario, nom, filt, star_catalog, src):
             seen = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
             fix_q, fix_q_real = (_processed_fixes(scenario, nom, seen, air) for air in (modelled, real))
             fix_mask = available
+            if filt.layout.refraction >= 0:
+                boresight = rot.rotate(seen, np.array([0.0, 0.0, 1.0]))
+                aberrated = _processed_stars(scenario, nom, boresight, np.arange(F), None)
+                fix_rho = np.cross(aberrated, _processed_stars(scenario, nom, boresight, np.arange(F), modelled))
         else:
             stars = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
             frame = np.repeat(np.arange(F), np.diff(stars.offsets))
@@ -260,6 +267,7 @@ def measurements(scenario, nom, filt, star_catalog, src):
             offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=F))])
             ref, ref_real = (_processed_stars(scenario, nom, catalog, frame, air) for air in (modelled, real))
             cov = isotropic_covariance(obs, stars.sigma[keep])
+            shift = ref - _processed_stars(scenario, nom, catalog, frame, None) if filt.layout.refraction >= 0 else np.zeros_like(ref)
     position, baro = build.position_sensor(scenario, 1.0 / (nom.ratio * dt)), build.baro(scenario)
     position_mask, position_sigma = np.zeros(F, np.bool_), np.zeros(3)
     if position is not None:
@@ -274,9 +282,10 @@ def measurements(scenario, nom, filt, star_catalog, src):
         baro_offset[every - 1::every] = h - lagged
         baro_var, baro_filter_var = baro.noise_sigma**2, float(np.hypot(baro.noise_sigma, baro.bias_sigma)) ** 2
     meas = Measurements(star_offsets=offsets, star_ref=np.ascontiguousarray(ref),
-                        star_ref_real=np.ascontiguousarray(ref_real), star_obs=np.ascontiguousarray(obs),
-                        star_cov=np.ascontiguousarray(cov), fix_mask=fix_mask, fix_q=np.ascontiguousarray(fix_q),
-                        fix_q_real=np.ascontiguousarray(fix_q_real), fix_R=np.ascontiguousarray(fix_R, dtype=float),
+                        star_ref_real=np.ascontiguousarray(ref_real), star_shift=np.ascontiguousarray(shift, dtype=float),
+                        star_obs=np.ascontiguousarray(obs), star_cov=np.ascontiguousarray(cov), fix_mask=fix_mask,
+                        fix_q=np.ascontiguousarray(fix_q), fix_q_real=np.ascontiguousarray(fix_q_real),
+                        fix_rho=np.ascontiguousarray(fix_rho, dtype=float), fix_R=np.ascontiguousarray(fix_R, dtype=float),
                         position_mask=position_mask,
                         position_sigma=position_sigma, baro_mask=baro_mask, baro_var=float(baro_var),
                         baro_filter_var=float(baro_filter_var), baro_offset=baro_offset,

@@ -218,7 +218,16 @@ def _refraction_text(refraction):
             f"{number(refraction['total_arcsec']['max'])}\"); the processing {corrected}. The real air departs from that "
             f"model by {number(refraction['pressure_error_percent'])} % in pressure and {number(refraction['temperature_error_k'])} K, "
             f"leaving {number(refraction['residual_arcsec']['mean'])}\" ({number(refraction['residual_position_m'])} m of "
-            f"position); left uncorrected the refraction would cost {number(refraction['uncorrected_position_m'])} m.")
+            f"position); left uncorrected the refraction would cost {number(refraction['uncorrected_position_m'])} m."
+            + _considered_text(refraction.get("considered")))
+
+
+def _considered_text(considered):
+    """The filter's refraction consider state, if it carries one."""
+    if considered is None:
+        return " The filter does not know of the model air's error."
+    return (f" The filter carries the model air's fractional error as a consider state of σ "
+            f"{number(100.0 * considered['fraction_sigma'])} % (the real air's: {number(100.0 * considered['fraction_true'])} %).")
 
 
 def _identification_text(ident):

@@ -188,7 +188,9 @@ def simulate(prepared, seed, compiled=True):
     log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, observer_runs,
                    compiled)
     q_BS_true = p.star_sensor.q_BS_true if p.star_sensor is not None else None
-    series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true)
+    refraction_true = None if p.star_sensor is None else build.refraction_fraction(scenario, truth.h[grid.frame_k],
+                                                                                    p.truth_off)
+    series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true, refraction_true)
     series["error_sigma_initial"] = np.sqrt(np.diag(config.P0))
     if p.star_sensor is not None:
         series["mounting_true"] = np.broadcast_to(rot.to_rotation_vector(rot.multiply(rot.conjugate(filt.star_sensor.q_BS),

@@ -322,6 +322,11 @@ def _check_star_sensor(checked, source):
     if sensor["identification"]["method"] == "prior" and (sensor["fidelity"] != "vector" or "photometry" not in sensor):
         raise InputError(f"{source}: star_sensor.identification.method: 'prior' identifies the detections of a "
                          "vector-fidelity sensor with a light budget ([star_sensor.photometry]: their magnitudes)")
+    refraction = sensor["refraction"]
+    if (refraction["pressure_sigma_percent"] or refraction["temperature_sigma_k"]) and not refraction["correction"]:
+        raise InputError(f"{source}: star_sensor.refraction: pressure_sigma_percent and temperature_sigma_k are the "
+                         "uncertainty of the air the processing corrects with; without the correction there is none "
+                         "(set correction = true or the σ to 0)")
     if sensor.get("image", {}).get("compare_without_stacking"):
         raise InputError(f"{source}: star_sensor.image.compare_without_stacking: the shadow filter of 004 §3 is the "
                          "attitude filter's; a navigation run compares the attitude solvers of the stacked frames only "

@@ -37,11 +37,11 @@ def group(series, first, size=3):
     return slice(names.index(first), names.index(first) + size) if first in names else None
 
 
-def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=None):
+def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=None, refraction_true=None):
     """The run's per-frame series from the loop's log ``arrays`` (the filter's snapshots and update
     statistics) at the frames' IMU samples ``frame_k``, the truth trajectory and the gyro and
     accelerometer records, for the filter's error-state ``layout`` (and the true star-sensor mounting
-    ``q_BS_true``): estimates and truths (lat, lon, h, v_n, q_nb, biases), ``state_names``,
+    ``q_BS_true`` and the truth's refraction fraction ε_r (F,) ``refraction_true``): estimates and truths (lat, lon, h, v_n, q_nb, biases), ``state_names``,
     ``error_state`` (F, n), ``error_sigma`` (F, n) = √diag P, ``covariance_final`` (n, n) (P at the
     last frame), ``position_error_m`` (F, 3) NED, ``nees`` and the truth's gravity disturbance
     ``gravity_disturbance_true`` (F, 3) [m/s²] (zero without one)."""
@@ -61,6 +61,8 @@ def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=Non
     series["gravity_disturbance_true"] = truth.gravity_disturbance[k]
     if layout.gravity >= 0:  # consider states: the truth itself
         parts.append(series["gravity_disturbance_true"])
+    if layout.refraction >= 0:
+        parts.append(np.asarray(refraction_true, dtype=float)[:, None])
     series["state_names"] = np.array(state_names(layout))
     series["error_state"] = np.concatenate(parts, axis=1)
     series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))

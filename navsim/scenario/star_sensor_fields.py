@@ -114,6 +114,12 @@ REFRACTION = Table(
                                         doc="the real air's pressure at the vehicle against the standard atmosphere's"),
         "temperature_error_k": Value("float", default=0.0, minimum=-60.0, maximum=60.0,
                                      doc="the real air's temperature at the vehicle against the standard atmosphere's"),
+        "pressure_sigma_percent": Value("float", default=0.0, minimum=0.0, maximum=50.0,
+                                        doc="what the processing takes its model air's pressure error to be (1σ); "
+                                            "with temperature_sigma_k the σ of the filter's refraction consider state "
+                                            "(0 and 0: no state)"),
+        "temperature_sigma_k": Value("float", default=0.0, minimum=0.0, maximum=60.0,
+                                     doc="what the processing takes its model air's temperature error to be (1σ)"),
     },
     doc="atmospheric refraction of the stars and its correction",
 )

@@ -217,6 +217,8 @@ CROSS_KEY = [
     ("navigation", 'epoch_utc="2024-13-01T00:00:00"', "epoch_utc"),
     ("navigation", 'epoch_utc="2024-03-20T00:00:00+02:00"', "epoch_utc"),
     ("navigation", "trajectory.start={lat_deg = 45.0}", "trajectory.start.lon_deg"),
+    # the uncertainty of a model air the processing does not correct with
+    ("sins_cns", "star_sensor.refraction={correction = false, pressure_sigma_percent = 3.0}", "star_sensor.refraction"),
 ]
 
 

@@ -65,11 +65,13 @@ WIDE_GATE = "filter.gate_probability=0.999999999"
 @pytest.mark.parametrize("scenario, overrides, departs", [
     # an uncalibrated mounting the filter ignores: the star sensor's 30", -45", 90" misalignment tilts and turns
     # the attitude far beyond the filter's σ
-    (SCENARIO, (*SHORT, "filter.mounting=ignore", WIDE_GATE), ("tilt", "heading")),
+    pytest.param(SCENARIO, (*SHORT, "filter.mounting=ignore", WIDE_GATE), ("tilt", "heading"),
+                 marks=pytest.mark.slow),  # 40 runs each (~15 s): the attitude kind's case stays in the default suite
     # a filter that trusts its measurements four times too much (every σ halved): the baro's error, taken for
     # half of what it is, leaves the vertical channel's true error well above the filter's σ (the attitude, held
     # by the mounting's and the level's uncertainty in straight flight, hardly moves)
-    (SCENARIO, (*SHORT, "filter.measurement_noise_scale=0.5", WIDE_GATE), ("vertical_position", "vertical_velocity")),
+    pytest.param(SCENARIO, (*SHORT, "filter.measurement_noise_scale=0.5", WIDE_GATE), ("vertical_position", "vertical_velocity"),
+                 marks=pytest.mark.slow),
     # the attitude kind: a 20", -30", 40" mounting error the MEKF does not carry, over 000's high-dynamic profile
     (ATTITUDE, ("duration_s=30", "settle_s=3", "star_sensor.misalignment_arcsec=[20.0, -30.0, 40.0]", WIDE_GATE),
      ("attitude", "cross_boresight", "roll")),

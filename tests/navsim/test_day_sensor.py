@@ -79,3 +79,43 @@ def test_bad_identification_and_refraction_keys_are_one_clear_line(tmp_path, cap
     status, err = run_cli(cli.main, ["run", DAY, "--out", tmp_path / "bad", "--set", override], capsys)
     assert status != 0 and message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "bad").exists()
+
+
+def test_the_sensor_prior_turns_the_field_by_the_refraction_states_sigma():
+    """The prior of the day sensor's identification (``NavFilter.sensor_prior``) carries the refraction consider
+    state: its attitude covariance exceeds the same filter's without the state by σ_ε² g gᵀ (to 1e-9 of it), g = R_SI ρ
+    the boresight's refraction rotation in sensor axes: about a horizontal axis, |g| = ΔZ of the boresight 50° up at
+    12 km (12.4", eq. 1 of navsim.earth.refraction) within 1 % (the aberrated boresight against the catalog one)."""
+    import dataclasses
+
+    from navsim.earth.frames import local_up
+    from navsim.earth.orientation import EarthOrientation
+    from navsim.earth.refraction import refraction_angle
+    from navsim.estimation.nav_filter import NavFilter
+    from navsim.kinds import resolve_scenario
+    from navsim.navigation import build
+    from startrack import rotation as rot
+
+    scenario = resolve_scenario(str(DAY), [])
+    gyro, accel = build.imu(scenario)
+    lat, lon, h = np.radians(40.0), np.radians(-10.0), 12000.0
+    q_nb = rot.from_rotation_vector(np.array([0.0, 0.0, np.radians(90.0)]))  # heading east, level
+    orientation = EarthOrientation.compute(scenario["epoch_utc"], np.array([0.0]))
+    config = build.filter_config(scenario, gyro, accel, lat, h, 0.01, orientation)
+    plain = dataclasses.replace(config, P0=config.P0[:-1, :-1],
+                                star_sensor=dataclasses.replace(config.star_sensor, refraction_sigma=0.0))
+    start = (lat, lon, h, np.array([0.0, 250.0, 0.0]), q_nb)
+    with_state, without = NavFilter(*start, config), NavFilter(*start, plain)
+    assert with_state.layout.refraction == with_state.layout.n - 1 and without.layout.refraction < 0
+    prior = with_state.sensor_prior()
+    extra = prior.P_theta - without.sensor_prior().P_theta
+    values, vectors = np.linalg.eigh(extra)
+    sigma = config.star_sensor.refraction_sigma
+    g = vectors[:, -1] * np.sqrt(values[-1]) / sigma
+    np.testing.assert_allclose(extra, sigma**2 * np.outer(g, g), atol=1e-9 * values[-1])
+    up = local_up(orientation.c_ie[0], lat, lon)
+    boresight = rot.rotate(prior.q_IS, np.array([0.0, 0.0, 1.0]))
+    rho = rot.rotate(prior.q_IS, g)
+    assert abs(rho @ up) < 1e-3 * np.linalg.norm(rho) and abs(rho @ boresight) < 1e-3 * np.linalg.norm(rho)
+    a, b = build.modelled_air(scenario).coefficients(np.array([h]))
+    assert np.linalg.norm(g) == pytest.approx(refraction_angle(boresight[None, :], up[None, :], a, b)[0], rel=0.01)

@@ -101,3 +101,87 @@ def test_a_fix_turned_back_by_the_boresights_refraction_is_the_true_attitude():
     angle = rot.to_rotation_vector(q_R)[0]
     assert np.linalg.norm(angle) == pytest.approx(refraction_angle(boresight, ZENITH, a, b)[0], rel=1e-9)
     assert abs(angle @ ZENITH[0]) < 1e-15
+
+
+def test_the_real_airs_refraction_is_the_models_times_one_plus_its_fraction():
+    """Eq. (3): the real air's refraction of a direction is the model's scaled by 1 + ε (``Air.fraction``) from 15° to
+    89° of elevation: exactly for a pressure error (A and B ∝ p; 1e-3 of its residual allowed, measured 7e-4), and
+    within 5e-4 of the model's refraction with a temperature error of a few K (B's temperature law is not A's:
+    measured 3e-4, 0.02" at 15°, 1.3 % of the residual); ε of a pressure error alone is that error (refractivity
+    ∝ p), of a temperature error −δT/(T + δT)."""
+    h = 11000.0
+    for real in (Air(1.65, pressure_error=0.1), Air(1.65, temperature_error=-3.0), Air(0.55, 0.02, 5.0)):
+        a, b = real.coefficients(h)
+        a0, b0 = real.modelled().coefficients(h)
+        eps = real.fraction(h)
+        for elevation in np.radians([15.0, 30.0, 45.0, 60.0, 89.0]):
+            u = at_elevation(elevation)
+            model = refract(u, ZENITH, a0, b0) - u
+            residual = refract(u, ZENITH, a, b) - u - model
+            bound = 1e-3 * np.linalg.norm(residual) if real.temperature_error == 0.0 else 5e-4 * np.linalg.norm(model)
+            assert np.linalg.norm(residual - eps * model) < bound
+    assert Air(1.65, pressure_error=0.1).fraction(h) == pytest.approx(0.1, abs=1e-12)
+    T = temperature_pressure(h)[0]
+    assert Air(1.65, temperature_error=-3.0).fraction(h) == pytest.approx(3.0 / (T - 3.0), rel=2e-3)
+
+
+def test_the_fraction_sigma_adds_the_pressure_and_temperature_parts():
+    """σ_ε of a pressure σ alone is that σ; of a temperature σ alone σ_T/T (∝ 1/T), within 0.2 %; together their
+    root-sum-square."""
+    model, h = Air(1.65), 12000.0
+    T = temperature_pressure(h)[0]
+    assert model.fraction_sigma(h, 0.03, 0.0) == pytest.approx(0.03, rel=1e-6)
+    assert model.fraction_sigma(h, 0.0, 5.0) == pytest.approx(5.0 / T, rel=2e-3)
+    assert model.fraction_sigma(h, 0.03, 5.0) == pytest.approx(np.hypot(0.03, 5.0 / T), rel=2e-3)
+
+
+def _nav_state(rng):
+    """A random strapdown state's first ten entries (L, λ, h, v_n, q_nb)."""
+    nav = np.zeros(10)
+    nav[0], nav[1], nav[2] = rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1), rng.uniform(0.0, 2e4)
+    nav[6:10] = rot.from_rotation_vector(rng.normal(size=3))
+    return nav
+
+
+def test_the_refraction_states_star_column_against_the_stars_it_moves():
+    """``star_terms``' ε_r column: the measured direction of a star the real air raises by (1 + ε) times the model's
+    shift moves the residual by H_ε ε, for random states, mountings and shifts of 20" (second order: < 1e-6 of it)."""
+    from navsim.estimation.celestial_kernels import inertial_attitude, star_terms
+    from navsim.estimation.nav_kernels import layout
+
+    rng = np.random.default_rng(3)
+    lay = layout(refraction=True)
+    for _ in range(20):
+        nav, q_ie, q_BS = _nav_state(rng), rot.from_rotation_vector(rng.normal(size=3)), rot.from_rotation_vector(rng.normal(size=3))
+        R_SI = rot.to_matrix(q_BS).T @ rot.to_matrix(inertial_attitude(nav, q_ie)).T
+        boresight = R_SI.T @ np.array([0.0, 0.0, 1.0])
+        ref = boresight + rng.normal(scale=0.05, size=(4, 3))
+        ref /= np.linalg.norm(ref, axis=1, keepdims=True)
+        shift = np.cross(rng.normal(size=(4, 3)), ref)
+        shift *= 20.0 * ARCSEC / np.linalg.norm(shift, axis=1, keepdims=True)
+        eps, cov = 0.05, np.repeat(np.eye(3)[None] * 1e-10, 4, axis=0)
+        moved = ref + eps * shift
+        moved /= np.linalg.norm(moved, axis=1, keepdims=True)
+        z0, H, _ = star_terms(nav, q_BS, q_ie, ref, ref @ R_SI.T, cov, lay, shift)
+        z1 = star_terms(nav, q_BS, q_ie, ref, moved @ R_SI.T, cov, lay, shift)[0]
+        np.testing.assert_allclose(z1 - z0, H[:, :, lay.refraction] * eps, atol=1e-6 * eps * 20.0 * ARCSEC)
+
+
+def test_the_refraction_states_fix_column_against_the_fix_it_turns():
+    """``fix_terms``' ε_r column: a fix turned back by the model's boresight rotation ρ when the real air turned it by
+    (1 + ε) ρ is off by −ε ρ in ICRS axes; its residual moves by H_ε ε (second order: < 1e-6 of it)."""
+    from navsim.estimation.celestial_kernels import fix_terms, inertial_attitude
+    from navsim.estimation.nav_kernels import layout
+
+    rng = np.random.default_rng(4)
+    lay = layout(refraction=True)
+    for _ in range(20):
+        nav, q_ie, q_BS = _nav_state(rng), rot.from_rotation_vector(rng.normal(size=3)), rot.from_rotation_vector(rng.normal(size=3))
+        q_IS = rot.multiply(inertial_attitude(nav, q_ie), q_BS)
+        rho = rng.normal(size=3)
+        rho *= 20.0 * ARCSEC / np.linalg.norm(rho)
+        eps = 0.05
+        z0, H, _ = fix_terms(nav, q_BS, q_ie, q_IS, np.eye(3) * 1e-10, lay, rho)
+        turned = rot.multiply(rot.from_rotation_vector(-eps * rho), q_IS)
+        z1 = fix_terms(nav, q_BS, q_ie, turned, np.eye(3) * 1e-10, lay, rho)[0]
+        np.testing.assert_allclose(z1 - z0, H[:, lay.refraction] * eps, atol=1e-6 * eps * 20.0 * ARCSEC)

@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 
 from navsim import cli
+from navsim.kinds import resolve_scenario
+from navsim.navigation.covariance import covariance_analysis
 from navsim.output import read_npz
 from tests.support import run_cli
 
@@ -146,16 +148,40 @@ def test_skipping_the_refraction_correction_costs_what_the_summary_says(tmp_path
     assert summary["nees"]["mean"] > 10.0 * tilted[0]["nees"]["mean"]
 
 
-def test_the_real_airs_pressure_error_leaves_its_residual(tmp_path, capsys, tilted):
+DENSER = "star_sensor.refraction.pressure_error_percent = 10.0"
+
+
+@pytest.fixture(scope="module")
+def denser(tmp_path_factory):
+    """The tilted run in an air 10 % denser than the processing's model, which the filter does not know of."""
+    return level_run(tmp_path_factory.mktemp("denser"), Uncaptured(), "denser", TILTED, DENSER)
+
+
+def test_the_real_airs_pressure_error_leaves_its_residual(tilted, denser):
     """The real air 10 % denser than the standard atmosphere the processing corrects with: 1.7" left in every star,
-    the Schuler mean moved by the summary's ``residual_position_m`` (~53 m) within 15 % (measured 3 %); without the
-    error the residual is zero."""
+    the Schuler mean moved by the summary's ``residual_position_m`` (~53 m) within 15 % (measured 3 %), and the filter,
+    which does not know of it, inconsistent (NEES mean 50.8 for 15 dof, above the band's 27.5); without the error the
+    residual is zero."""
     assert tilted[0]["celestial"]["refraction"]["residual_position_m"] == 0.0
-    summary, _ = level_run(tmp_path, capsys, "denser", TILTED, "star_sensor.refraction.pressure_error_percent = 10.0")
+    summary = denser[0]
     refraction = summary["celestial"]["refraction"]
     assert refraction["residual_arcsec"]["mean"] == pytest.approx(1.7, abs=0.1)
     shift = np.linalg.norm(schuler_mean(summary) - schuler_mean(tilted[0]))
     assert shift == pytest.approx(refraction["residual_position_m"], rel=0.15)
+    assert summary["nees"]["mean"] > summary["nees"]["band_95"][1]
+
+
+def test_a_filter_that_considers_the_airs_uncertainty_is_consistent_with_its_error(tmp_path, capsys, denser):
+    """The same 10 % denser air with the processing's pressure σ of 10 %: the filter carries ε_r as a consider state
+    (16 dof) and is consistent (NEES mean 11.4 inside [6.9, 28.8], 95 % of frames in the band: at least 90 % asked),
+    while the Schuler mean keeps the residual's shift (a consider state is not estimated; within 5 m, measured 1 m)."""
+    summary, series = level_run(tmp_path, capsys, "considered", TILTED, DENSER,
+                                "star_sensor.refraction.pressure_sigma_percent = 10.0")
+    assert list(series["state_names"])[-1] == "refraction" and summary["nees"]["dof"] == 16
+    np.testing.assert_allclose(series["error_state"][:, -1], 0.1, atol=1e-9)  # the truth's ε_r at 11 km
+    low, high = summary["nees"]["band_95"]
+    assert low < summary["nees"]["mean"] < high and summary["nees"]["fraction_in_band"] >= 0.9
+    assert np.linalg.norm(schuler_mean(summary) - schuler_mean(denser[0])) < 5.0
 
 
 def test_the_covariance_analysis_carries_the_refraction_residual_as_its_own_source(tilted):
@@ -163,9 +189,6 @@ def test_the_covariance_analysis_carries_the_refraction_residual_as_its_own_sour
     source (the residual) and the rest; the refraction source's mean horizontal error over the steady frames is the
     summary's R·δΔZ (~53 m) within 15 % (measured 54.2 m, the runs' shift 54.2 m), and without the error the source is
     absent."""
-    from navsim.kinds import resolve_scenario
-    from navsim.navigation.covariance import covariance_analysis
-
     overrides = ['filter.mounting="ignore"', TILTED.replace(" ", ""), "star_sensor.refraction.pressure_error_percent=10.0"]
     analysis = covariance_analysis(resolve_scenario(str(LEVEL), overrides), split=True)
     assert "refraction" in analysis.sources and "aberration" not in analysis.sources
@@ -178,6 +201,22 @@ def test_the_covariance_analysis_carries_the_refraction_residual_as_its_own_sour
     assert shift == pytest.approx(predicted, rel=0.15)
     plain = covariance_analysis(resolve_scenario(str(LEVEL), overrides[:2]), split=True)
     assert "refraction" not in plain.sources
+    assert analysis.nees[steady].mean() > 2.0 * analysis.nees_dof  # the filter does not know of the air's error
+
+
+def test_the_covariance_analysis_of_a_filter_considering_the_air():
+    """With the processing's pressure σ of 10 % the analysis carries the real air's ε_r = 0.1 as the truth's
+    refraction state and the filter's consider state: the refraction source still moves the horizontal error by
+    R·δΔZ (~54 m, within 15 %) and the expected NEES is the filter's dof, 16 (within 5 %: measured 16.0; 54.9 of 15
+    without the state)."""
+    overrides = ['filter.mounting="ignore"', TILTED.replace(" ", ""), "star_sensor.refraction.pressure_error_percent=10.0",
+                 "star_sensor.refraction.pressure_sigma_percent=10.0"]
+    analysis = covariance_analysis(resolve_scenario(str(LEVEL), overrides), split=True)
+    assert analysis.filter_names[-1] == "refraction" and analysis.nees_dof == 16
+    steady = analysis.t >= 600.0
+    mean = analysis._projected_mean(analysis.quantities["horizontal_position"])[analysis.sources.index("refraction")]
+    assert np.linalg.norm(mean[steady].mean(axis=0)) == pytest.approx(54.2, rel=0.15)
+    assert analysis.nees[steady].mean() == pytest.approx(16.0, rel=0.05)
 
 
 def test_turns_make_the_accelerometer_bias_observable(tmp_path, capsys, level):

@@ -112,6 +112,7 @@ def test_truth_off_switches_the_truth_not_the_filter(level):
         ins_simulation.prepare(scenario, truth_off={"baro"})
 
 
+@pytest.mark.slow  # 20 runs of a Monte Carlo budget (~1 min); the covariance budget's tests stay in the default suite
 def test_budget_parts_add_up_and_follow_eq_1(level, tmp_path, capsys):
     """Two runs per source under the scenario's own filter, the mounting calibrated (ignored by the
     filter, zero in the truth): in straight and level flight over one Schuler period the parts add up —

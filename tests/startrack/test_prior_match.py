@@ -79,6 +79,7 @@ def campaign(catalog):
     return results
 
 
+@pytest.mark.slow  # a 10 000-frame campaign (16 s)
 def test_no_more_wrong_matches_than_the_stated_probability_over_10000_frames(campaign):
     """Over all 10 000 frames the wrong matches (checked against the truth) stay within the Poisson count the
     matches' eq. (2) probabilities sum to (at 99.9 %: Σp + 3.1 √Σp + 1); measured: 0 wrong against Σp ~ 2."""
@@ -88,6 +89,7 @@ def test_no_more_wrong_matches_than_the_stated_probability_over_10000_frames(cam
     assert wrong <= stated + 3.1 * np.sqrt(stated) + 1.0
 
 
+@pytest.mark.slow  # a 10 000-frame campaign (16 s)
 def test_the_success_rate_falls_with_the_priors_sigma(campaign):
     """Stars identified / stars detected: nearly all with a 5" prior (a tracking INS; measured 99.9 %), most with 30"
     (80 %: the stars near the limit, which may have gone undetected and left a false detection alone in their gate,
