@@ -20,6 +20,7 @@ from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
 from navsim.scenario.star_sensor_fields import FAULTS, IDENTIFICATION, PHOTOMETRY, REFRACTION, STAR_SENSOR, check_faults, check_star_sensor, mounting
+from navsim.scenario.star_sensor_presets import PRESETS, with_preset
 from navsim.truth import segments, trajectory
 from startrack import rotation as rot
 from startrack.errors import InputError
@@ -131,6 +132,9 @@ SCHEMA = Table(
             }, optional=True, doc="position fixes (GNSS-like): the truth plus white NED noise"),
         }, doc="no table: a free INS"),
         "star_sensor": Table({
+            "preset": Value("str", default=None, choices=tuple(PRESETS),
+                            doc="a named sensor (navsim.scenario.star_sensor_presets) filling the keys the table "
+                                "leaves unset: field, band, catalog depth, image size, exposure, aperture, detector"),
             **STAR_SENSOR,
             "aberration_correction": Value("bool", default=True,
                                            doc="the processing aberrates the catalog stars with the INS's velocity and "
@@ -212,6 +216,8 @@ EPHEMERIS_YEARS = (1900, 2100)
 def validate(data, source):
     """The checked dictionary of a navigation scenario: :data:`SCHEMA` and the cross-key rules (derived
     defaults filled: ``duration_s``, ``settle_s``); one InputError naming the key otherwise."""
+    if isinstance(data, dict) and "star_sensor" in data:
+        data = {**data, "star_sensor": with_preset(data["star_sensor"], source)}
     checked = checked_table(SCHEMA, data, source)
     try:
         utc_epoch(checked["epoch_utc"])

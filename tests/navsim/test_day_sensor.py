@@ -119,3 +119,36 @@ def test_the_sensor_prior_turns_the_field_by_the_refraction_states_sigma():
     assert abs(rho @ up) < 1e-3 * np.linalg.norm(rho) and abs(rho @ boresight) < 1e-3 * np.linalg.norm(rho)
     a, b = build.modelled_air(scenario).coefficients(np.array([h]))
     assert np.linalg.norm(g) == pytest.approx(refraction_angle(boresight[None, :], up[None, :], a, b)[0], rel=0.01)
+
+
+def _limiting_magnitude(*overrides):
+    """The median limiting magnitude at the boresight over the day flight's first minute (``navsim sky``'s)."""
+    from navsim.kinds import resolve_scenario
+    from navsim.navigation.availability import star_availability
+
+    return float(np.median(star_availability(resolve_scenario(str(DAY), ["duration_s=60.0", *overrides])).series["limiting_mag"]))
+
+
+def test_a_preset_fills_what_the_scenario_leaves_and_yields_to_what_it_sets():
+    """``star_sensor.preset`` (navsim.scenario.star_sensor_presets): the day scenario's SWIR sensor comes from
+    ``swir_day_3deg`` (limiting H 4.5, its design value); the 1° preset (150 mm on pixels of a ninth of the solid
+    angle) reaches deeper by less than the background-limited gain 2.5 log10((150/100)·3) = 1.63 mag (its read and
+    dark noise weigh more on the fainter sky per pixel) and more than 1 mag (measured 1.26); a key the scenario sets
+    wins over the preset's."""
+    from navsim.kinds import resolve_scenario
+
+    checked = resolve_scenario(str(DAY), [])["star_sensor"]
+    assert checked["preset"] == "swir_day_3deg" and checked["fov_deg"] == 3.0 and checked["band"] == "H"
+    assert checked["image"]["width_px"] == 640 and checked["photometry"]["aperture_mm"] == 100.0
+    wide = _limiting_magnitude()
+    narrow = _limiting_magnitude('star_sensor.preset="swir_day_1deg"')
+    assert wide == pytest.approx(4.5, abs=0.1)
+    assert 1.0 < narrow - wide < 2.5 * np.log10(1.5 * 3.0)
+    own = resolve_scenario(str(DAY), ["star_sensor.fov_deg=2.0", "star_sensor.photometry.aperture_mm=80.0"])["star_sensor"]
+    assert own["fov_deg"] == 2.0 and own["photometry"]["aperture_mm"] == 80.0 and own["photometry"]["detector"] == "ingaas_swir"
+
+
+def test_an_unknown_preset_is_one_clear_line(tmp_path, capsys):
+    status, err = run_cli(cli.main, ["run", DAY, "--out", tmp_path / "o", "--set", 'star_sensor.preset = "nonsense"'], capsys)
+    assert status == 2 and "star_sensor.preset" in err and "swir_day_3deg" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
