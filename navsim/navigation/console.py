@@ -12,6 +12,8 @@ def run_lines(summary):
         f"{nav['imu_rate_hz']:g} Hz, aiding: {', '.join(nav['aiding']) or 'none (free INS)'})",
         f"horizontal error    final {horizontal['final']:.2f} m ({nmi['final']:.3f} nmi, {nmi['final_per_hour']:.3f} nmi/h)  "
         f"RMS {horizontal['rms']:.2f} m  max {horizontal['max']:.2f} m",
+        f"along/cross track   RMS {position['along_track']['rms']:.2f} m / {position['cross_track']['rms']:.2f} m  "
+        f"final {position['along_track']['final']:.2f} m / {position['cross_track']['final']:.2f} m",
         f"vertical error      final {vertical['final']:.2f} m  RMS {vertical['rms']:.2f} m  max {vertical['max']:.2f} m",
         f"velocity error RMS  horizontal {velocity['horizontal']['rms']:.3f} m/s  vertical {velocity['vertical']['rms']:.3f} m/s",
         f"attitude error RMS  tilt {summary['tilt_error_arcsec']['rms']:.1f}\"  heading {summary['heading_error_arcsec']['rms']:.1f}\"",

@@ -15,8 +15,9 @@ from navsim import records
 class RunSummary(records.RunSummary):
     """A navigation run (the INS): ``bias_error_final_deg_per_h`` the gyro bias error (truth − estimate)
     at the end; ``navigation``: {imu_rate_hz, frame_rate_hz, aiding (the kinds), filter_states,
-    epoch_utc}; ``position_error_m``/``velocity_error_m_per_s``: {horizontal, vertical}, each {final,
-    rms, max} of the error's magnitude; ``position_error_nmi``: {horizontal: {final, rms, max,
+    epoch_utc}; ``position_error_m``: {horizontal, vertical, along_track, cross_track} and
+    ``velocity_error_m_per_s``: {horizontal, vertical}, each {final, rms, max} of the error's magnitude (along and
+    across the true track: :func:`navsim.navigation.summary.track_metres`); ``position_error_nmi``: {horizontal: {final, rms, max,
     final_per_hour}}; ``tilt_error_arcsec``, ``heading_error_arcsec``: {final, rms, max};
     ``position_sigma_final_m`` (N, E, D); ``accel_bias_error_final_micro_g``; ``imu_calibration``: the
     IMU error states at the end (biases [deg/h, µg], scale factors [ppm], the star-sensor mounting

@@ -88,7 +88,9 @@ def _run_key_results(doc, summary):
         f"{number(100 * nees['fraction_in_band'], 1)} % of the frames lie inside the 95 % band "
         f"[{number(nees['band_95'][0])}, {number(nees['band_95'][1])}]."))
     rows = []
-    for label, block, unit, digits in (("horizontal position", position["horizontal"], "m", 2),
+    track = [(f"{side}-track position", position[f"{side}_track"], "m", 2) for side in ("along", "cross")
+             if f"{side}_track" in position]  # runs written before issue 31 have none
+    for label, block, unit, digits in (("horizontal position", position["horizontal"], "m", 2), *track,
                                        ("vertical position", position["vertical"], "m", 2),
                                        ("horizontal velocity", velocity["horizontal"], "m/s", 3),
                                        ("vertical velocity", velocity["vertical"], "m/s", 3),

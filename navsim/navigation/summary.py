@@ -3,9 +3,10 @@ and its :class:`~navsim.records.RunSummary` (position, velocity, tilt and headin
 error states, NEES over the filter's own error state).
 
 The error state is the filter's (docs/design.md): x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ)
-(, δg)], est − true except the IMU and star-sensor errors and the gravity disturbance (true − est),
+(, δg) (, ε_r)], est − true except the IMU and star-sensor errors and the gravity disturbance (true − est),
 with C_nb,est = (I − [φ×]) C_nb,true, so φ_N, φ_E are the tilts and the heading error (est − true) is
-−φ_D. The position error in NED metres is (δL (R_M + h), δλ (R_N + h) cos L, −δh).
+−φ_D. The position error in NED metres is (δL (R_M + h), δλ (R_N + h) cos L, −δh); along and across the true
+track it is that horizontal error resolved on the track's direction and its right (:func:`track_metres`).
 """
 
 import numpy as np
@@ -14,6 +15,7 @@ from navsim.earth.wgs84 import radii
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.estimation.nav_filter import error_state, mounting_error, state_names
 from navsim.navigation.records import RunSummary
+from startrack import rotation as rot
 from startrack import units
 
 #: Slices of the error state: tilt (φ_N, φ_E), heading (φ_D), velocity, position, biases; the optional
@@ -22,6 +24,8 @@ TILT, HEADING, VELOCITY, POSITION = slice(0, 2), 2, slice(3, 6), slice(6, 9)
 GYRO_BIAS, ACCEL_BIAS = slice(9, 12), slice(12, 15)
 #: The accelerometer-bias unit of the summaries [m/s²].
 MICRO_G = 1e-6 * units.STANDARD_GRAVITY
+#: Below this ground speed [m/s] the track is the body's heading (a vehicle at rest has no course).
+MIN_TRACK_SPEED = 0.1
 
 
 def ned_metres(delta_position, lat, h):
@@ -29,6 +33,18 @@ def ned_metres(delta_position, lat, h):
     r_m, r_n = radii(lat)
     return np.stack([delta_position[..., 0] * (r_m + h), delta_position[..., 1] * (r_n + h) * np.cos(lat),
                      -delta_position[..., 2]], axis=-1)
+
+
+def track_metres(error_ne, v_n, q_nb):
+    """Horizontal position errors (F, 2) [m] along and across the true track (across positive to the right): the
+    NED errors ``error_ne`` (F, 2) resolved on the course χ of the true ground velocity ``v_n`` (F, 3), along = δN cos χ
+    + δE sin χ, across = −δN sin χ + δE cos χ; where the speed is below :data:`MIN_TRACK_SPEED` the course is the
+    heading of the true body x axis (``q_nb`` (F, 4))."""
+    forward = rot.rotate(q_nb, np.array([1.0, 0.0, 0.0]))
+    slow = np.hypot(v_n[:, 0], v_n[:, 1]) < MIN_TRACK_SPEED
+    course = np.where(slow, np.arctan2(forward[:, 1], forward[:, 0]), np.arctan2(v_n[:, 1], v_n[:, 0]))
+    c, s = np.cos(course), np.sin(course)
+    return np.stack([error_ne[:, 0] * c + error_ne[:, 1] * s, -error_ne[:, 0] * s + error_ne[:, 1] * c], axis=-1)
 
 
 def group(series, first, size=3):
@@ -68,15 +84,17 @@ def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=Non
     series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))
     series["covariance_final"] = P[-1].copy()
     series["position_error_m"] = ned_metres(error[:, POSITION], series["lat_true"], series["h_true"])
+    series["track_error_m"] = track_metres(series["position_error_m"][:, :2], series["v_n_true"], series["q_nb_true"])
     series["nees"] = nees(P, series["error_state"])
     return series
 
 
 def magnitudes(series):
-    """{quantity: per-frame magnitude} of a navigation series: horizontal and vertical position [m]
-    and velocity [m/s] errors, tilt and heading errors [rad]."""
+    """{quantity: per-frame magnitude} of a navigation series: horizontal, vertical, along- and cross-track position
+    [m] and velocity [m/s] errors, tilt and heading errors [rad]."""
     e, p = series["error_state"], series["position_error_m"]
     return {"horizontal": np.hypot(p[:, 0], p[:, 1]), "vertical": np.abs(p[:, 2]),
+            "along_track": np.abs(series["track_error_m"][:, 0]), "cross_track": np.abs(series["track_error_m"][:, 1]),
             "velocity_horizontal": np.hypot(e[:, 3], e[:, 4]), "velocity_vertical": np.abs(e[:, 5]),
             "tilt": np.hypot(e[:, 0], e[:, 1]), "heading": np.abs(e[:, HEADING])}
 
@@ -103,7 +121,8 @@ def summarize(scenario, seed, series, grid):
         scenario=scenario.name, seed=seed, duration_s=scenario["duration_s"], frames=int(t.size), settle_s=scenario["settle_s"],
         navigation={"imu_rate_hz": scenario["imu"]["rate_hz"], "frame_rate_hz": 1.0 / (grid.ratio * grid.dt),
                     "aiding": aiding, "filter_states": int(e.shape[1]), "epoch_utc": scenario["epoch_utc"]},
-        position_error_m={"horizontal": stats(size["horizontal"]), "vertical": stats(size["vertical"])},
+        position_error_m={"horizontal": stats(size["horizontal"]), "vertical": stats(size["vertical"]),
+                          "along_track": stats(size["along_track"]), "cross_track": stats(size["cross_track"])},
         position_error_nmi={"horizontal": nmi},
         velocity_error_m_per_s={"horizontal": stats(size["velocity_horizontal"]), "vertical": stats(size["velocity_vertical"])},
         tilt_error_arcsec=stats(size["tilt"], units.ARCSEC), heading_error_arcsec=stats(size["heading"], units.ARCSEC),

@@ -156,3 +156,22 @@ def test_tune_needs_measurements():
     short = {**FREE_AT_REST, "trajectory": {**FREE_AT_REST["trajectory"], "segments": [{"kind": "hold", "duration_s": 60.0}]}}
     with pytest.raises(InputError, match="filter tuning needs measurements"):
         tune({key: value for key, value in short.items() if key != "baro"}, runs=1)
+
+
+def test_along_and_cross_track_errors_resolve_the_horizontal_error_on_the_course():
+    """``track_metres``: due east the along-track error is the east error and the cross-track error (right of the
+    track: south) is −north; due north they are north and east; any course keeps the horizontal size; at rest the
+    course is the body's heading."""
+    from navsim.navigation.summary import track_metres
+    from startrack import rotation as rot
+
+    error = np.array([[3.0, 4.0], [3.0, 4.0], [-1.0, 2.0], [3.0, 4.0]])
+    v_n = np.array([[0.0, 250.0, 0.0], [10.0, 0.0, 1.0], [7.0, -7.0, 0.0], [0.0, 0.0, 0.0]])
+    q_nb = rot.from_rotation_vector(np.array([[0.0, 0.0, 0.3]] * 3 + [[0.0, 0.0, np.pi / 2]]))  # the last faces east
+    track = track_metres(error, v_n, q_nb)
+    np.testing.assert_allclose(track[0], [4.0, -3.0], atol=1e-12)
+    np.testing.assert_allclose(track[1], [3.0, 4.0], atol=1e-12)
+    np.testing.assert_allclose(np.hypot(*track.T), np.hypot(*error.T), rtol=1e-12)
+    np.testing.assert_allclose(track[2], [(-7.0 - 14.0) / np.hypot(7.0, 7.0), (-7.0 + 14.0) / np.hypot(7.0, 7.0)],
+                               atol=1e-12)
+    np.testing.assert_allclose(track[3], [4.0, -3.0], atol=1e-12)
