@@ -1,4 +1,4 @@
-"""Directions on the celestial sphere: RA/Dec <-> unit vectors, angular distance.
+"""Directions on the celestial sphere: RA/Dec <-> unit vectors, angular distance, the azimuthal equidistant map.
 
 Conventions (docs/design.md): inertial frame I = ICRS; RA = atan2(y, x) in [0, 2 pi),
 Dec = asin(z); radians everywhere.
@@ -53,3 +53,17 @@ def tangent_basis(s):
     e1 = np.cross(s, helper)
     e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
     return np.stack([e1, np.cross(s, e1)], axis=1)
+
+
+def azimuthal_equidistant(ra, dec, centre_ra, centre_dec):
+    """(x, y) (...,) [rad] of the directions at (ra, dec) [rad] on the azimuthal equidistant map centred at
+    (centre_ra, centre_dec) (Snyder 1987, ch. 25): each at its angular distance from the centre, in its bearing there,
+    x towards east (increasing ra), y towards north. No point is singular but the centre's antipode; the poles and the
+    180° meridian are ordinary points (a map of any route on the Earth, longitude and latitude for ra and dec)."""
+    centre, east, north = local_frame(centre_ra, centre_dec)
+    u = radec_to_vector(ra, dec)
+    distance = angular_distance(centre, u)
+    e, n = u @ east, u @ north
+    norm = np.hypot(e, n)
+    scale = np.divide(distance, norm, out=np.zeros_like(distance), where=norm > 0.0)
+    return e * scale, n * scale

@@ -1,8 +1,8 @@
-"""Report figures of navigation runs and campaigns (the INS): the ground track on a map, the position,
+"""Report figures of navigation runs and campaigns (the INS): the ground track on an azimuthal equidistant map, the position,
 velocity and attitude errors with the filter's ±3σ, the IMU error estimates, and across a campaign the
 horizontal error percentiles (CEP) over time and the final errors with their CEP circles.
 
-Units at this edge: degrees of latitude and longitude, metres, m/s, arcsec, deg/h and µg; time in
+Units at this edge: kilometres on the map, metres, m/s, arcsec, deg/h and µg; time in
 minutes. The error state and its σ are the filter's (:mod:`navsim.navigation.summary`).
 """
 
@@ -12,8 +12,11 @@ from navsim.navigation.celestial import floor_ned
 from navsim.navigation.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
 from navsim.typeset.figures import COLORS, new_figure
 from startrack import units
+from startrack.sphere import azimuthal_equidistant, radec_to_vector, vector_to_radec
 
 NED = ("north", "east", "down")
+#: The radius of the ground-track map's sphere [km] (IUGG mean radius, (2a + b)/3 of WGS-84).
+EARTH_MEAN_RADIUS_KM = 6371.0088
 
 
 def _minutes(t):
@@ -21,20 +24,34 @@ def _minutes(t):
 
 
 def ground_track(run):
-    """The estimated and true ground tracks on a map (longitude, latitude [deg], equal scales at the
-    track's mean latitude), with the start and end marked."""
+    """The estimated and true ground tracks on the azimuthal equidistant map centred on the true track (on the
+    sphere of the Earth's mean radius, :data:`EARTH_MEAN_RADIUS_KM`: distances and bearings from the centre true,
+    the poles and the 180° meridian ordinary points), with the start and end marked and a pole the track comes within
+    the map of."""
     s = run.series
-    lat_t, lon_t = np.degrees(s["lat_true"]), np.degrees(s["lon_true"])
-    lat_e, lon_e = np.degrees(s["lat"]), np.degrees(s["lon"])
+    true_u = radec_to_vector(s["lon_true"], s["lat_true"])
+    centre = vector_to_radec(np.mean(true_u, axis=0))
+
+    def project(lat, lon):
+        x, y = azimuthal_equidistant(lon, lat, *centre)
+        return EARTH_MEAN_RADIUS_KM * x, EARTH_MEAN_RADIUS_KM * y
+
+    (x_t, y_t), (x_e, y_e) = project(s["lat_true"], s["lon_true"]), project(s["lat"], s["lon"])
     fig, axes = new_figure(4.6)
     ax = axes[0, 0]
-    ax.plot(lon_t, lat_t, color="k", lw=1.2, label="truth")
-    ax.plot(lon_e, lat_e, color="tab:red", lw=0.8, ls="--", label="estimate")
-    ax.plot(lon_t[0], lat_t[0], "o", color="tab:green", ms=5, label="start")
-    ax.plot(lon_t[-1], lat_t[-1], "s", color="k", ms=4, label="end (truth)")
-    ax.plot(lon_e[-1], lat_e[-1], "s", color="tab:red", ms=4, mfc="none", label="end (estimate)")
-    ax.set_aspect(1.0 / np.cos(np.radians(np.mean(lat_t))), adjustable="datalim")
-    ax.set(xlabel="longitude [deg]", ylabel="latitude [deg]")
+    ax.plot(x_t, y_t, color="k", lw=1.2, label="truth")
+    ax.plot(x_e, y_e, color="tab:red", lw=0.8, ls="--", label="estimate")
+    ax.plot(x_t[0], y_t[0], "o", color="tab:green", ms=5, label="start")
+    ax.plot(x_t[-1], y_t[-1], "s", color="k", ms=4, label="end (truth)")
+    ax.plot(x_e[-1], y_e[-1], "s", color="tab:red", ms=4, mfc="none", label="end (estimate)")
+    span = max(np.ptp(x_t), np.ptp(y_t), 1.0)
+    for pole, name in ((0.5 * np.pi, "North Pole"), (-0.5 * np.pi, "South Pole")):
+        x_p, y_p = project(np.array(pole), np.array(0.0))
+        if np.hypot(x_p - np.mean(x_t), y_p - np.mean(y_t)) < span:
+            ax.plot(x_p, y_p, "+", color="tab:blue", ms=8, label=name)
+    ax.set_aspect(1.0, adjustable="datalim")
+    lat0, lon0 = np.degrees(centre[1]), np.degrees(np.mod(centre[0] + np.pi, 2.0 * np.pi) - np.pi)
+    ax.set(xlabel=f"east of {lat0:.2f}°, {lon0:.2f}° [km]", ylabel="north [km]")
     ax.legend(loc="best", ncols=2)
     return fig
 
