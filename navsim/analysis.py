@@ -83,7 +83,9 @@ class Analysis:
         return np.einsum("kri,ski->skr", q.rows, self.mean[:, :, :B])
 
     def _variance(self, q):
-        return np.einsum("kri,skij,krj->sk", q.rows, self.block, q.rows)
+        """tr(J P_s Jᵀ) (S, K) [SI²]; a zero one propagated through the turns of the wander-azimuth frame can come out a
+        rounding below zero (−2e-31 seen against 5e-8), held at zero."""
+        return np.maximum(np.einsum("kri,skij,krj->sk", q.rows, self.block, q.rows), 0.0)
 
     def mean_square(self):
         """{quantity: (S, K)} each source's share of the true mean square [SI²]: tr(J P_s Jᵀ) + (J m_s)·(J m),

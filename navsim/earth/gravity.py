@@ -32,7 +32,13 @@ from startrack.jit import njit
 def normal_gravity(lat, h):
     """Normal gravity γ(L, h) [m/s²] at geodetic latitude ``lat`` [rad] and height ``h`` [m]
     (TR8350.2 eqs. 4-1 and 4-3)."""
-    s2 = np.sin(lat) ** 2
+    return normal_gravity_of_sine(np.sin(lat), h)
+
+
+@njit
+def normal_gravity_of_sine(s, h):
+    """:func:`normal_gravity` at sin L = ``s`` (the wander-azimuth frame's −C_ew[2, 2])."""
+    s2 = s * s
     gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
     return gamma0 * (1.0 - 2.0 / A * (1.0 + F + M - 2.0 * F * s2) * h + 3.0 * h * h / (A * A))
 
@@ -47,15 +53,20 @@ def normal_gravity_height_gradient(lat, h):
 
 @njit
 def normal_gravity_latitude_gradient(lat, h):
-    """∂γ/∂L [m/s²/rad] of :func:`normal_gravity` (about 0.05 sin 2L)."""
-    s = np.sin(lat)
-    c = np.cos(lat)
+    """∂γ/∂L [m/s²/rad] of :func:`normal_gravity` (about 0.05 sin 2L): cos L ∂γ/∂(sin L)."""
+    return np.cos(lat) * normal_gravity_sine_gradient(np.sin(lat), h)
+
+
+@njit
+def normal_gravity_sine_gradient(s, h):
+    """∂γ/∂(sin L) [m/s²] of :func:`normal_gravity` at sin L = ``s`` (finite at the poles, where the wander-azimuth
+    error state takes its latitude derivative through sin L = −C_ew[2, 2])."""
     s2 = s * s
     w = 1.0 - E2 * s2
     gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(w)
-    d_gamma0 = GAMMA_E * 2.0 * s * c * (K_SOMIGLIANA / np.sqrt(w) + (1.0 + K_SOMIGLIANA * s2) * E2 / (2.0 * w**1.5))
+    d_gamma0 = GAMMA_E * 2.0 * s * (K_SOMIGLIANA / np.sqrt(w) + (1.0 + K_SOMIGLIANA * s2) * E2 / (2.0 * w**1.5))
     height = 1.0 - 2.0 / A * (1.0 + F + M - 2.0 * F * s2) * h + 3.0 * h * h / (A * A)
-    return d_gamma0 * height + gamma0 * (8.0 * F * s * c * h / A)
+    return d_gamma0 * height + gamma0 * (8.0 * F * s * h / A)
 
 
 @dataclass(frozen=True)

@@ -2,29 +2,25 @@
 implies, its error in terms of the navigation error state, and the gated updates with an attitude
 fix or with identified star vectors one by one.
 
-The INS's inertial attitude is C_ib = C_ie C_en(L̂, λ̂) C_nb (docs/design.md, frames i, e, n, b).
-With C_nb,est = (I − [φ×]) C_nb,true and the estimated navigation frame turned from the true one by
-
-    δθ_n = [δλ cos L, −δL, −δλ sin L]      (C_en(p̂) = C_en(p) (I + [δθ_n×]), from Ċ_en = C_en [ω_en^n×],
-                                           ω_en^n = [λ̇ cos L, −L̇, −λ̇ sin L]),
-
+The INS's inertial attitude is C_ib = C_ie C_ew C_wb (docs/design.md, frames i, e, w, b). With
+C_wb,est = (I − [φ×]) C_wb,true and the estimated wander-azimuth frame turned from the true one by the
+horizontal δθ = [δθ_x, δθ_y, 0] (C_ew,est = C_ew,true (I + [δθ×]); :mod:`navsim.estimation.nav_kernels`),
 the estimate is C_ib,est = C_ib,true (I − [δθ_b×]) to first order, with the body-axes error
 
-    δθ_b = C_bn (φ − δθ_n) = C_bn ψ,                                                           (1)
+    δθ_b = C_bw (φ − δθ) = C_bw ψ,                                                              (1)
 
-ψ = φ − δθ_n the psi angle (Titterton & Weston, 2nd ed., §12.2.1: ψ̇ = −ω_in × ψ − C_nb ε, free of
-the velocity and position errors). Eq. (1) is the attitude-difference measurement of SINS/CNS: it
-couples the tilt φ with δL, δλ (the "mathematical horizon"; PSINS ``test_SINS_CNS_def``'s H of
-kfhk 184 in ENU; Yang et al. 2022), so the star sensor measures ψ, the accelerometers hold φ to
-the local vertical through the Schuler loop, and their difference is the position. Its attitude
+ψ = φ − δθ the psi angle (Titterton & Weston, 2nd ed., §12.2.1: ψ̇ = −ω_iw × ψ − C_wb ε, free of
+the velocity and position errors; in NED δθ is [δλ cos L, −δL, −δλ sin L]). Eq. (1) is the attitude-difference
+measurement of SINS/CNS: it couples the tilt φ with the position (the "mathematical horizon"; PSINS
+``test_SINS_CNS_def``'s H of kfhk 184 in ENU; Yang et al. 2022), so the star sensor measures ψ, the accelerometers
+hold φ to the local vertical through the Schuler loop, and their difference is the position. Its attitude
 filter form — q_IB,true = q_IB ⊗ δq(δθ_b) — lets the star residuals and fix residuals of
 :mod:`navsim.estimation.kernels` serve the INS: their H for (δθ_b, δm) is chained through
-A = ∂δθ_b/∂x = C_bn [I₃ (φ), −∂δθ_n/∂(δL, δλ)].
+A = ∂δθ_b/∂x = C_bw [I₃ (φ), −I₃[:, 0:2] (δθ_x, δθ_y)].
 """
 
 import numpy as np
 
-from navsim.earth.frames import q_en
 from navsim.estimation.kernels import fix_residual, gate_stars, star_residuals, tangent_basis
 from navsim.estimation.linalg import joseph_update, mm
 from navsim.estimation.nav_kernels import DP, flush, gated_update, reset
@@ -34,23 +30,22 @@ from startrack.rotation_jit import quat_multiply, quat_to_matrix
 
 @njit
 def inertial_attitude(nav, q_ie):
-    """q_IB of the INS, q_ie ⊗ q_en(L̂, λ̂) ⊗ q_nb (C_ib = C_ie C_en C_nb), for the navigation state
-    ``nav`` and the Earth's orientation q_ie (4,) at the time of the update."""
-    return quat_multiply(quat_multiply(q_ie, np.array(q_en(nav[0], nav[1]))), nav[6:10])
+    """q_IB of the INS, q_ie ⊗ q_ew ⊗ q_wb (C_ib = C_ie C_ew C_wb), for the navigation state ``nav`` and the
+    Earth's orientation q_ie (4,) at the time of the update."""
+    return quat_multiply(quat_multiply(q_ie, nav[0:4]), nav[8:12])
 
 
 @njit
 def attitude_jacobian(nav, n):
-    """A (3, n) with δθ_b = A x (eq. 1 of the module): C_bn in the φ columns and −C_bn ∂δθ_n/∂(δL, δλ)
-    = −C_bn [[0, cos L], [−1, 0], [0, −sin L]] in the δL, δλ columns."""
-    C_bn = quat_to_matrix(nav[6:10]).T
+    """A (3, n) with δθ_b = A x (eq. 1 of the module): C_bw in the φ columns and −C_bw's first two columns in the
+    δθ_x, δθ_y columns."""
+    C_bw = quat_to_matrix(nav[8:12]).T
     A = np.zeros((3, n))
-    c, s = np.cos(nav[0]), np.sin(nav[0])
     for i in range(3):
         for j in range(3):
-            A[i, j] = C_bn[i, j]
-        A[i, DP] = C_bn[i, 1]
-        A[i, DP + 1] = -(C_bn[i, 0] * c - C_bn[i, 2] * s)
+            A[i, j] = C_bw[i, j]
+        A[i, DP] = -C_bw[i, 0]
+        A[i, DP + 1] = -C_bw[i, 1]
     return A
 
 

@@ -2,11 +2,11 @@
 star sensor (SINS/CNS).
 
 The filter owns the nominal navigation state (the strapdown ``nav`` vector of
-:mod:`navsim.ins.strapdown`: L, λ, h, v_n, q_nb), its estimates beside it (gyro and accelerometer
-biases, optional scale factors, the star sensor's mounting q̂_BS) and the covariance P of the error
-state (:mod:`navsim.estimation.nav_kernels`, docs/design.md):
+:mod:`navsim.ins.strapdown`: q_ew, h, v_w, q_wb in the wander-azimuth frame w), its estimates beside it (gyro and
+accelerometer biases, optional scale factors, the star sensor's mounting q̂_BS) and the covariance P of the error
+state (:mod:`navsim.estimation.nav_kernels`, docs/design.md), which it shows in NED with the position in metres:
 
-    x = [φ, δv_n, δL, δλ, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg) (, ε_r)],   C_nb,est = (I − [φ×]) C_nb,true,
+    x = [φ, δv_n, δN, δE, δh, ε, ∇ (, δs_g, δs_a) (, μ) (, δg) (, ε_r)],   C_nb,est = (I − [φ×]) C_nb,true,
 
 μ the star-sensor mounting error (estimated or a consider state), δg the gravity disturbance the
 INS does not know and ε_r the fractional error of the air its star processing corrects the refraction with
@@ -16,7 +16,7 @@ tested against expm and Van Loan); the updates — ``update_position``, ``update
 ``update_attitude`` (a star-sensor fix) and ``update_stars`` (identified stars one by one,
 :mod:`navsim.estimation.celestial_kernels`) — gate each measurement by its chi-square NIS against
 the prior, update in Joseph form and reset the estimate into the nominal state. With a star sensor
-the filter also serves it (``sensor_prediction``: q̂_IS = q_ie ⊗ q_en ⊗ q_nb ⊗ q̂_BS and the rate in
+the filter also serves it (``sensor_prediction``: q̂_IS = q_ie ⊗ q_ew ⊗ q_wb ⊗ q̂_BS and the rate in
 sensor axes) and takes its faults (``reinitialise`` from a fix after a lost track, ``disturb``).
 ``process_record`` is the compiled fast path over a whole position/baro record, tested equal to the
 step-by-step loop of :mod:`navsim.closed_loop`. Nobody else writes the state or P: read them
@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.apparent import fix_rotation
-from navsim.earth.frames import local_up, q_en
+from navsim.earth.frames import c_en, local_up
+from navsim.earth.wander import ned_offset, normal, normal_turn, to_ned
 from navsim.earth.orientation import observer_velocity
 from navsim.earth.refraction import refract
 from navsim.estimation import celestial_kernels, nav_kernels
@@ -192,7 +193,8 @@ class NavFilter:
         self._calib = np.zeros(CALIB_SIZE)
         self._calib[12:16] = (0.0, 0.0, 0.0, 1.0) if config.star_sensor is None else rot.normalize(config.star_sensor.q_BS)
         self._nav = strapdown.initial_state(lat, lon, h, v_n, q_nb)
-        self._P = np.array(config.P0)
+        T_inv = np.linalg.inv(nav_kernels.public_jacobian(self._nav, self.n, self.layout.gravity))
+        self._P = T_inv @ np.array(config.P0) @ T_inv.T
         self._P0_attitude = self._P[0:3, 0:3].copy()
         self._acc = np.zeros(nav_kernels.ACC_SIZE)
         self._intervals = 0
@@ -271,13 +273,13 @@ class NavFilter:
         return rot.multiply(q_IB, self._calib[12:16]), rot.to_matrix(self._calib[12:16]).T @ a
 
     def reinitialise(self, q_IS):
-        """Restart the attitude from a star-sensor fix q_IS after a lost track: q_nb = q_en⁻¹ ⊗ q_ie⁻¹ ⊗
+        """Restart the attitude from a star-sensor fix q_IS after a lost track: q_wb = q_ew⁻¹ ⊗ q_ie⁻¹ ⊗
         q_IS ⊗ q̂_BS⁻¹ (the fix corrected like an update's), the attitude block of P back to its
         initial value and its correlations cleared."""
         j = self._frame()
         q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
-        q_ni = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], np.array(q_en(self._nav[0], self._nav[1]))))
-        self._nav[6:10] = rot.normalize(rot.multiply(rot.multiply(q_ni, q_IS), rot.conjugate(self._calib[12:16])))
+        q_wi = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], self._nav[0:4]))
+        self._nav[8:12] = rot.normalize(rot.multiply(rot.multiply(q_wi, q_IS), rot.conjugate(self._calib[12:16])))
         self._P[0:3, :] = 0.0
         self._P[:, 0:3] = 0.0
         self._P[0:3, 0:3] = self._P0_attitude
@@ -285,7 +287,7 @@ class NavFilter:
     def disturb(self, rotation_vector):
         """The attitude-jump fault: the estimate is knocked off by ``rotation_vector`` [rad] (body axes),
         as by a disturbance the filter is not told about; P is left as it was."""
-        self._nav[6:10] = rot.normalize(rot.multiply(self._nav[6:10], rot.from_rotation_vector(rotation_vector)))
+        self._nav[8:12] = rot.normalize(rot.multiply(self._nav[8:12], rot.from_rotation_vector(rotation_vector)))
 
     def _frame(self):
         if self.star_sensor is None:
@@ -294,7 +296,8 @@ class NavFilter:
 
     def _observer_velocity(self, j):
         o = self.star_sensor.orientation
-        return observer_velocity(o.c_ie[j], o.v_earth[j], self._nav[0], self._nav[1], self._nav[2], self._nav[3:6])
+        lat, lon, v_n, _ = self._ned()
+        return observer_velocity(o.c_ie[j], o.v_earth[j], lat, lon, self._nav[4], v_n)
 
     def sensor_prior(self):
         """The star sensor's :class:`~navsim.sensors.star_sensor.SensorPrior` at this frame: q̂_IS (as
@@ -344,8 +347,9 @@ class NavFilter:
         air = self.star_sensor.refraction
         if air is None:
             return None
-        a, b = air.coefficients(self._nav[2])
-        return local_up(self.star_sensor.orientation.c_ie[j], self._nav[0], self._nav[1]), a, b
+        lat, lon, _, _ = self._ned()
+        a, b = air.coefficients(self._nav[4])
+        return local_up(self.star_sensor.orientation.c_ie[j], lat, lon), a, b
 
     def _corrected_fix(self, q_IS, j):
         """The fix turned back by the rotation of its boresight to its apparent direction, as far as the processing
@@ -369,21 +373,24 @@ class NavFilter:
                                      record.baro_sigma * self.sigma_scale, self.gates, self.estimated,
                                      self.baro_estimated)
         self._intervals += samples.shape[0]
-        nav_log, calib_log, P_log = out[0], out[1], out[2]
+        nav_log, calib_log = out[0], out[1]
+        P_log = nav_kernels.public_covariances(nav_log, out[2], self.layout.gravity)
         log = dict(zip(("n_measurements", "n_accepted", "nis", "nis_dof", "innovation_rms"), out[3:]))
         return {**self._snapshot_arrays(nav_log, calib_log), "P": P_log, **log}
 
     def snapshot(self):
         """What a run log keeps of the filter at an epoch: position, velocity, attitude, the estimates
         beside them and P (copies)."""
-        return {**self._snapshot_arrays(self._nav[0:10], self._calib), "P": self.P}
+        return {**self._snapshot_arrays(self._nav[0:strapdown.ROW], self._calib), "P": self.P}
 
     def _snapshot_arrays(self, nav, calib):
-        """The snapshot's named parts (copies) of nav[0:10] and the estimates ``calib``, one row or (F, ·)
-        rows: lat, lon, h, v_n, q_nb, gyro_bias, accel_bias and, with scale-factor states,
-        gyro_scale_factor and accel_scale_factor, with a star sensor q_bs."""
-        out = {"lat": nav[..., 0].copy(), "lon": nav[..., 1].copy(), "h": nav[..., 2].copy(),
-               "v_n": nav[..., 3:6].copy(), "q_nb": nav[..., 6:10].copy(), "gyro_bias": calib[..., 0:3].copy(),
+        """The snapshot's named parts (copies) of solution rows nav[0:ROW] and the estimates ``calib``, one row or
+        (F, ·) rows: lat, lon, h, v_n, q_nb (in NED, :func:`navsim.earth.wander.to_ned`), q_ew (the wander-azimuth
+        frame), gyro_bias, accel_bias and, with scale-factor states, gyro_scale_factor and accel_scale_factor, with a
+        star sensor q_bs."""
+        lat, lon, v_n, q_nb = to_ned(nav[..., 0:4], nav[..., 5:8], nav[..., 8:12])
+        out = {"lat": lat, "lon": lon, "h": nav[..., 4].copy(), "v_n": v_n, "q_nb": q_nb, "q_ew": nav[..., 0:4].copy(),
+               "gyro_bias": calib[..., 0:3].copy(),
                "accel_bias": calib[..., 3:6].copy()}
         if self.layout.scale >= 0:
             out["gyro_scale_factor"], out["accel_scale_factor"] = calib[..., 6:9].copy(), calib[..., 9:12].copy()
@@ -393,21 +400,27 @@ class NavFilter:
 
     @property
     def P(self):
-        """Covariance of the error state at the last propagation (a copy)."""
-        return self._P.copy()
+        """Covariance of the error state at the last propagation, in NED with the position in metres (module
+        docstring; :func:`nav_kernels.public_jacobian`)."""
+        return nav_kernels.to_public(self._P, self._nav[0:strapdown.ROW], self.layout.gravity)
 
     @property
     def position(self):
         """(L, λ, h) [rad, rad, m]."""
-        return tuple(float(x) for x in self._nav[0:3])
+        lat, lon, _, _ = self._ned()
+        return float(lat), float(lon), float(self._nav[4])
 
     @property
     def v_n(self):
-        return self._nav[3:6].copy()
+        return self._ned()[2]
 
     @property
     def q_nb(self):
-        return self._nav[6:10].copy()
+        return self._ned()[3]
+
+    def _ned(self):
+        """(L, λ, v_n, q_nb) of the wander-azimuth solution (:func:`navsim.earth.wander.to_ned`)."""
+        return to_ned(self._nav[0:4], self._nav[5:8], self._nav[8:12])
 
     @property
     def gyro_bias(self):
@@ -430,7 +443,7 @@ class NavFilter:
 
 def state_names(layout):
     """The names of the error state's components in order (timeseries ``state_names``)."""
-    names = ["phi_N", "phi_E", "phi_D", "dv_N", "dv_E", "dv_D", "dlat", "dlon", "dh", "eps_x", "eps_y", "eps_z",
+    names = ["phi_N", "phi_E", "phi_D", "dv_N", "dv_E", "dv_D", "dN", "dE", "dh", "eps_x", "eps_y", "eps_z",
              "nabla_x", "nabla_y", "nabla_z"]
     if layout.scale >= 0:
         names += ["dsg_x", "dsg_y", "dsg_z", "dsa_x", "dsa_y", "dsa_z"]
@@ -445,11 +458,26 @@ def state_names(layout):
 
 def error_state(lat, lon, h, v_n, q_nb, gyro_bias, accel_bias, truth_lat, truth_lon, truth_h, truth_v_n,
                 truth_q_nb, truth_gyro_bias, truth_accel_bias):
-    """The filter's error (est − true in its definitions) (..., 15): φ from C_est C_trueᵀ = I − [φ×],
-    δv, δL, δλ, δh, ε = b_g,true − b̂_g, ∇ = b_a,true − b̂_a. Inputs broadcast over a leading axis."""
-    phi = -rot.to_rotation_vector(rot.multiply(q_nb, rot.conjugate(truth_q_nb)))
-    dp = np.stack([np.asarray(lat) - truth_lat, np.asarray(lon) - truth_lon, np.asarray(h) - truth_h], axis=-1)
-    return np.concatenate([phi, np.asarray(v_n) - truth_v_n, dp, np.asarray(truth_gyro_bias) - gyro_bias,
+    """The filter's error (est − true in its definitions, as it shows them: NED axes of the estimate, position in
+    metres) (..., 15). With δθ_e the turn of the true normal into the estimated one
+    (:func:`navsim.earth.wander.normal_turn`; the true local-level frame is the estimated one turned back by it):
+    φ from C_eb,est C_be,true exp(−[δθ_e×]) = I − [φ_e×], δv from v_e,est − exp([δθ_e×]) v_e,true, both resolved by
+    C_ne,est; (δN, δE) the estimate's offset from the truth in its own NED (minus :func:`navsim.earth.wander.ned_offset`
+    of the truth from it); δh; ε = b_g,true − b̂_g,
+    ∇ = b_a,true − b̂_a. Inputs broadcast over a leading axis."""
+    C_en, C_en_true = c_en(lat, lon), c_en(truth_lat, truth_lon)
+    C_ne = np.swapaxes(C_en, -1, -2)
+    turn = normal_turn(normal(truth_lat, truth_lon), normal(lat, lon))
+    q_turn = rot.from_rotation_vector(turn)
+    q_eb = rot.multiply(rot.from_matrix(C_en), q_nb)
+    q_eb_true = rot.multiply(rot.multiply(q_turn, rot.from_matrix(C_en_true)), truth_q_nb)
+    phi_e = -rot.to_rotation_vector(rot.multiply(q_eb, rot.conjugate(q_eb_true)))
+    v_e = np.einsum("...ij,...j->...i", C_en, v_n)
+    v_e_true = rot.rotate(q_turn, np.einsum("...ij,...j->...i", C_en_true, truth_v_n))
+    rows = lambda x: np.einsum("...ij,...j->...i", C_ne, x)  # noqa: E731
+    dp = -ned_offset(truth_lat, truth_lon, truth_h, lat, lon, h)  # the truth from the estimate, in its NED; δh = −(−δD)
+    dp[..., 2] *= -1.0
+    return np.concatenate([rows(phi_e), rows(v_e - v_e_true), dp, np.asarray(truth_gyro_bias) - gyro_bias,
                            np.asarray(truth_accel_bias) - accel_bias], axis=-1)
 
 

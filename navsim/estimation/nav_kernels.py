@@ -5,12 +5,15 @@ the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kerne
 Error state x (zero between updates; docs/design.md), each optional group where :class:`Layout`
 puts it:
 
-    [φ (3) | δv_n (3) | δL, δλ, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) | μ (3) | δg (3) | ε_r]
+    [φ (3) | δv_w (3) | δθ_x, δθ_y, δh | ε (3) | ∇ (3) | δs_g (3), δs_a (3) | μ (3) | δg (3) | ε_r]
 
-with C_nb,est = (I − [φ×]) C_nb,true, δv = v_est − v_true, δL = L_est − L_true (…), ε = b_g,true −
-b̂_g and ∇ = b_a,true − b̂_a (the residual biases of the corrected increments), δs = s_true − ŝ, the
-star-sensor mounting error μ (q_BS,true = q̂_BS ⊗ δq(μ), μ in sensor axes) and the gravity
-disturbance of the truth δg = [−ξγ, −ηγ, Δg] (NED) that the INS does not know: a first-order
+resolved in the wander-azimuth frame w of the INS (:mod:`navsim.earth.wander`; issue 31: no latitude or
+longitude in it, so it holds at the poles), with C_ew,est = C_ew,true (I + [δθ×]), δθ = [δθ_x, δθ_y, 0] horizontal
+(the true w frame is the local-level frame at the true position that the minimal rotation turns into the
+estimated one), C_wb,est = (I − [φ×]) C_wb,true, δv = v_w,est − v_w,true (each in its own w frame), δh = h_est −
+h_true, ε = b_g,true − b̂_g and ∇ = b_a,true − b̂_a (the residual biases of the corrected increments), δs = s_true − ŝ,
+the star-sensor mounting error μ (q_BS,true = q̂_BS ⊗ δq(μ), μ in sensor axes) and the gravity
+disturbance of the truth δg = [−ξγ, −ηγ, Δg] (in w) that the INS does not know: a first-order
 Gauss-Markov process in travelled distance (σ, correlation length D: in time, 1/τ = V/D with V the
 horizontal speed; a random constant when D is infinite), kept as consider states (Schmidt), and the fractional
 error ε_r of the air the star sensor's processing corrects the refraction with (eq. 3 of
@@ -19,21 +22,24 @@ Corrected increments are (1 − ŝ)(Δθ̃ − b̂_g Δt) and (1 − ŝ_a)(Δṽ
 
 The filter's estimates beside the strapdown ``nav`` vector are ``calib`` (:data:`CALIB_SIZE`):
 [b̂_g (3), b̂_a (3), ŝ_g (3), ŝ_a (3), q̂_BS (4)].
+
+What the filter shows (its ``P``, a run's error state) is this state turned into NED with the position in metres
+(:func:`public_jacobian`): [φ_n | δv_n | δN, δE, δh | … | δg_n | …], defined wherever NED is.
 """
 
 from collections import namedtuple
 
 import numpy as np
 
-from navsim.earth.frames import earth_rate_n, transport_rate_n
-from navsim.earth.gravity import normal_gravity_height_gradient, normal_gravity_latitude_gradient
+from navsim.earth.gravity import normal_gravity_height_gradient, normal_gravity_sine_gradient
+from navsim.earth.wander import curvature, earth_rate_w, frame_angles, radii_of_sine, transport_rate_w
 from navsim.earth.wgs84 import E2, radii
 from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t, van_loan
-from navsim.ins.strapdown import step
+from navsim.ins.strapdown import ROW, step
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, skew
 
-#: First index of the position error (δL, δλ, δh) in the error state.
+#: First index of the position error (δθ_x, δθ_y, δh) in the error state.
 DP = 6
 #: The 15 states every navigation filter carries (attitude, velocity, position, the two biases).
 BASE_STATES = 15
@@ -62,58 +68,82 @@ def layout(scale_factors=False, mounting=False, gravity=False, refraction=False)
 #: really carries; a white-noise height reference does, and the filter may then update every state:
 #: ``NavFilterConfig(baro_states="all")``, as PSINS's SINS/CNS height measurement.)
 BARO_STATES = (5, DP + 2, 14)
-#: Layout of the accumulator of one covariance interval: [count, Σ C_nb Δv (3), Σ C_nb (9),
-#: Σ C_nb diag(Δθ) (9), Σ C_nb diag(Δv) (9)].
+#: Layout of the accumulator of one covariance interval: [count, Σ C_wb Δv (3), Σ C_wb (9),
+#: Σ C_wb diag(Δθ) (9), Σ C_wb diag(Δv) (9)].
 ACC_SIZE = 31
 
 
 @njit
-def continuous_f(lat, h, v, f_n, C, C_w, C_f, layout, inv_length):
-    """Continuous error dynamics F (n x n) at (L, h, v_n) [rad, m, m/s] for the specific force f_n
-    [m/s²] in n, the mean C_nb ``C``, and (for the scale-factor columns) C_nb diag(ω_b) ``C_w``
-    [rad/s] and C_nb diag(f_b) ``C_f`` [m/s²], the states of ``layout`` and the gravity
-    disturbance's 1/D [1/m] (Titterton & Weston, 2nd ed., ch. 12; Groves, 2nd ed., §14.2.4, with
-    this φ sign):
-
-    φ̇ = −ω_in × φ + δω_in − C_nb (ε + diag(ω_b) δs_g),
-    δv̇ = f^n × φ + C_nb (∇ + diag(f_b) δs_a) − (2ω_ie + ω_en) × δv − (2δω_ie + δω_en) × v + δγ − δg,
-    δL̇ = δv_N/(R_M+h) − v_N δh/(R_M+h)², δλ̇ = δv_E/((R_N+h) cos L) + v_E tan L δL/((R_N+h) cos L)
-    − v_E δh/((R_N+h)² cos L), δḣ = −δv_D; δγ = [0, 0, ∂γ/∂L δL + ∂γ/∂h δh]; the mounting constant;
-    the disturbance δ̇g = −(V/D) δg (the truth's gravity, so −δg in δv̇: the INS lacks it); and the terms of
-    dR_M/dL = 3 R_M e² sin L cos L/(1 − e² sin²L), dR_N/dL = R_N e² sin L cos L/(1 − e² sin²L)
-    in every δL column (usually neglected; kept so that F is the exact Jacobian).
-    """
-    r_m, r_n = radii(lat)
+def _rho_derivatives(C_ew, h, v):
+    """(ρ (3,), ∂δρ/∂δv (3, 3), ∂δρ/∂(δθ_x, δθ_y, δh) (3, 3)) of the transport rate ρ = ω_ew^w (eq. 2 of
+    :mod:`navsim.earth.wander`, g = D v_h, ρ = [g_y, −g_x, 0]), δρ = ρ_est − ρ_true each in its own frame. The true
+    frame turns about the vertical at −(ρ × δθ)_z (it keeps δθ horizontal), hence δρ_z = ρ_x δθ_y − ρ_y δθ_x.
+    Through the position: δs = c_1 δθ_x − c_0 δθ_y, δc = s [δθ_y, −δθ_x] (from C_ew,est = C_ew,true (I + [δθ×]))."""
+    D, k, s, c = curvature(C_ew, h)
+    r_m, r_n, dr_m, dr_n = radii_of_sine(s)
     rm, rn = r_m + h, r_n + h
-    s, c, t = np.sin(lat), np.cos(lat), np.tan(lat)
-    k = E2 * s * c / (1.0 - E2 * s * s)
-    dr_m, dr_n = 3.0 * r_m * k, r_n * k  # dR_M/dL, dR_N/dL
-    w_ie = np.array(earth_rate_n(lat))
-    w_en = np.array(transport_rate_n(lat, h, v[0], v[1]))
-    # ∂ω_en/∂v, ∂ω_ie/∂p and ∂ω_en/∂p (p = L, λ, h)
-    d_en_v = np.zeros((3, 3))
-    d_en_v[0, 1], d_en_v[1, 0], d_en_v[2, 1] = 1.0 / rn, -1.0 / rm, -t / rn
-    d_ie_p = np.zeros((3, 3))
-    d_ie_p[0, 0], d_ie_p[2, 0] = w_ie[2], -w_ie[0]  # Ω(−sin L, 0, −cos L)
-    d_en_p = np.zeros((3, 3))
-    d_en_p[0, 0], d_en_p[1, 0] = -v[1] * dr_n / rn**2, v[0] * dr_m / rm**2
-    d_en_p[2, 0] = -v[1] / (rn * c * c) + v[1] * t * dr_n / rn**2
-    d_en_p[0, 2], d_en_p[1, 2], d_en_p[2, 2] = -v[1] / rn**2, v[0] / rm**2, v[1] * t / rn**2
+    rho = transport_rate_w(C_ew, h, v)
+    cv = c[0] * v[0] + c[1] * v[1]
+    dg_dh = np.empty(2)
+    dg_ds = np.empty(2)
+    dk_dh = -k * (1.0 / rm + 1.0 / rn)
+    dk_ds = k * (dr_n / r_n + 2.0 * E2 * s / (1.0 - E2 * s * s) - dr_m / rm - dr_n / rn)
+    for i in range(2):
+        dg_dh[i] = -v[i] / rn**2 + dk_dh * c[i] * cv
+        dg_ds[i] = -v[i] * dr_n / rn**2 + dk_ds * c[i] * cv
+    # ∂g/∂θ = ∂g/∂s [c_1, −c_0] + k (cv I + c v_hᵀ) [[0, s], [−s, 0]]
+    dg_dt = np.empty((2, 2))
+    for i in range(2):
+        m0, m1 = k * (cv * (i == 0) + c[i] * v[0]), k * (cv * (i == 1) + c[i] * v[1])
+        dg_dt[i, 0] = dg_ds[i] * c[1] - m1 * s
+        dg_dt[i, 1] = -dg_ds[i] * c[0] + m0 * s
+    d_v = np.zeros((3, 3))
+    d_p = np.zeros((3, 3))
+    for j in range(2):
+        d_v[0, j], d_v[1, j] = D[1, j], -D[0, j]
+        d_p[0, j], d_p[1, j] = dg_dt[1, j], -dg_dt[0, j]
+    d_p[0, 2], d_p[1, 2] = dg_dh[1], -dg_dh[0]
+    d_p[2, 0], d_p[2, 1] = -rho[1], rho[0]
+    return rho, d_v, d_p
+
+
+@njit
+def continuous_f(C_ew, h, v, f_w, C, C_w, C_f, layout, inv_length):
+    """Continuous error dynamics F (n x n) at the position C_ew (3, 3), h [m] and ground velocity v (3,) [m/s] in w
+    for the specific force f_w [m/s²] in w, the mean C_wb ``C``, and (for the scale-factor columns) C_wb diag(ω_b)
+    ``C_w`` [rad/s] and C_wb diag(f_b) ``C_f`` [m/s²], the states of ``layout`` and the gravity disturbance's 1/D
+    [1/m] (Titterton & Weston, 2nd ed., §12.3.2 with w for n; Groves, 2nd ed., §14.2.4, with this φ sign):
+
+    φ̇ = −ω_iw × φ + δω_ie + δρ − C_wb (ε + diag(ω_b) δs_g),  δω_ie = ω_ie^w × δθ,
+    δv̇ = f^w × φ + C_wb (∇ + diag(f_b) δs_a) − (2ω_ie + ρ) × δv − (2δω_ie + δρ) × v + δγ − δg,
+    δθ̇_x,y = δρ_x,y,  δḣ = −δv_z;  δγ = [0, 0, ∂γ/∂s δs + ∂γ/∂h δh];
+
+    δρ of :func:`_rho_derivatives` (the exact derivatives of the ellipsoid's curvature, finite at the poles); the
+    mounting constant; the disturbance δ̇g = −(V/D) δg (the truth's gravity, so −δg in δv̇: the INS lacks it).
+    """
+    w_ie = earth_rate_w(C_ew)
+    rho, d_v, d_p = _rho_derivatives(C_ew, h, v)
+    d_ie = np.zeros((3, 3))
+    W = skew(w_ie)
+    for i in range(3):
+        d_ie[i, 0], d_ie[i, 1] = W[i, 0], W[i, 1]
     V = skew(v)
     F = np.zeros((layout.n, layout.n))
-    F[0:3, 0:3] = -skew(w_ie + w_en)
-    F[0:3, 3:6] = d_en_v
-    F[0:3, 6:9] = d_ie_p + d_en_p
+    F[0:3, 0:3] = -skew(w_ie + rho)
+    F[0:3, 3:6] = d_v
+    F[0:3, 6:9] = d_ie + d_p
     F[0:3, 9:12] = -C
-    F[3:6, 0:3] = skew(f_n)
-    F[3:6, 3:6] = -skew(2.0 * w_ie + w_en) + mm(V, d_en_v)
-    F[3:6, 6:9] = mm(V, 2.0 * d_ie_p + d_en_p)
-    F[5, 6] += normal_gravity_latitude_gradient(lat, h)
-    F[5, 8] += normal_gravity_height_gradient(lat, h)
+    F[3:6, 0:3] = skew(f_w)
+    F[3:6, 3:6] = -skew(2.0 * w_ie + rho) + mm(V, d_v)
+    F[3:6, 6:9] = mm(V, 2.0 * d_ie + d_p)
+    s = -C_ew[2, 2]
+    dgamma = normal_gravity_sine_gradient(s, h)
+    F[5, 6] += dgamma * C_ew[2, 1]
+    F[5, 7] -= dgamma * C_ew[2, 0]
+    F[5, 8] += normal_gravity_height_gradient(np.arcsin(min(1.0, max(-1.0, s))), h)
     F[3:6, 12:15] = C
-    F[6, 3], F[6, 6], F[6, 8] = 1.0 / rm, -v[0] * dr_m / rm**2, -v[0] / rm**2
-    F[7, 4], F[7, 8] = 1.0 / (rn * c), -v[1] / (rn * rn * c)
-    F[7, 6] = v[1] * s / (rn * c * c) - v[1] * dr_n / (rn * rn * c)
+    F[6:8, 3:6] = d_v[0:2]
+    F[6:8, 6:9] = d_p[0:2]
     F[8, 5] = -1.0
     if layout.scale >= 0:
         F[0:3, layout.scale:layout.scale + 3] = -C_w
@@ -124,6 +154,26 @@ def continuous_f(lat, h, v, f_n, C, C_w, C_f, layout, inv_length):
             F[3 + i, layout.gravity + i] = -1.0
             F[layout.gravity + i, layout.gravity + i] = -decay
     return F
+
+
+@njit
+def public_jacobian(nav, n, gravity):
+    """T (n, n): the error state in w turned into what the filter shows (module docstring): φ_n = C_nw φ,
+    δv_n = C_nw δv, (δN, δE) = −diag(R_M + h, R_N + h) R(α) J (δθ_x, δθ_y) (J = [[0, 1], [−1, 0]], the inverse of the
+    position map of :func:`navsim.earth.wander.ned_offset`), δh, δg_n = C_nw δg (``gravity`` its first index, −1:
+    none); the other states as they are. α from :func:`navsim.earth.wander.frame_angles`."""
+    C_ew = quat_to_matrix(nav[0:4])
+    lat, _, alpha = frame_angles(C_ew)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    r_m, r_n = radii(lat)
+    T = np.eye(n)
+    for b in (0, 3, gravity):
+        if b >= 0:
+            T[b, b], T[b, b + 1], T[b + 1, b], T[b + 1, b + 1] = ca, -sa, sa, ca
+    h = nav[4]
+    T[DP, DP], T[DP, DP + 1] = -(r_m + h) * sa, -(r_m + h) * ca
+    T[DP + 1, DP], T[DP + 1, DP + 1] = (r_n + h) * ca, -(r_n + h) * sa
+    return T
 
 
 @njit
@@ -168,9 +218,10 @@ def noise_densities(nav, model):
     q = model.q_c.copy()
     g = model.layout.gravity
     if g >= 0:
-        rate = np.hypot(nav[3], nav[4]) * model.gm[3]
+        rate = np.hypot(nav[5], nav[6]) * model.gm[3]
+        horizontal = 0.5 * (model.gm[0] + model.gm[1])  # the w frame turns: an isotropic horizontal field
         for i in range(3):
-            q[g + i] = 2.0 * model.gm[i] * rate
+            q[g + i] = 2.0 * (horizontal if i < 2 else model.gm[2]) * rate
     return q
 
 
@@ -185,7 +236,7 @@ def flush(nav, P, acc, model):
     C = acc[4:13].reshape(3, 3) / count
     C_w = acc[13:22].reshape(3, 3) / span
     C_f = acc[22:31].reshape(3, 3) / span
-    F = continuous_f(nav[0], nav[2], nav[3:6], acc[1:4] / span, C, C_w, C_f, model.layout, model.gm[3])
+    F = continuous_f(quat_to_matrix(nav[0:4]), nav[4], nav[5:8], acc[1:4] / span, C, C_w, C_f, model.layout, model.gm[3])
     Phi, Q = discretize(F, noise_densities(nav, model), span)
     P_next = mm(Phi, mm(Phi, P).T.copy()) + Q  # Φ (Φ P)ᵀ = Φ P Φᵀ with sparse left factors
     P[:, :] = 0.5 * (P_next + P_next.T)
@@ -200,7 +251,7 @@ def predict(nav, calib, P, acc, samples, model):
     scale = model.layout.scale >= 0
     for k in range(samples.shape[0]):
         correct(samples[k], calib, model.dt, scale, a, b)
-        accumulate(acc, nav[6:10], a, b)
+        accumulate(acc, nav[8:12], a, b)
         step(nav, a, b, model.dt)
         if acc[0] >= model.every:
             flush(nav, P, acc, model)
@@ -208,13 +259,15 @@ def predict(nav, calib, P, acc, samples, model):
 
 @njit
 def reset(nav, calib, dx, layout):
-    """Fold the error estimate dx into the nominal state (in place): C_nb ← exp([φ×]) C_nb,
-    v ← v − δv, (L, λ, h) ← − (δL, δλ, δh), b̂ ← b̂ + (ε, ∇), ŝ ← ŝ + δs, q̂_BS ← q̂_BS ⊗ δq(μ)
+    """Fold the error estimate dx into the nominal state (in place): C_wb ← exp([φ×]) C_wb,
+    v ← v − δv, C_ew ← C_ew exp(−[δθ×]), h ← h − δh, b̂ ← b̂ + (ε, ∇), ŝ ← ŝ + δs, q̂_BS ← q̂_BS ⊗ δq(μ)
     (the gravity disturbance is a consider state: never estimated)."""
-    q = quat_multiply(quat_from_rotation_vector(dx[0:3]), nav[6:10])
-    nav[6:10] = q / np.sqrt(np.sum(q * q))
-    nav[3:6] -= dx[3:6]
-    nav[0:3] -= dx[6:9]
+    q = quat_multiply(quat_from_rotation_vector(dx[0:3]), nav[8:12])
+    nav[8:12] = q / np.sqrt(np.sum(q * q))
+    nav[5:8] -= dx[3:6]
+    q = quat_multiply(nav[0:4], quat_from_rotation_vector(np.array([-dx[DP], -dx[DP + 1], 0.0])))
+    nav[0:4] = q / np.sqrt(np.sum(q * q))
+    nav[4] -= dx[DP + 2]
     calib[0:6] += dx[9:15]
     if layout.scale >= 0:
         calib[6:12] += dx[layout.scale:layout.scale + 6]
@@ -225,25 +278,45 @@ def reset(nav, calib, dx, layout):
 
 
 @njit
+def position_terms(nav, fix, sigma, n):
+    """(z (3,) [m, w axes], H (3, n), R (3, 3), C_nw (3, 3)) of a position fix ``fix`` = (L, λ, h) [rad, rad, m] of
+    NED σ ``sigma`` (3,) [m]: z = the estimate's offset from the fix, horizontal −D⁻¹ J δθ (δθ the rotation that
+    turns the fix's normal into the estimate's, in w; D of eq. 2 of :mod:`navsim.earth.wander`), then −δh (down);
+    H = [−D⁻¹ J, −e_h] in the position columns, R = C_wn diag(σ²) C_nw."""
+    C_ew = quat_to_matrix(nav[0:4])
+    cl = np.cos(fix[0])
+    up_fix = np.array([cl * np.cos(fix[1]), cl * np.sin(fix[1]), np.sin(fix[0])])
+    up = np.array([-C_ew[0, 2], -C_ew[1, 2], -C_ew[2, 2]])
+    axis = np.cross(up_fix, up)
+    sine = np.sqrt(np.sum(axis * axis))
+    theta_e = axis * (np.arctan2(sine, np.sum(up_fix * up)) / sine if sine > 0.0 else 1.0)
+    theta = C_ew.T @ theta_e
+    D, _, _, _ = curvature(C_ew, nav[4])
+    D_inv = inverse_small(D)
+    z = np.empty(3)
+    H = np.zeros((3, n))
+    for i in range(2):
+        z[i] = -(D_inv[i, 0] * theta[1] - D_inv[i, 1] * theta[0])
+        H[i, DP], H[i, DP + 1] = D_inv[i, 1], -D_inv[i, 0]
+    z[2] = -(nav[4] - fix[2])
+    H[2, DP + 2] = -1.0
+    _, _, alpha = frame_angles(C_ew)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    C_nw = np.array([[ca, -sa, 0.0], [sa, ca, 0.0], [0.0, 0.0, 1.0]])
+    R = C_nw.T @ np.diag(sigma * sigma) @ C_nw
+    return z, H, R, C_nw
+
+
+@njit
 def position_update(nav, calib, P, acc, model, fix, sigma, gate, estimated):
     """Flush the covariance, then the gated update with a position fix ``fix`` = (L, λ, h) [rad, rad, m]
-    of NED σ ``sigma`` (3,) [m]: z = (L̂, λ̂, ĥ) − fix, H = [0 0 I 0 …],
-    R = diag(σ_N²/(R_M+h)², σ_E²/((R_N+h) cos L)², σ_D²), the ``estimated`` states corrected.
+    of NED σ ``sigma`` (3,) [m] (:func:`position_terms`), the ``estimated`` states corrected.
     Returns (z in NED metres (3,), nis, accepted); the state, P and the nominal state change in place."""
     flush(nav, P, acc, model)
-    n = P.shape[0]
-    r_m, r_n = radii(nav[0])
-    scale = np.array([r_m + nav[2], (r_n + nav[2]) * np.cos(nav[0]), -1.0])
-    H = np.zeros((3, n))
-    R = np.zeros((3, 3))
-    z = np.empty(3)
-    for i in range(3):
-        H[i, DP + i] = 1.0
-        R[i, i] = (sigma[i] / scale[i]) ** 2
-        z[i] = nav[i] - fix[i]
-    z_m = z * scale
+    z, H, R, C_nw = position_terms(nav, fix, sigma, P.shape[0])
+    z_n = C_nw @ z
     nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
-    return z_m, nis, accepted
+    return z_n, nis, accepted
 
 
 @njit
@@ -254,7 +327,7 @@ def baro_update(nav, calib, P, acc, model, height, sigma, gate, estimated):
     H = np.zeros((1, P.shape[0]))
     H[0, DP + 2] = 1.0
     R = np.full((1, 1), sigma * sigma)
-    z = np.array([nav[2] - height])
+    z = np.array([nav[4] - height])
     nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return z, nis, accepted
 
@@ -286,11 +359,11 @@ def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sig
     ``position`` (F, 3), NaN: none) and baro height (``baro`` (F,), NaN: none) update it in that
     order (the fix correcting the ``estimated`` states, the baro the ``baro_estimated``), with ``gates`` =
     (3-dof, 1-dof) NIS gates. Returns the per-frame logs of the step-by-step
-    loop: nav[0:10] (F, 10), the estimates ``calib`` (F, 16), P (F, n, n) and the frame's update
+    loop: nav[0:ROW] (F, ROW), the estimates ``calib`` (F, 16), P (F, n, n) and the frame's update
     statistics (measurements, accepted, NIS sum, dof, innovation RMS [m])."""
     frames = position.shape[0]
     n = P.shape[0]
-    nav_log, calib_log, P_log = np.empty((frames, 10)), np.empty((frames, CALIB_SIZE)), np.empty((frames, n, n))
+    nav_log, calib_log, P_log = np.empty((frames, ROW)), np.empty((frames, CALIB_SIZE)), np.empty((frames, n, n))
     n_meas, n_acc, dof_log = np.zeros(frames, np.int32), np.zeros(frames, np.int32), np.zeros(frames, np.int32)
     nis_log, rms_log = np.full(frames, np.nan), np.full(frames, np.nan)
     for f in range(frames):
@@ -306,8 +379,52 @@ def run_record(nav, calib, P, acc, samples, ratio, model, position, position_sig
             count += 1
             if ok:
                 accepted, nis_sum, dof, squares = accepted + 1, nis_sum + nis, dof + 1, squares + z[0] * z[0]
-        nav_log[f], calib_log[f], P_log[f] = nav[0:10], calib, P
+        nav_log[f], calib_log[f], P_log[f] = nav[0:ROW], calib, P
         n_meas[f], n_acc[f], dof_log[f] = count, accepted, dof
         if accepted:
             nis_log[f], rms_log[f] = nis_sum, np.sqrt(squares / dof)
     return nav_log, calib_log, P_log, n_meas, n_acc, nis_log, dof_log, rms_log
+
+
+@njit
+def public_covariances(nav_rows, P_rows, gravity):
+    """:func:`to_public` of each logged P (F, n, n) at its solution row (F, ROW)."""
+    out = np.empty_like(P_rows)
+    for f in range(P_rows.shape[0]):
+        out[f] = to_public(P_rows[f], nav_rows[f], gravity)
+    return out
+
+
+@njit
+def to_public(P, nav, gravity):
+    """T P Tᵀ for T = :func:`public_jacobian` (n, n) of the solution row ``nav``, using its structure: T differs from
+    the identity only on the leading nine states and the gravity disturbance's three."""
+    n = P.shape[0]
+    T = public_jacobian(nav, n, gravity)
+    count = 9 if gravity < 0 else 12
+    idx = np.empty(count, np.int64)
+    for a in range(9):
+        idx[a] = a
+    for a in range(count - 9):
+        idx[9 + a] = gravity + a
+    out = P.copy()
+    for a in range(count):  # rows: (T P)[i, :] = Σ_b T[i, b] P[b, :] over the turned states
+        for j in range(n):
+            total = 0.0
+            for b in range(count):
+                total += T[idx[a], idx[b]] * P[idx[b], j]
+            out[idx[a], j] = total
+    rows = out.copy()
+    for i in range(n):  # columns: (T P Tᵀ)[:, j] = Σ_b (T P)[:, b] T[j, b]
+        for a in range(count):
+            total = 0.0
+            for b in range(count):
+                total += rows[i, idx[b]] * T[idx[a], idx[b]]
+            out[i, idx[a]] = total
+    return out
+
+
+@njit
+def to_public_vector(x, nav, gravity):
+    """T x (n,) for T = :func:`public_jacobian` of the solution row ``nav``."""
+    return public_jacobian(nav, x.shape[0], gravity) @ x

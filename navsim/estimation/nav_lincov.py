@@ -14,11 +14,12 @@ from collections import namedtuple
 
 import numpy as np
 
-from navsim.earth.wgs84 import radii
+from navsim.earth.wander import frame_angles
 from navsim.estimation.celestial_kernels import fix_terms, star_terms
 from navsim.estimation.linalg import van_loan
 from navsim.estimation.lincov import allocate_log, keep, propagate, trimmed, update
-from navsim.estimation.nav_kernels import DP, continuous_f, discretize, noise_densities
+from navsim.estimation.nav_kernels import (DP, continuous_f, discretize, noise_densities, position_terms,
+                                           public_jacobian, to_public, to_public_vector)
 from startrack.jit import njit
 from startrack.rotation_jit import quat_to_matrix
 
@@ -48,23 +49,23 @@ Measurements = namedtuple("Measurements", "star_offsets star_ref star_ref_real s
                                           "refraction_source")
 #: The off-diagonal terms (i, j) of a misalignment matrix M, in the order of its six states.
 MISALIGNMENT_PAIRS = ((0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
-#: The leading block kept in full at every output frame: φ, δv, δL, δλ, δh.
+#: The leading block kept in full at every output frame: φ, δv, δN, δE, δh.
 BLOCK = 9
 
 
 @njit
-def truth_f(lat, h, v, f_n, C, G_w, G_f, tl, inv_length, inv_tau):
+def truth_f(C_ew, h, v, f_n, C, G_w, G_f, tl, inv_length, inv_tau):
     """The truth's continuous error dynamics (n_t, n_t): :func:`nav_kernels.continuous_f` of its ``base``
-    layout (1/D ``inv_length`` of its gravity disturbance), then φ̇ −= C_nb g_g, δv̇ += C_nb g_a with
-    ġ = −g/τ (``inv_tau`` = (1/τ_g, 1/τ_a)), and the misalignment columns φ̇ −= C_nb M_g ω_b,
-    δv̇ += C_nb M_a f_b: column (i, j) is −G_w[:, i, j] (G_w[a, i, j] the interval mean of C_nb[a, i] ω_j,
+    layout (1/D ``inv_length`` of its gravity disturbance), then φ̇ −= C_wb g_g, δv̇ += C_wb g_a with
+    ġ = −g/τ (``inv_tau`` = (1/τ_g, 1/τ_a)), and the misalignment columns φ̇ −= C_wb M_g ω_b,
+    δv̇ += C_wb M_a f_b: column (i, j) is −G_w[:, i, j] (G_w[a, i, j] the interval mean of C_wb[a, i] ω_j,
     [rad/s]) and G_f[:, i, j] [m/s²]."""
     C_w, C_f = np.empty((3, 3)), np.empty((3, 3))
     for a in range(3):
         for i in range(3):
             C_w[a, i], C_f[a, i] = G_w[a, i, i], G_f[a, i, i]
     F = np.zeros((tl.n, tl.n))
-    F[:tl.base.n, :tl.base.n] = continuous_f(lat, h, v, f_n, C, C_w, C_f, tl.base, inv_length)
+    F[:tl.base.n, :tl.base.n] = continuous_f(C_ew, h, v, f_n, C, C_w, C_f, tl.base, inv_length)
     if tl.gyro_gm >= 0:
         F[0:3, tl.gyro_gm:tl.gyro_gm + 3] = -C
         for i in range(3):
@@ -83,14 +84,33 @@ def truth_f(lat, h, v, f_n, C, G_w, G_f, tl, inv_length, inv_tau):
 
 
 @njit
-def _interval_means(q_nb, dtheta, dv, k0, k1, dt):
-    """(C, f_n, G_w, G_f) over IMU intervals k0..k1−1 with C_nb at the start of each interval, as the
-    filter's accumulator has them: the mean C_nb, the mean specific force in n [m/s²], and
-    G_w[a, i, j] = mean C_nb[a, i] ω_j [rad/s], G_f likewise with f_b [m/s²]."""
+def _to_frame(P, mean, P_f, nav, tl, model, inward):
+    """Turn the truth's stacks P (S, n_t, n_t), ``mean`` (S, n_t) and the filter's P_f between the public coordinates
+    and the wander-azimuth frame of the solution row ``nav`` (``inward``: public to w; else w to public), in place
+    (:func:`nav_kernels.to_public`)."""
+    if inward:
+        T_t = np.linalg.inv(public_jacobian(nav, tl.n, tl.base.gravity))
+        T_f = np.linalg.inv(public_jacobian(nav, P_f.shape[0], model.layout.gravity))
+        for s in range(P.shape[0]):
+            P[s] = T_t @ P[s] @ T_t.T
+            mean[s] = T_t @ mean[s]
+        P_f[:, :] = T_f @ P_f @ T_f.T
+        return
+    for s in range(P.shape[0]):
+        P[s] = to_public(P[s], nav, tl.base.gravity)
+        mean[s] = to_public_vector(mean[s], nav, tl.base.gravity)
+    P_f[:, :] = to_public(P_f, nav, model.layout.gravity)
+
+
+@njit
+def _interval_means(q_wb, dtheta, dv, k0, k1, dt):
+    """(C, f_w, G_w, G_f) over IMU intervals k0..k1−1 with C_wb at the start of each interval, as the
+    filter's accumulator has them: the mean C_wb, the mean specific force in w [m/s²], and
+    G_w[a, i, j] = mean C_wb[a, i] ω_j [rad/s], G_f likewise with f_b [m/s²]."""
     C, f_n = np.zeros((3, 3)), np.zeros(3)
     G_w, G_f = np.zeros((3, 3, 3)), np.zeros((3, 3, 3))
     for k in range(k0, k1):
-        Ck = quat_to_matrix(q_nb[k])
+        Ck = quat_to_matrix(q_wb[k])
         for a in range(3):
             for i in range(3):
                 C[a, i] += Ck[a, i]
@@ -103,13 +123,9 @@ def _interval_means(q_nb, dtheta, dv, k0, k1, dt):
 
 
 @njit
-def _nav(lat, lon, h, v_n, q_nb, k):
-    """The strapdown state's first ten entries (L, λ, h, v_n, q_nb) of the nominal at sample k."""
-    nav = np.empty(10)
-    nav[0], nav[1], nav[2] = lat[k], lon[k], h[k]
-    nav[3:6] = v_n[k]
-    nav[6:10] = q_nb[k]
-    return nav
+def _nav(rows, k):
+    """The strapdown state's solution row (q_ew, h, v_w, q_wb) of the nominal at sample k."""
+    return rows[k].copy()
 
 
 @njit
@@ -125,19 +141,21 @@ def _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, span, tl, truth_q, 
                         gravity_source, model):
     """Eq. (1) of :mod:`navsim.estimation.lincov` for the truth and the filter over ``span`` [s]; the
     truth's gravity disturbance driven by 2σ² V/D at the current speed (``gravity_drive`` = 2σ²/D)."""
-    speed = np.hypot(nav[3], nav[4])
+    speed = np.hypot(nav[5], nav[6])
     q = truth_q.copy()
-    if tl.base.gravity >= 0:
+    if tl.base.gravity >= 0:  # an isotropic horizontal field in the turning w frame, as the filter's
         for i in range(3):
-            q[gravity_source, tl.base.gravity + i] += gravity_drive[i] * speed
-    F_t = truth_f(nav[0], nav[2], nav[3:6], f_n, C, G_w, G_f, tl, inv_length, inv_tau)
+            drive = 0.5 * (gravity_drive[0] + gravity_drive[1]) if i < 2 else gravity_drive[2]
+            q[gravity_source, tl.base.gravity + i] += drive * speed
+    C_ew = quat_to_matrix(nav[0:4])
+    F_t = truth_f(C_ew, nav[4], nav[5:8], f_n, C, G_w, G_f, tl, inv_length, inv_tau)
     Phi, Q = van_loan(F_t, q, span)
     propagate(P, mean, Phi, Q)
     C_w, C_f = np.empty((3, 3)), np.empty((3, 3))
     for a in range(3):
         for i in range(3):
             C_w[a, i], C_f[a, i] = G_w[a, i, i], G_f[a, i, i]
-    F_f = continuous_f(nav[0], nav[2], nav[3:6], f_n, C, C_w, C_f, model.layout, model.gm[3])
+    F_f = continuous_f(C_ew, nav[4], nav[5:8], f_n, C, C_w, C_f, model.layout, model.gm[3])
     Phi_f, Q_f = discretize(F_f, noise_densities(nav, model), span)
     P_next = Phi_f @ P_f @ Phi_f.T + Q_f
     P_f[:, :] = 0.5 * (P_next + P_next.T)
@@ -171,15 +189,12 @@ def _offset_update(P, mean, P_f, W, H_t, R_t, meas, d, d_real, estimated, tl):
 
 @njit
 def _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated):
-    """The frame's position fix (H = [0 0 I …], R in radians of L, λ and metres of h) and baro height
+    """The frame's position fix (H and R of :func:`nav_kernels.position_terms` at the nominal) and baro height
     (H = e_δh − e_baro bias, R the white noise; the filter's R its σ with the bias), in that order."""
     if meas.position_mask[f]:
-        r_m, r_n = radii(nav[0])
-        scale = np.array([r_m + nav[2], (r_n + nav[2]) * np.cos(nav[0]), 1.0])
-        H_t, R_t = np.zeros((3, tl.n)), np.zeros((3, 3))
-        for i in range(3):
-            H_t[i, DP + i] = 1.0
-            R_t[i, i] = (meas.position_sigma[i] / scale[i]) ** 2
+        lat, lon, _ = frame_angles(quat_to_matrix(nav[0:4]))
+        _, H, R_t, _ = position_terms(nav, np.array([lat, lon, nav[4]]), meas.position_sigma, tl.base.n)
+        H_t = _embed(H, tl.n)
         update(P, mean, P_f, W, H_t, R_t, meas.r_scale2 * R_t, np.zeros(3), estimated, meas.aiding_source,
                meas.aiding_source)
     if meas.baro_mask[f]:
@@ -194,10 +209,11 @@ def _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
 
 
 @njit
-def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_q, inv_length, inv_tau, gravity_drive,
+def run(rows, dtheta, dv, dt, ratio, every, stride, tl, truth_q, inv_length, inv_tau, gravity_drive,
         gravity_source, model, W, T, estimated, baro_estimated, P, mean, P_f, q_ie, q_BS, meas, step_frames, step_values,
         step_source):
-    """The pass along the nominal (samples of L, λ, h, v_n, q_nb (N+1, ·); increments Δθ, Δv (N, 3) on IMU
+    """The pass along the nominal (its wander-azimuth solution rows (q_ew, h, v_w, q_wb) (N+1, ROW); increments
+    Δθ, Δv (N, 3) on IMU
     intervals of ``dt`` [s]): per frame of ``ratio`` intervals, the truth's stacks P (S, n_t, n_t) and
     ``mean`` (S, n_t) (one per error source) and the filter's P_f propagated every ``every`` intervals and at the frame's end
     (:func:`_propagate_interval`; the truth's noise densities ``truth_q`` (S, n_t)), the gyro bias steps of
@@ -205,8 +221,10 @@ def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_
     measurements (``meas``: stars or a fix, then the position fix and the baro). Every ``stride`` frames
     (and at the last) it keeps: the time, the mean, the diagonal of each source's P in the truth's and
     (T P Tᵀ) the filter's coordinates, each source's leading :data:`BLOCK` x BLOCK, the filter's own
-    diagonal and block, and the filter's expected NEES tr(P_f⁻¹ (T (Σ P + m mᵀ) Tᵀ))."""
-    frames = (q_nb.shape[0] - 1) // ratio
+    diagonal and block, and the filter's expected NEES tr(P_f⁻¹ (T (Σ P + m mᵀ) Tᵀ)). The stacks come and go in
+    the public coordinates (NED, position in metres: :func:`nav_kernels.to_public`); the pass runs in w."""
+    frames = (rows.shape[0] - 1) // ratio
+    _to_frame(P, mean, P_f, rows[0], tl, model, True)
     S, n_t, n_f = P.shape[0], tl.n, P_f.shape[0]
     log = allocate_log((frames + stride - 1) // stride, S, n_t, n_f, BLOCK)
     out = 0
@@ -217,21 +235,23 @@ def run(q_nb, dtheta, dv, lat, lon, h, v_n, dt, ratio, every, stride, tl, truth_
         k0, end = f * ratio, (f + 1) * ratio
         while k0 < end:
             k1 = min(k0 + every, end)
-            C, f_n, G_w, G_f = _interval_means(q_nb, dtheta, dv, k0, k1, dt)
-            nav = _nav(lat, lon, h, v_n, q_nb, k1)
+            C, f_n, G_w, G_f = _interval_means(rows[:, 8:12], dtheta, dv, k0, k1, dt)
+            nav = _nav(rows, k1)
             _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, (k1 - k0) * dt, tl, truth_q, inv_length, inv_tau,
                                 gravity_drive, gravity_source, model)
             k0 = k1
-        nav = _nav(lat, lon, h, v_n, q_nb, end)
-        rows = (meas.star_offsets[f], meas.star_offsets[f + 1])
-        if rows[1] > rows[0]:
-            _update_stars(P, mean, P_f, nav, q_ie[f], q_BS, rows, meas, tl, W, estimated)
+        nav = _nav(rows, end)
+        span = (meas.star_offsets[f], meas.star_offsets[f + 1])
+        if span[1] > span[0]:
+            _update_stars(P, mean, P_f, nav, q_ie[f], q_BS, span, meas, tl, W, estimated)
         if meas.fix_mask[f]:
             z, H, R = fix_terms(nav, q_BS, q_ie[f], meas.fix_q[f], meas.fix_R, tl.base, meas.fix_rho[f])
             z_real = fix_terms(nav, q_BS, q_ie[f], meas.fix_q_real[f], meas.fix_R, tl.base, meas.fix_rho[f])[0]
             _offset_update(P, mean, P_f, W, _embed(H, n_t), R, meas, z, z_real, estimated, tl)
         _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
         if (f + 1) % stride == 0 or f == frames - 1:
-            keep(log, out, end * dt, P, mean, P_f, T, n_f)
+            Pp, mp, Pfp = P.copy(), mean.copy(), P_f.copy()
+            _to_frame(Pp, mp, Pfp, nav, tl, model, False)
+            keep(log, out, end * dt, Pp, mp, Pfp, T, n_f)
             out += 1
     return trimmed(log, out)

@@ -1,25 +1,29 @@
-"""Strapdown mechanization in the local-level NED frame, compiled (numba), one IMU interval per step.
+"""Strapdown mechanization in the wander-azimuth frame w (:mod:`navsim.earth.wander`), compiled (numba), one IMU
+interval per step: regular everywhere, the poles included (issue 31).
 
-State vector ``nav`` (float64, :data:`SIZE`): [L, λ, h | v_N, v_E, v_D | q_nb (4, scalar-last) |
-previous Δθ (3) | previous Δv (3) | baro-loop acceleration correction u]. Each step takes the
-increments Δθ, Δv [rad, m/s] of one interval of length dt [s] and updates, in this order
-(Savage 1998, Parts 1 and 2; Groves, 2nd ed., §5.4-5.5):
+State vector ``nav`` (float64, :data:`SIZE`): [q_ew (4, scalar-last) | h | v_w (3) | q_wb (4) | previous Δθ (3) |
+previous Δv (3) | baro-loop acceleration correction u]; the position is C_ew and the height, v_w the ground velocity
+in w. Each step takes the increments Δθ, Δv [rad, m/s] of one interval of length dt [s] and updates, in this order
+(Savage 1998, Parts 1 and 2; Groves, 2nd ed., §5.4-5.5 with w for n; Titterton & Weston, 2nd ed., §3.7.1):
 
 1. coning: α = Δθ + (1/12) Δθ_prev × Δθ (two-sample, previous-interval form; Savage Part 1,
    Ignagni 1990 algorithm with one previous sample);
 2. velocity in the body frame at t_(k−1): Δv_b = Δv + ½ Δθ × Δv + ⅙ Δθ × (Δθ × Δv) (rotation, to
    second order) + (1/12)(Δθ_prev × Δv + Δv_prev × Δθ) (sculling; Savage Part 2);
-3. specific-force increment in n: Δv_sf^n = C_nb Δv_b − ½ ζ × C_nb Δv_b, ζ = ω_in^n dt
-   (the rotation of the n frame over the interval);
-4. velocity: v_k = v_(k−1) + Δv_sf^n + [g_n − (2 ω_ie^n + ω_en^n) × v] dt (Groves eq. 5.54), the
+3. specific-force increment in w: Δv_sf^w = C_wb Δv_b − ½ ζ × C_wb Δv_b, ζ = ω_iw^w dt
+   (the rotation of the w frame over the interval);
+4. velocity: v_k = v_(k−1) + Δv_sf^w + [g_w − (2 ω_ie^w + ω_ew^w) × v] dt (Groves eq. 5.54), the
    bracket at the interval midpoint by one predictor-corrector pass;
-5. position by the trapezoid rule (Groves eq. 5.56): h, then L with R_M(L_(k−1)), then λ with
-   R_N(L_k);
-6. attitude: q_nb,k = q(−ζ) ⊗ q_nb,(k−1) ⊗ q(α), q(·) the quaternion of a rotation vector.
+5. position: h by the trapezoid rule, C_ew,k = C_ew,(k−1) exp([ω_ew^w dt ×]), the transport rate at the
+   interval's midpoint (the mean velocity, the midpoint height and position);
+6. attitude: q_wb,k = q(−ζ) ⊗ q_wb,(k−1) ⊗ q(α), q(·) the quaternion of a rotation vector.
+
+Latitude, longitude, NED velocity and q_nb are outputs (:func:`navsim.earth.wander.to_ned`); a start from
+(L, λ, h, v_n, q_nb) takes the wander angle 0 (w = NED there).
 
 Optional barometric damping of the vertical channel (the third-order loop of Widnall & Sinha 1980):
 with δh = h − h_baro,
-ḣ ← ḣ − k1 δh, v̇_D ← v̇_D + k2 δh + u, u̇ = k3 δh, and k1 = 3/τ, k2 = 3/τ² + 2γ/a, k3 = 1/τ³
+ḣ ← ḣ − k1 δh, v̇_z ← v̇_z + k2 δh + u, u̇ = k3 δh, and k1 = 3/τ, k2 = 3/τ² + 2γ/a, k3 = 1/τ³
 (three poles at −1/τ once the 2γ/a instability is cancelled).
 """
 
@@ -27,38 +31,53 @@ from typing import NamedTuple
 
 import numpy as np
 
-from navsim.earth.frames import earth_rate_n, transport_rate_n
-from navsim.earth.gravity import normal_gravity
-from navsim.earth.wgs84 import GAMMA_E, A, radii
+from navsim.earth.gravity import normal_gravity_of_sine
+from navsim.earth.wander import earth_rate_w, geodetic, q_ew, to_ned, transport_rate_w
+from navsim.earth.wgs84 import GAMMA_E, A
 from startrack import rotation as rot
 from startrack.errors import InputError
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix
 
-SIZE = 17
+SIZE = 19
+#: Length of a solution row (q_ew, h, v_w, q_wb): what a log keeps of ``nav``.
+ROW = 12
 
 
 class Log(NamedTuple):
     """Navigation solution at the logged samples: ``lat``, ``lon`` [rad], ``h`` [m] (K,),
-    ``v_n`` (K, 3) [m/s], ``q_nb`` (K, 4)."""
+    ``v_n`` (K, 3) [m/s], ``q_nb`` (K, 4), and the wander-azimuth solution itself ``q_ew`` (K, 4), ``v_w`` (K, 3),
+    ``q_wb`` (K, 4)."""
 
     lat: np.ndarray
     lon: np.ndarray
     h: np.ndarray
     v_n: np.ndarray
     q_nb: np.ndarray
+    q_ew: np.ndarray
+    v_w: np.ndarray
+    q_wb: np.ndarray
+
+
+def log_of(rows):
+    """The :class:`Log` of solution rows (K, :data:`ROW`)."""
+    q, v_w, q_wb = rows[:, 0:4], rows[:, 5:8], rows[:, 8:12]
+    lat, lon, v_n, q_nb = to_ned(q, v_w, q_wb)
+    return Log(lat=lat, lon=lon, h=rows[:, 4].copy(), v_n=v_n, q_nb=q_nb, q_ew=q.copy(), v_w=v_w.copy(), q_wb=q_wb.copy())
 
 
 def initial_state(lat, lon, h, v_n, q_nb):
-    """The ``nav`` vector of a start at (L, λ, h) [rad, rad, m], NED velocity [m/s] and q_nb."""
+    """The ``nav`` vector of a start at (L, λ, h) [rad, rad, m], NED velocity [m/s] and q_nb, wander angle 0
+    (at a pole, NED is the limit along the meridian λ)."""
     if not abs(lat) <= 0.5 * np.pi:
         raise InputError(f"lat: |latitude| must be <= 90 deg, got {np.degrees(lat)} deg")
     if not h >= -1000.0:
         raise InputError(f"height: must be >= -1000 m, got {h}")
     nav = np.zeros(SIZE)
-    nav[0:3] = lat, lon, h
-    nav[3:6] = v_n
-    nav[6:10] = rot.normalize(q_nb)
+    nav[0:4] = q_ew(lat, lon)
+    nav[4] = h
+    nav[5:8] = v_n
+    nav[8:12] = rot.normalize(q_nb)
     return nav
 
 
@@ -77,15 +96,15 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit
-def _velocity_change(lat, h, v0, v1, v2, u0, u1, u2, dt):
-    """(Δv_n (3), ζ (3)) over dt with the rates at (L, h, v): Δv_n = Δv_sf^n + [g_n − (2ω_ie^n + ω_en^n)
-    × v] dt, Δv_sf^n = u − ½ ζ × u (steps 3-4 for u = C_nb Δv_b), ζ = (ω_ie^n + ω_en^n) dt."""
-    e0, e1, e2 = earth_rate_n(lat)
-    t0, t1, t2 = transport_rate_n(lat, h, v0, v1)
-    z0, z1, z2 = (e0 + t0) * dt, (e1 + t1) * dt, (e2 + t2) * dt
+def _velocity_change(C, h, v0, v1, v2, u0, u1, u2, dt):
+    """(Δv_w (3), ζ (3)) over dt with the rates at (C_ew, h, v): Δv_w = Δv_sf^w + [g_w − (2ω_ie^w + ω_ew^w)
+    × v] dt, Δv_sf^w = u − ½ ζ × u (steps 3-4 for u = C_wb Δv_b), ζ = (ω_ie^w + ω_ew^w) dt."""
+    e = earth_rate_w(C)
+    t = transport_rate_w(C, h, np.array([v0, v1, v2]))
+    z0, z1, z2 = (e[0] + t[0]) * dt, (e[1] + t[1]) * dt, (e[2] + t[2]) * dt
     r0, r1, r2 = _cross(z0, z1, z2, u0, u1, u2)
-    c0, c1, c2 = _cross(2.0 * e0 + t0, 2.0 * e1 + t1, 2.0 * e2 + t2, v0, v1, v2)
-    g = normal_gravity(lat, h)
+    c0, c1, c2 = _cross(2.0 * e[0] + t[0], 2.0 * e[1] + t[1], 2.0 * e[2] + t[2], v0, v1, v2)
+    g = normal_gravity_of_sine(-C[2, 2], h)
     return (u0 - 0.5 * r0 - c0 * dt, u1 - 0.5 * r1 - c1 * dt, u2 - 0.5 * r2 + (g - c2) * dt), (z0, z1, z2)
 
 
@@ -108,58 +127,70 @@ def _body_increment(dtheta, dv, dtheta_prev, dv_prev):
 
 
 @njit
+def _moved(q, C, h, v, span):
+    """(q_ew, C_ew) turned by the transport rate at (C, h, v) over ``span`` [s]: q ⊗ q(ω_ew^w span)."""
+    t = transport_rate_w(C, h, v)
+    p = quat_multiply(q, quat_from_rotation_vector(np.array([t[0] * span, t[1] * span, 0.0])))
+    p = p / np.sqrt(np.sum(p * p))
+    return p, quat_to_matrix(p)
+
+
+@njit
 def step(nav, dtheta, dv, dt):
     """Advance ``nav`` in place by one interval of increments Δθ, Δv (3,) and length dt [s]."""
-    lat, lon, h, v0, v1, v2 = nav[0], nav[1], nav[2], nav[3], nav[4], nav[5]
-    alpha, dv_b = _body_increment(dtheta, dv, nav[10:13], nav[13:16])
-    C = quat_to_matrix(nav[6:10])
+    q, h, v0, v1, v2 = nav[0:4], nav[4], nav[5], nav[6], nav[7]
+    C_ew = quat_to_matrix(q)
+    alpha, dv_b = _body_increment(dtheta, dv, nav[12:15], nav[15:18])
+    C = quat_to_matrix(nav[8:12])
     u0 = C[0, 0] * dv_b[0] + C[0, 1] * dv_b[1] + C[0, 2] * dv_b[2]
     u1 = C[1, 0] * dv_b[0] + C[1, 1] * dv_b[1] + C[1, 2] * dv_b[2]
     u2 = C[2, 0] * dv_b[0] + C[2, 1] * dv_b[1] + C[2, 2] * dv_b[2]
     # predictor with the rates at the start, corrector with the rates at the midpoint
-    a, _ = _velocity_change(lat, h, v0, v1, v2, u0, u1, u2, dt)
-    m0, m1, m2 = v0 + 0.5 * a[0], v1 + 0.5 * a[1], v2 + 0.5 * a[2]
-    h_mid = h - 0.5 * dt * m2
-    lat_mid = lat + 0.5 * dt * m0 / (radii(lat)[0] + h_mid)
-    a, zeta = _velocity_change(lat_mid, h_mid, m0, m1, m2, u0, u1, u2, dt)
+    a, _ = _velocity_change(C_ew, h, v0, v1, v2, u0, u1, u2, dt)
+    m = np.array([v0 + 0.5 * a[0], v1 + 0.5 * a[1], v2 + 0.5 * a[2]])
+    h_mid = h - 0.5 * dt * m[2]
+    _, C_mid = _moved(q, C_ew, h_mid, m, 0.5 * dt)
+    a, zeta = _velocity_change(C_mid, h_mid, m[0], m[1], m[2], u0, u1, u2, dt)
     w0, w1, w2 = v0 + a[0], v1 + a[1], v2 + a[2]
     h_new = h - 0.5 * dt * (v2 + w2)
-    r_m, r_n = radii(lat)
-    lat_new = lat + 0.5 * dt * (v0 / (r_m + h) + w0 / (r_m + h_new))
-    lon_new = lon + 0.5 * dt * (v1 / ((r_n + h) * np.cos(lat)) + w1 / ((radii(lat_new)[1] + h_new) * np.cos(lat_new)))
+    mean = np.array([0.5 * (v0 + w0), 0.5 * (v1 + w1), 0.5 * (v2 + w2)])
+    h_mean = 0.5 * (h + h_new)
+    _, C_half = _moved(q, C_ew, h_mean, mean, 0.5 * dt)
+    q_new, _ = _moved(q, C_half, h_mean, mean, dt)
     minus_zeta = np.array([-zeta[0], -zeta[1], -zeta[2]])
-    q = quat_multiply(quat_from_rotation_vector(minus_zeta), quat_multiply(nav[6:10], quat_from_rotation_vector(alpha)))
-    norm = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    nav[0], nav[1], nav[2], nav[3], nav[4], nav[5] = lat_new, lon_new, h_new, w0, w1, w2
+    p = quat_multiply(quat_from_rotation_vector(minus_zeta), quat_multiply(nav[8:12], quat_from_rotation_vector(alpha)))
+    norm = np.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3])
     for i in range(4):
-        nav[6 + i] = q[i] / norm
+        nav[i] = q_new[i]
+        nav[8 + i] = p[i] / norm
+    nav[4], nav[5], nav[6], nav[7] = h_new, w0, w1, w2
     for i in range(3):
-        nav[10 + i] = dtheta[i]
-        nav[13 + i] = dv[i]
+        nav[12 + i] = dtheta[i]
+        nav[15 + i] = dv[i]
 
 
 @njit
 def baro_damp(nav, baro_h, gains, dt):
     """One step of the third-order baro loop on ``nav`` (in place) with baro altitude ``baro_h`` [m]."""
-    dh = nav[2] - baro_h
-    nav[2] -= gains[0] * dh * dt
-    nav[5] += (gains[1] * dh + nav[16]) * dt
-    nav[16] += gains[2] * dh * dt
+    dh = nav[4] - baro_h
+    nav[4] -= gains[0] * dh * dt
+    nav[7] += (gains[1] * dh + nav[18]) * dt
+    nav[18] += gains[2] * dh * dt
 
 
 @njit
 def integrate(nav, dtheta, dv, dt, baro_h, gains, every):
     """Run ``step`` over the increments (M, 3); damp with ``baro_h[k]`` where finite (NaN: none).
-    Returns the solution rows nav[0:10] (1 + M // every, 10): the start, then every ``every`` steps."""
+    Returns the solution rows nav[0:ROW] (1 + M // every, ROW): the start, then every ``every`` steps."""
     m = dtheta.shape[0]
-    out = np.empty((1 + m // every, 10))
-    out[0] = nav[0:10]
+    out = np.empty((1 + m // every, ROW))
+    out[0] = nav[0:ROW]
     for k in range(m):
         step(nav, dtheta[k], dv[k], dt)
         if not np.isnan(baro_h[k]):
             baro_damp(nav, baro_h[k], gains, dt)
         if (k + 1) % every == 0:
-            out[(k + 1) // every] = nav[0:10]
+            out[(k + 1) // every] = nav[0:ROW]
     return out
 
 
@@ -174,4 +205,18 @@ def run(nav, dtheta, dv, dt, baro_h=None, baro_time_constant=60.0, every=1):
         baro_h = np.full(dtheta.shape[0], np.nan)
     rows = integrate(nav, dtheta, dv, float(dt), np.asarray(baro_h, dtype=float),
                      baro_gains(baro_time_constant), int(every))
-    return Log(lat=rows[:, 0], lon=rows[:, 1], h=rows[:, 2], v_n=rows[:, 3:6], q_nb=rows[:, 6:10])
+    return log_of(rows)
+
+
+def wander_rows(truth):
+    """The solution rows (N+1, :data:`ROW`) of a truth trajectory (``lat``, ``lon``, ``h``, ``v_n``, ``q_nb`` at N + 1
+    samples, increments ``dtheta``, ``dv``, interval ``dt``) in the wander-azimuth frame this mechanization would
+    carry along it: the wander angle α of the truth's own increments integrated from 0 (the vertical channel held on
+    the true height), the position, velocity and attitude the truth's: q_ew(L, λ, α), v_w = C_wn v_n,
+    q_wb = q_z(−α) ⊗ q_nb."""
+    nav = initial_state(truth.lat[0], truth.lon[0], truth.h[0], truth.v_n[0], truth.q_nb[0])
+    alpha = geodetic(run(nav, truth.dtheta, truth.dv, truth.dt, baro_h=truth.h[1:]).q_ew)[2]
+    zero = np.zeros_like(alpha)
+    q_wn = rot.from_rotation_vector(np.stack([zero, zero, -alpha], axis=-1))
+    return np.concatenate([q_ew(truth.lat, truth.lon, alpha), truth.h[:, None], rot.rotate(q_wn, truth.v_n),
+                           rot.multiply(q_wn, truth.q_nb)], axis=1)

@@ -10,12 +10,12 @@ from navsim.build.inertial import accelerometer_model, gyro_model
 from navsim.earth.frames import julian_year
 from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.refraction import Air
-from navsim.earth.wgs84 import OMEGA_IE, radii
+from navsim.earth.wgs84 import OMEGA_IE
 from navsim.estimation.nav_filter import GravityUncertainty, ImuNoise, NavFilterConfig, StarSensorModel
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel
-from navsim.truth.segments import Profile
+from navsim.truth.route import profile_of
 from startrack import units
 from startrack.bands import band
 
@@ -31,8 +31,8 @@ GRAVITY_FLOORS = (0.01 * units.ARCSEC, 0.1 * units.MILLIGAL)
 
 
 def profile(scenario):
-    """The trajectory's :class:`~navsim.truth.segments.Profile`."""
-    return Profile.from_table(scenario["trajectory"])
+    """The trajectory's :class:`~navsim.truth.segments.Profile` (segments or a route)."""
+    return profile_of(scenario["trajectory"])
 
 
 def imu(scenario):
@@ -188,8 +188,7 @@ def initial_covariance(scenario, gyro, accel, lat, h):
             else max(accel_bias / normal_gravity(lat, h), FLOORS["tilt"]))
     heading = (units.deg_to_rad(f["initial_heading_sigma_deg"]) if f["initial_heading_sigma_deg"] is not None
                else max(min(gyro_bias / (OMEGA_IE * np.cos(lat)), MAX_DEFAULT_HEADING), FLOORS["heading"]))
-    r_m, r_n = radii(lat)
-    position = f["initial_position_sigma_m"] / np.array([r_m + h, (r_n + h) * np.cos(lat), 1.0])
+    position = f["initial_position_sigma_m"] * np.ones(3)
     sigma = [tilt, tilt, heading, *[f["initial_velocity_sigma_m_per_s"]] * 3, *position, *[gyro_bias] * 3,
              *[accel_bias] * 3]
     if estimates_scale_factors(scenario, gyro, accel):

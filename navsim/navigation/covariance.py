@@ -33,10 +33,10 @@ from navsim.build.star_sensor import vector_equivalent
 from navsim.earth.apparent import apparent, fix_rotation
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.orientation import EarthOrientation
-from navsim.earth.wgs84 import radii
 from navsim.estimation.nav_filter import NavFilter, state_names
 from navsim.estimation.nav_kernels import layout as nav_layout
 from navsim.estimation.nav_lincov import BLOCK, Measurements, TruthLayout, run
+from navsim.ins.strapdown import wander_rows
 from navsim.navigation import build, exclusion, sky_background
 from navsim.navigation.budget import SOURCES as BUDGET_SOURCES
 from navsim.navigation.run import fixed_initial_error
@@ -63,7 +63,7 @@ COVARIANCE_QUANTITIES = {"horizontal_position": ("m", 1.0), "vertical_position":
               "horizontal_velocity": ("m/s", 1.0), "vertical_velocity": ("m/s", 1.0),
               "tilt": ("arcsec", units.ARCSEC), "heading": ("arcsec", units.ARCSEC)}
 #: Edge units of the error states by the first letters of their names.
-STATE_UNITS = (("phi", "arcsec", units.ARCSEC), ("dv", "m/s", 1.0), ("dlat", "m", None), ("dlon", "m", None),
+STATE_UNITS = (("phi", "arcsec", units.ARCSEC), ("dv", "m/s", 1.0), ("dN", "m", 1.0), ("dE", "m", 1.0),
                ("dh", "m", 1.0), ("eps", "deg/h", units.DEG / units.HOUR), ("nabla", "micro_g", 1e-6 * units.STANDARD_GRAVITY),
                ("ggm", "deg/h", units.DEG / units.HOUR), ("agm", "micro_g", 1e-6 * units.STANDARD_GRAVITY),
                ("dsg", "ppm", units.PPM), ("dsa", "ppm", units.PPM), ("mu", "arcsec", units.ARCSEC),
@@ -135,7 +135,7 @@ def model(scenario, nominal, filt, gyro, accel, baro):
     P0, m0, q = np.zeros((S, n, n)), np.zeros((S, n)), np.zeros((S, n))
     src = {name: i for i, name in enumerate(SOURCES)}
     P0[src["initial"], :9, :9] = filt.config.P0[:9, :9]
-    fixed = fixed_initial_error(scenario, nominal.lat[0], nominal.h[0])
+    fixed = fixed_initial_error(scenario)
     given = np.zeros(n, dtype=bool)
     given[:9] = ~np.isnan(fixed)
     P0[src["initial"]][given, :] = 0.0
@@ -353,20 +353,19 @@ def covariance_analysis(scenario, split=False, star_catalog=None):
     q_BS = mounting(scenario["star_sensor"])[0] if "star_sensor" in scenario.data else np.array([0.0, 0.0, 0.0, 1.0])
     q_ie = nom.orientation.q_ie if nom.orientation is not None else np.zeros((nom.frames, 4))
     P, mean, P_f = np.ascontiguousarray(P0), np.ascontiguousarray(m0), np.array(filt.P)
-    out = run(path.q_nb, path.dtheta, path.dv, path.lat, path.lon, path.h, path.v_n, nom.dt, nom.ratio,
+    out = run(np.ascontiguousarray(wander_rows(path)), path.dtheta, path.dv, nom.dt, nom.ratio,
               nom.every, stride, mod.layout, np.ascontiguousarray(q), mod.inv_length,
               mod.inv_tau, mod.gravity_drive, max(src("gravity"), 0), filt.model, np.ascontiguousarray(mod.W),
               np.ascontiguousarray(mod.T), filt.estimated, filt.baro_estimated, P, mean, P_f, q_ie,
               np.asarray(q_BS, dtype=float), meas, step_frames, step_values, max(src("inertial"), 0))
     t, mean_out, diag_t, diag_f, block, filter_diag, filter_block, nees = out
     k = np.rint(t / nom.dt).astype(int)
-    lat, h = path.lat[k], path.h[k]
     names_f = tuple(state_names(filt.layout))
     return Analysis(t=t, sources=sources, truth_names=mod.names, filter_names=names_f, mean=mean_out, diag_t=diag_t,
                     diag_f=diag_f, block=block, filter_diag=filter_diag, filter_block=filter_block, nees=nees,
-                    nees_dof=len(names_f), T=mod.T, quantities=quantities(lat, h),
-                    units_t=tuple(state_unit(n)[0] for n in mod.names), scale_t=edge_scale(mod.names, lat, h),
-                    units_f=tuple(state_unit(n)[0] for n in names_f), scale_f=edge_scale(names_f, lat, h),
+                    nees_dof=len(names_f), T=mod.T, quantities=quantities(k.size),
+                    units_t=tuple(state_unit(n)[0] for n in mod.names), scale_t=edge_scale(mod.names, k.size),
+                    units_f=tuple(state_unit(n)[0] for n in names_f), scale_f=edge_scale(names_f, k.size),
                     run_errors=run_errors, notes=() if note is None else (note,), wall_seconds=time.perf_counter() - started)
 
 
@@ -385,33 +384,27 @@ def _present(mod, i, scenario, name):
 
 
 def state_unit(name):
-    """(unit, SI size) of an error state at the edge (δL, δλ in metres: their size depends on the position)."""
+    """(unit, SI size) of an error state at the edge."""
     for prefix, unit, size in STATE_UNITS:
         if name.startswith(prefix):
             return unit, size
     raise KeyError(name)
 
 
-def edge_scale(names, lat, h):
-    """(K, len(names)) SI size of each state's edge unit at the positions (L, h) (K,) (δL, δλ in metres there)."""
-    r_m, r_n = radii(lat)
-    out = np.empty((np.size(lat), len(names)))
-    for j, name in enumerate(names):
-        out[:, j] = {"dlat": 1.0 / (r_m + h), "dlon": 1.0 / ((r_n + h) * np.cos(lat))}.get(name, state_unit(name)[1])
-    return out
+def edge_scale(names, count):
+    """(count, len(names)) SI size of each state's edge unit."""
+    return np.tile([state_unit(name)[1] for name in names], (count, 1))
 
 
-def quantities(lat, h):
-    """{name: :class:`~navsim.analysis.Quantity`} of the summary quantities at the positions (L, h) (K,): the NED
-    position (δL (R_M + h), δλ (R_N + h) cos L, −δh), velocity and φ components of the leading block."""
-    K = np.size(lat)
-    r_m, r_n = radii(lat)
-    rows = {"horizontal_position": ((6, r_m + h), (7, (r_n + h) * np.cos(lat))), "vertical_position": ((8, -np.ones(K)),),
+def quantities(count):
+    """{name: :class:`~navsim.analysis.Quantity`} of the summary quantities at ``count`` rows: the NED position
+    (δN, δE, −δh), velocity and φ components of the leading block."""
+    rows = {"horizontal_position": ((6, 1.0), (7, 1.0)), "vertical_position": ((8, -1.0),),
             "horizontal_velocity": ((3, 1.0), (4, 1.0)), "vertical_velocity": ((5, 1.0),),
             "tilt": ((0, 1.0), (1, 1.0)), "heading": ((2, 1.0),)}
     out = {}
     for name, components in rows.items():
-        sel = np.zeros((K, len(components), BLOCK))
+        sel = np.zeros((count, len(components), BLOCK))
         for r, (column, scale) in enumerate(components):
             sel[:, r, column] = scale
         out[name] = Quantity(unit=COVARIANCE_QUANTITIES[name][0], size=COVARIANCE_QUANTITIES[name][1], rows=sel)

@@ -75,7 +75,7 @@ def error_with_bounds(t, errors, sigmas, labels, unit, title=None, references=()
 
 
 def _position_sigma(s):
-    return np.abs(ned_metres(s["error_sigma"][:, 6:9], s["lat_true"], s["h_true"]))
+    return np.abs(ned_metres(s["error_sigma"][:, 6:9]))
 
 
 def position_errors(run):

@@ -54,8 +54,9 @@ def run_report(run) -> bytes:
         _run_key_results(doc, summary)
         scenario_section(doc, run.scenario)
         doc.heading("Ground track")
-        doc.paragraph(markup("The true track (black) and the filter's estimate (red, dashed) in longitude and latitude, "
-                             "drawn with equal scales at the track's mean latitude."))
+        doc.paragraph(markup("The true track (black) and the filter's estimate (red, dashed) on the azimuthal "
+                             "equidistant map centred on the true track: distances and bearings from the centre are "
+                             "true, and the poles and the 180° meridian are ordinary points (Snyder 1987, ch. 25)."))
         doc.figure(nav_figures.ground_track(run), "Ground track: truth and estimate.")
         doc.heading("Navigation errors")
         doc.paragraph(markup(

@@ -39,7 +39,7 @@ class HorizontalPercentiles:
 
 def _position_sigma(run, n):
     s = run.series
-    return np.abs(ned_metres(s["error_sigma"][:n, 6:9], s["lat_true"][:n], s["h_true"][:n]))
+    return np.abs(ned_metres(s["error_sigma"][:n, 6:9]))
 
 
 def horizontal_percentiles(campaign):

@@ -34,7 +34,7 @@ from navsim.build.star_sensor import observers
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
-from navsim.earth.wgs84 import radii
+from navsim.earth.wander import displaced
 from navsim.estimation.nav_filter import NavFilter
 from navsim.navigation import build, celestial, exclusion, sky_background
 from navsim.navigation.scenario import frame_rate
@@ -177,7 +177,7 @@ def simulate(prepared, seed, compiled=True):
         gyro = dataclasses.replace(gyro, omega=omega, bias=bias)
     accel = accel_truth.measure(truth.dv[:n] / grid.dt, accel_ss)
     config = build.filter_config(scenario, p.gyro, p.accel, truth.lat[0], truth.h[0], grid.dt, p.orientation)
-    fixed = fixed_initial_error(scenario, truth.lat[0], truth.h[0])
+    fixed = fixed_initial_error(scenario)
     filt = NavFilter(*_start(truth, config.P0, init_ss, zero="initial" in p.truth_off, fixed=fixed), config)
     record = _aiding_record(p, truth, position_ss, baro_ss)
     sensor_run, loop_truth, jumps, sky, observer_runs = AidingRun(record), truth, None, None, []
@@ -267,11 +267,12 @@ def _start(truth, P0, seed, zero=False, fixed=None):
     if fixed is not None and not zero:
         x0 = np.where(np.isnan(fixed), x0, fixed)
     q0 = rot.multiply(rot.from_rotation_vector(-x0[0:3]), truth.q_nb[0])
-    return truth.lat[0] + x0[6], truth.lon[0] + x0[7], truth.h[0] + x0[8], truth.v_n[0] + x0[3:6], q0
+    lat, lon = displaced(truth.lat[0], truth.lon[0], truth.h[0], x0[6], x0[7])
+    return lat, lon, truth.h[0] + x0[8], truth.v_n[0] + x0[3:6], q0
 
 
-def fixed_initial_error(scenario, lat, h):
-    """The filter's initial error x0[0:9] (φ, δv, δL, δλ, δh) the scenario fixes at (L, h), NaN where it is drawn
+def fixed_initial_error(scenario):
+    """The filter's initial error x0[0:9] (φ, δv, δN, δE, δh) the scenario fixes, NaN where it is drawn
     (``filter.initial_attitude_error_arcsec``, ``initial_velocity_error_m_per_s``, ``initial_position_error_m``)."""
     f = scenario["filter"]
     x0 = np.full(9, np.nan)
@@ -280,7 +281,6 @@ def fixed_initial_error(scenario, lat, h):
     if f["initial_velocity_error_m_per_s"] is not None:
         x0[3:6] = f["initial_velocity_error_m_per_s"]
     if f["initial_position_error_m"] is not None:
-        r_m, r_n = radii(lat)
         north, east, down = f["initial_position_error_m"]
-        x0[6:9] = north / (r_m + h), east / ((r_n + h) * np.cos(lat)), -down
+        x0[6:9] = north, east, -down
     return x0

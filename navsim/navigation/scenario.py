@@ -21,12 +21,12 @@ from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, M
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
 from navsim.scenario.star_sensor_fields import FAULTS, IDENTIFICATION, PHOTOMETRY, REFRACTION, STAR_SENSOR, check_faults, check_star_sensor, mounting
 from navsim.scenario.star_sensor_presets import PRESETS, with_preset
-from navsim.truth import segments, trajectory
+from navsim.truth import route, segments, trajectory
 from startrack import rotation as rot
 from startrack.errors import InputError
 
-#: Bounds: speed [m/s] (below orbital speed), height [m] (the ellipsoid +/- ), latitude [deg] (the NED
-#: frame is singular at the poles), a segment's duration [s].
+#: Bounds: speed [m/s] (below orbital speed), height [m] (the ellipsoid +/- ), a segments start's latitude [deg]
+#: (headings from north are singular at the poles: routes go there), a segment's duration [s].
 MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 7500.0, 1e5, 89.0, 2.6e6
 #: Samples of the flight on which the star sensor's boresight elevation is checked.
 ELEVATION_SAMPLES = 2000
@@ -90,6 +90,23 @@ SEGMENT = Tagged("kind", {
     "ship": _ship(),
 })
 
+#: A route of waypoints flown over along geodesics (:mod:`navsim.truth.route`), instead of start and segments.
+ROUTE = Table({
+    "bank_deg": Value("float", default=_default(route.Route, "bank_deg"), exclusive_minimum=0.0,
+                      maximum=route.MAX_BANK_DEG, doc="of the coordinated turns between legs"),
+    "roll_in_s": _seconds(route.Route, "roll_in_s"),
+    "acceleration_m_per_s2": Value("float", default=_default(route.Route, "acceleration_m_per_s2"),
+                                   exclusive_minimum=0.0, maximum=100.0, doc="of the speed changes at a leg's start"),
+    "climb_rate_m_per_s": Value("float", default=_default(route.Route, "climb_rate_m_per_s"), exclusive_minimum=0.0,
+                                maximum=1000.0, doc="of the height changes at a leg's start"),
+    "waypoints": ListOfTables(Table({
+        "lat_deg": Value("float", minimum=-90.0, maximum=90.0),
+        "lon_deg": Value("float", minimum=-360.0, maximum=360.0),
+        "height_m": Value("float", default=0.0, minimum=-1000.0, maximum=MAX_HEIGHT),
+        "speed_m_per_s": Value("float", exclusive_minimum=0.0, maximum=MAX_SPEED),
+    }), required=True, doc="flown over in order (at least two), each at its height and speed"),
+}, optional=True, doc="waypoints flown over along geodesics, the poles and the antimeridian included")
+
 SCHEMA = Table(
     {
         "name": Value("str"),
@@ -109,8 +126,9 @@ SCHEMA = Table(
                                   doc="above the WGS-84 ellipsoid; at most 1 km below it"),
                 "speed_m_per_s": Value("float", default=0.0, minimum=0.0, maximum=MAX_SPEED),
                 "heading_deg": Value("float", default=0.0, minimum=-360.0, maximum=360.0),
-            }),
-            "segments": ListOfTables(SEGMENT, required=True, min_length=1),
+            }, optional=True, doc="where the segments start (not with a route)"),
+            "segments": ListOfTables(SEGMENT, doc="headings and turns from the start, at least one (not with a route)"),
+            "route": ROUTE,
         }),
         "imu": Table({
             "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e4),
@@ -221,7 +239,7 @@ def validate(data, source):
     checked = checked_table(SCHEMA, data, source)
     try:
         utc_epoch(checked["epoch_utc"])
-        flown = segments.Profile.from_table(checked["trajectory"]).duration
+        flown = route.profile_of(checked["trajectory"]).duration
     except InputError as error:
         raise InputError(f"{source}: {error}") from None
     imu_hz = checked["imu"]["rate_hz"]
@@ -229,7 +247,7 @@ def validate(data, source):
         checked["duration_s"] = flown
     if checked["duration_s"] > flown + 1e-9:
         raise InputError(f"{source}: duration_s: {checked['duration_s']:g} s is longer than the trajectory "
-                         f"({flown:g} s of segments)")
+                         f"({flown:g} s)")
     if checked["duration_s"] * imu_hz < 1.0:
         raise InputError(f"{source}: imu.rate_hz: {imu_hz:g} Hz gives no IMU interval in {checked['duration_s']:g} s")
     frame_hz = frame_rate(checked, source)
@@ -379,7 +397,7 @@ def boresight_elevation(checked, samples=ELEVATION_SAMPLES):
     """The star sensor's boresight elevation above the local horizon [rad] at ``samples`` times of the
     flight and at SEGMENT_SAMPLES times of each segment (a short bank in a long flight is not missed):
     asin(−b_D) of b_n = C_nb R_BS e_z (nominal mounting and misalignment)."""
-    profile = segments.Profile.from_table(checked["trajectory"])
+    profile = route.profile_of(checked["trajectory"])
     duration = checked["duration_s"]
     ends = np.append(profile.starts[1:], profile.duration)
     per_segment = np.linspace(profile.starts, ends, SEGMENT_SAMPLES).ravel()

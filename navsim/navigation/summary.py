@@ -11,7 +11,7 @@ track it is that horizontal error resolved on the track's direction and its righ
 
 import numpy as np
 
-from navsim.earth.wgs84 import radii
+from navsim.earth.wander import ned_offset
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.estimation.nav_filter import error_state, mounting_error, state_names
 from navsim.navigation.records import RunSummary
@@ -28,11 +28,9 @@ MICRO_G = 1e-6 * units.STANDARD_GRAVITY
 MIN_TRACK_SPEED = 0.1
 
 
-def ned_metres(delta_position, lat, h):
-    """Position errors (δL, δλ, δh) (..., 3) [rad, rad, m] at (L, h) as NED metres (..., 3)."""
-    r_m, r_n = radii(lat)
-    return np.stack([delta_position[..., 0] * (r_m + h), delta_position[..., 1] * (r_n + h) * np.cos(lat),
-                     -delta_position[..., 2]], axis=-1)
+def ned_metres(delta_position):
+    """The error state's position part (δN, δE, δh) (..., 3) [m] as NED metres (..., 3)."""
+    return np.stack([delta_position[..., 0], delta_position[..., 1], -delta_position[..., 2]], axis=-1)
 
 
 def track_metres(error_ne, v_n, q_nb):
@@ -83,7 +81,7 @@ def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=Non
     series["error_state"] = np.concatenate(parts, axis=1)
     series["error_sigma"] = np.sqrt(np.diagonal(P, axis1=1, axis2=2))
     series["covariance_final"] = P[-1].copy()
-    series["position_error_m"] = ned_metres(error[:, POSITION], series["lat_true"], series["h_true"])
+    series["position_error_m"] = ned_offset(series["lat"], series["lon"], series["h"], truth.lat[k], truth.lon[k], truth.h[k])
     series["track_error_m"] = track_metres(series["position_error_m"][:, :2], series["v_n_true"], series["q_nb_true"])
     series["nees"] = nees(P, series["error_state"])
     return series
@@ -126,7 +124,7 @@ def summarize(scenario, seed, series, grid):
         position_error_nmi={"horizontal": nmi},
         velocity_error_m_per_s={"horizontal": stats(size["velocity_horizontal"]), "vertical": stats(size["velocity_vertical"])},
         tilt_error_arcsec=stats(size["tilt"], units.ARCSEC), heading_error_arcsec=stats(size["heading"], units.ARCSEC),
-        position_sigma_final_m=[float(v) for v in ned_sigma(sigma[-1], series["lat_true"][-1], series["h_true"][-1])],
+        position_sigma_final_m=[float(v) for v in np.abs(ned_metres(sigma[-1, POSITION]))],
         bias_error_final_deg_per_h=[float(v) for v in units.rad_per_s_to_deg_per_h(e[-1, GYRO_BIAS])],
         accel_bias_error_final_micro_g=[float(v) for v in e[-1, ACCEL_BIAS] / MICRO_G],
         imu_calibration=imu_calibration(series),
@@ -135,11 +133,6 @@ def summarize(scenario, seed, series, grid):
         updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])),
                  "measurements": measurements, "accepted": accepted, "rejected": measurements - accepted},
     )
-
-
-def ned_sigma(sigma, lat, h):
-    """The position part of an error-state σ (n,) as NED σ [m] (3,) at (L, h)."""
-    return np.abs(ned_metres(sigma[POSITION], lat, h))
 
 
 def imu_calibration(series):

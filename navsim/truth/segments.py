@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from navsim.truth.level_frames import North
 from startrack import units
 from startrack.errors import InputError
 
@@ -317,12 +318,14 @@ class Start:
 
 @dataclass(frozen=True)
 class Profile:
-    """A start and its segments, checked in sequence (each segment against the speed it enters with).
+    """A start and its segments, checked in sequence (each segment against the speed it enters with), their
+    headings measured in the level frame ``frame`` (:mod:`navsim.truth.level_frames`: north by default).
 
     ``starts`` [s] and ``entries`` hold each segment's start time and entry state; ``duration`` is the total."""
 
     start: Start
     segments: tuple
+    frame: object = North()
 
     def __post_init__(self):
         entry, t, starts, entries = self.start.entry, 0.0, [], []

@@ -3,28 +3,28 @@ position, NED velocity and attitude at the IMU sample times, and the exactly con
 increments over each interval (the inverse strapdown).
 
 Velocity and attitude are closed-form functions of time (the segments'
-:class:`~navsim.truth.segments.Channels`); position is their integral on the ellipsoid,
-L̇ = v_N/(R_M + h), λ̇ = v_E/((R_N + h) cos L), ḣ = −v_D (Groves, 2nd ed., eq. 2.111), by
-four-point Gauss-Legendre quadrature per interval (exact for polynomials of degree 7), iterated
-to convergence in L. The body rate and specific force follow at every quadrature node from the
-kinematics (Groves eqs. 5.35 and 5.53 solved for the sensed quantities):
+:class:`~navsim.truth.segments.Channels`) in the profile's local-level frame f (its ``frame``, a
+strategy of :mod:`navsim.truth.level_frames`: NED, or free in azimuth for routes); position is their
+integral on the ellipsoid by four-point Gauss-Legendre quadrature per interval (exact for polynomials
+of degree 7). The body rate and specific force follow at every quadrature node from the kinematics
+(Groves eqs. 5.35 and 5.53 solved for the sensed quantities, f for n):
 
-    ω_ib^b = C_bn (ω_ie^n + ω_en^n) + ω_nb^b,
-    f^b   = C_bn (v̇_n + (2 ω_ie^n + ω_en^n) × v_n − g_n),
+    ω_ib^b = C_bf (ω_ie^f + ω_ef^f) + ω_fb^b,
+    f^b   = C_bf (v̇_f + (2 ω_ie^f + ω_ef^f) × v_f − g_f),
 
-with ω_nb^b from the Euler-angle rates and g_n the truth gravity (normal gravity plus an optional
+with ω_fb^b from the Euler-angle rates and g_f the truth gravity (normal gravity plus an optional
 disturbance). The increments are what an integrating IMU outputs,
 
     Δθ_k = ∫ ω_ib^b dt,   Δv_k = ∫ f^b dt   over [t_(k−1), t_k] in the moving body axes,
 
 so the coning and sculling content of the motion is in them; the same quadrature gives both.
 
-These increments under normal gravity are seed-free (:class:`Kinematics`). A gravity disturbance δg_n
-(linear in time between samples) adds −∫ C_bn δg_n dt to Δv, taken by the trapezoidal rule over
-each interval (:func:`with_gravity`), whose error dt³/12 |(C_bn δg_n)''| is set by the turns and the
-field's roughness. Against the four-node quadrature of the same field it is at most 3e-12 m/s per
-5 ms interval and 5e-10 m/s summed over the 4 h of ``sins_cns_aircraft_vector``, and 8e-11 m/s per
-10 ms interval in a 4 deg/s roll-in (position: below a micrometre).
+These increments under normal gravity are seed-free (:class:`Kinematics`). A gravity disturbance δg_f
+(its deflections along f's axes; linear in time between samples) adds −∫ C_bf δg_f dt to Δv, taken by
+the trapezoidal rule over each interval (:func:`with_gravity`), whose error dt³/12 |(C_bf δg_f)''| is
+set by the turns and the field's roughness. Against the four-node quadrature of the same field it is at
+most 3e-12 m/s per 5 ms interval and 5e-10 m/s summed over the 4 h of ``sins_cns_aircraft_vector``,
+and 8e-11 m/s per 10 ms interval in a 4 deg/s roll-in (position: below a micrometre).
 """
 
 from dataclasses import dataclass
@@ -32,20 +32,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from navsim.earth.frames import earth_rate_n, transport_rate_n
 from navsim.earth.gravity import disturbance_n, normal_gravity
-from navsim.earth.wgs84 import radii
+from navsim.truth.level_frames import NODES, WEIGHTS
 from startrack import rotation as rot
-from startrack import units
 from startrack.errors import InputError
 
-#: Gauss-Legendre nodes on [0, 1] and weights (sum 1).
-_X, _W = np.polynomial.legendre.leggauss(4)
-NODES = 0.5 * (_X + 1.0)
-WEIGHTS = 0.5 * _W
-#: Cubic Hermite basis at the nodes (h00, h10, h01, h11) for value/derivative interpolation.
-_HERMITE = np.stack([2 * NODES**3 - 3 * NODES**2 + 1, NODES**3 - 2 * NODES**2 + NODES,
-                     -2 * NODES**3 + 3 * NODES**2, NODES**3 - NODES**2])
 CHUNK = 50_000
 
 
@@ -90,8 +81,10 @@ class Trajectory:
 class Kinematics:
     """The seed-free part of a truth trajectory: the N + 1 sample times ``t`` [s], the segments'
     ``channels`` there, ``v_n`` (N+1, 3) [m/s], ``lat``, ``lon`` [rad], ``h`` [m], ``q_nb``
-    (N+1, 4), and the increments ``dtheta``, ``dv`` (N, 3) under normal gravity. A gravity disturbance
-    changes only the specific force, so a random one drawn per run reuses them (:func:`with_gravity`)."""
+    (N+1, 4), the attitude ``q_fb`` in the profile's level frame f and its angle ``alpha`` [rad] from
+    north (None: f = NED), and the increments ``dtheta``, ``dv`` (N, 3) under normal gravity. A gravity
+    disturbance changes only the specific force, so a random one drawn per run reuses them
+    (:func:`with_gravity`)."""
 
     t: np.ndarray
     channels: object
@@ -100,6 +93,8 @@ class Kinematics:
     lon: np.ndarray
     h: np.ndarray
     q_nb: np.ndarray
+    q_fb: np.ndarray
+    alpha: np.ndarray | None
     dtheta: np.ndarray
     dv: np.ndarray
     rate_hz: float
@@ -123,31 +118,62 @@ def kinematics(profile, rate_hz, duration=None):
     if n < 1:
         raise InputError(f"imu.rate_hz: {rate_hz} Hz gives no sample interval in {span} s")
     t = np.arange(n + 1) * dt
-    at_samples = profile.channels(t)
-    v_samples = _velocity(at_samples)
-    v_nodes = np.concatenate([_velocity(profile.channels(_node_times(t, lo, hi))) for lo, hi in _chunks(n)])
-    lat, lon, h = _position(profile.start, dt, v_samples, v_nodes)
+    at_samples, v_samples, track = _flown(profile, t)
     dtheta, dv = np.empty((n, 3)), np.empty((n, 3))
     for lo, hi in _chunks(n):
-        dtheta[lo:hi], dv[lo:hi] = _increments(profile, t, lo, hi, (lat, lon, h), v_samples)
-    return Kinematics(t=t, channels=at_samples, v_n=v_samples, lat=lat, lon=lon, h=h,
-                      q_nb=attitude(at_samples), dtheta=dtheta, dv=dv, rate_hz=float(rate_hz))
+        dtheta[lo:hi], dv[lo:hi] = _increments(profile, t, lo, hi, track, v_samples[lo:hi + 1])
+    q_fb = attitude(at_samples)
+    return Kinematics(t=t, channels=at_samples, v_n=ned_of(track.alpha, v_samples), lat=track.lat, lon=track.lon,
+                      h=track.h, q_nb=_attitude_ned(track.alpha, q_fb), q_fb=q_fb, alpha=track.alpha, dtheta=dtheta,
+                      dv=dv, rate_hz=float(rate_hz))
+
+
+def track(profile, rate_hz):
+    """The :class:`~navsim.truth.level_frames.Track` (position only) of ``profile`` at ``rate_hz`` [Hz] over its
+    whole duration (the last partial interval dropped)."""
+    n = int(np.floor(profile.duration * rate_hz + 1e-9))
+    return _flown(profile, np.arange(n + 1) / rate_hz)[2]
+
+
+def _flown(profile, t):
+    """(channels, v_f (N+1, 3) [m/s], Track) at the sample times ``t`` (uniform)."""
+    at_samples = profile.channels(t)
+    v_samples = _velocity(at_samples)
+    v_nodes = np.concatenate([_velocity(profile.channels(_node_times(t, lo, hi))) for lo, hi in _chunks(t.size - 1)])
+    return at_samples, v_samples, profile.frame.track(profile.start, t[1] - t[0], v_samples, v_nodes.reshape(-1, 4, 3))
 
 
 def with_gravity(kin, disturbance=None, seed=None):
     """The :class:`Trajectory` of :class:`Kinematics` ``kin`` under the truth gravity: normal gravity
-    plus the optional ``disturbance`` (a random one drawn from ``seed``): Δv gains −∫ C_bn δg_n dt by the
-    trapezoidal rule (module docstring)."""
+    plus the optional ``disturbance`` (a random one drawn from ``seed``) along f: Δv gains −∫ C_bf δg_f dt
+    by the trapezoidal rule (module docstring); δg_n = C_nf δg_f."""
     dt = 1.0 / kin.rate_hz
     components = _disturbance_components(disturbance, seed, kin.channels, dt)
     if components is None:
         delta_g, dv = np.zeros((kin.t.size, 3)), kin.dv
     else:
-        delta_g = disturbance_n(components, normal_gravity(kin.lat, kin.h))
-        g_b = rot.rotate(rot.conjugate(kin.q_nb), delta_g)
+        delta_f = disturbance_n(components, normal_gravity(kin.lat, kin.h))
+        g_b = rot.rotate(rot.conjugate(kin.q_fb), delta_f)
         dv = kin.dv - 0.5 * dt * (g_b[:-1] + g_b[1:])
+        delta_g = ned_of(kin.alpha, delta_f)
     return Trajectory(t=kin.t, lat=kin.lat, lon=kin.lon, h=kin.h, v_n=kin.v_n, q_nb=kin.q_nb, dtheta=kin.dtheta,
                       dv=dv, gravity_disturbance=delta_g, rate_hz=kin.rate_hz)
+
+
+def ned_of(alpha, vectors):
+    """C_nf ``vectors`` (N+1, 3): turned about the vertical by the angle ``alpha`` (N+1,) [rad] of f from north
+    (None: f = NED, unchanged)."""
+    return vectors if alpha is None else rot.rotate(_q_nf(alpha), vectors)
+
+
+def _attitude_ned(alpha, q_fb):
+    """q_nb = q_nf ⊗ q_fb (:func:`ned_of`)."""
+    return q_fb if alpha is None else rot.multiply(_q_nf(alpha), q_fb)
+
+
+def _q_nf(alpha):
+    zero = np.zeros_like(alpha)
+    return rot.from_rotation_vector(np.stack([zero, zero, alpha], axis=-1))
 
 
 def _chunks(n):
@@ -160,19 +186,19 @@ def _node_times(t, lo, hi):
 
 
 def _velocity(ch):
-    """v_n (..., 3) [m/s] of channels: [V cos ψ, V sin ψ, −climb]."""
+    """v_f (..., 3) [m/s] of channels: [V cos ψ, V sin ψ, −climb]."""
     return np.stack([ch.speed * np.cos(ch.heading), ch.speed * np.sin(ch.heading), -ch.climb], axis=-1)
 
 
 def _velocity_rate(ch):
-    """v̇_n (..., 3) [m/s²] of channels."""
+    """v̇_f (..., 3) [m/s²] of channels."""
     c, s = np.cos(ch.heading), np.sin(ch.heading)
     return np.stack([ch.speed_rate * c - ch.speed * s * ch.heading_rate,
                      ch.speed_rate * s + ch.speed * c * ch.heading_rate, -ch.climb_rate], axis=-1)
 
 
 def attitude(ch):
-    """q_nb (..., 4) of yaw ψ, pitch θ, roll φ (ZYX): q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)."""
+    """q_fb (..., 4) of yaw ψ, pitch θ, roll φ (ZYX) in the level frame f: q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)."""
     zero = np.zeros_like(ch.heading)
     q_yaw = rot.from_rotation_vector(np.stack([zero, zero, ch.heading], axis=-1))
     q_pitch = rot.from_rotation_vector(np.stack([zero, ch.pitch, zero], axis=-1))
@@ -181,7 +207,7 @@ def attitude(ch):
 
 
 def _body_rate_from_euler(ch):
-    """ω_nb^b (..., 3) [rad/s] from the ZYX Euler angles (yaw ψ, pitch θ, roll φ) and their rates
+    """ω_fb^b (..., 3) [rad/s] from the ZYX Euler angles (yaw ψ, pitch θ, roll φ) and their rates
     (the inverse of the ZYX Euler-rate equations; Titterton & Weston, 2nd ed., ch. 3):
     [φ̇ − ψ̇ sin θ, θ̇ cos φ + ψ̇ sin φ cos θ, −θ̇ sin φ + ψ̇ cos φ cos θ]."""
     sr, cr = np.sin(ch.roll), np.cos(ch.roll)
@@ -189,39 +215,6 @@ def _body_rate_from_euler(ch):
     return np.stack([ch.roll_rate - ch.heading_rate * sp,
                      ch.pitch_rate * cr + ch.heading_rate * sr * cp,
                      -ch.pitch_rate * sr + ch.heading_rate * cr * cp], axis=-1)
-
-
-def _hermite(values, rates, dt):
-    """Cubic Hermite interpolation of sample ``values`` (N+1,) with derivatives ``rates`` at the
-    quadrature nodes: (N, 4)."""
-    h00, h10, h01, h11 = _HERMITE
-    return (values[:-1, None] * h00 + dt * rates[:-1, None] * h10
-            + values[1:, None] * h01 + dt * rates[1:, None] * h11)
-
-
-def _cumulative(start, integrand, dt):
-    """start + ∫ integrand dt at the samples, integrand (N, 4) at the nodes."""
-    return start + np.concatenate([[0.0], np.cumsum(dt * integrand @ WEIGHTS)])
-
-
-def _position(start, dt, v_samples, v_nodes):
-    """(L, λ, h) (N+1,) at the samples by quadrature of the position rates; L iterated to
-    convergence (its rate depends on L through R_M; each pass gains ~3 digits)."""
-    v_nodes = v_nodes.reshape(-1, 4, 3)
-    h = _cumulative(start.height_m, -v_nodes[..., 2], dt)
-    h_nodes = _hermite(h, -v_samples[:, 2], dt)
-    lat = np.full(h.shape, start.lat_deg * units.DEG)
-    for _ in range(20):
-        lat_rate = v_samples[:, 0] / (radii(lat)[0] + h)
-        lat_nodes = _hermite(lat, lat_rate, dt)
-        new = _cumulative(lat[0], v_nodes[..., 0] / (radii(lat_nodes)[0] + h_nodes), dt)
-        change = np.max(np.abs(new - lat))
-        lat = new
-        if change < 1e-16:
-            break
-    lat_nodes = _hermite(lat, v_samples[:, 0] / (radii(lat)[0] + h), dt)
-    lon = _cumulative(start.lon_deg * units.DEG, v_nodes[..., 1] / ((radii(lat_nodes)[1] + h_nodes) * np.cos(lat_nodes)), dt)
-    return lat, lon, h
 
 
 def _disturbance_components(disturbance, seed, at_samples, dt):
@@ -233,24 +226,18 @@ def _disturbance_components(disturbance, seed, at_samples, dt):
     return disturbance.components(distance, np.random.default_rng(seed))
 
 
-def _increments(profile, t, lo, hi, position, v_samples):
+def _increments(profile, t, lo, hi, track, v_part):
     """(Δθ, Δv) (hi−lo, 3) of intervals lo..hi−1 under normal gravity by quadrature of ω_ib^b and f^b at
-    the nodes."""
+    the nodes; ``v_part`` the velocities in f at samples lo..hi."""
     dt = t[1] - t[0]
     ch = profile.channels(_node_times(t, lo, hi))
-    lat, lon, h = position
-    span = slice(lo, hi + 1)
-    v_part = v_samples[span]
-    lat_n = _hermite(lat[span], v_part[:, 0] / (radii(lat[span])[0] + h[span]), dt).ravel()
-    h_n = _hermite(h[span], -v_part[:, 2], dt).ravel()
-    v_n, v_dot = _velocity(ch), _velocity_rate(ch)
-    w_ie = np.stack(earth_rate_n(lat_n), axis=-1)
-    w_en = np.stack(transport_rate_n(lat_n, h_n, v_n[:, 0], v_n[:, 1]), axis=-1)
+    v_f, v_dot = _velocity(ch), _velocity_rate(ch)
+    w_ie, w_ef, lat_n, h_n = profile.frame.node_rates(track, lo, hi, dt, v_part, v_f)
     gamma = normal_gravity(lat_n, h_n)
-    g_n = np.zeros_like(v_n)
-    g_n[:, 2] = gamma
-    C_bn = np.swapaxes(rot.to_matrix(attitude(ch)), -1, -2)
-    omega = np.einsum("nij,nj->ni", C_bn, w_ie + w_en) + _body_rate_from_euler(ch)
-    force = np.einsum("nij,nj->ni", C_bn, v_dot + np.cross(2.0 * w_ie + w_en, v_n) - g_n)
+    g_f = np.zeros_like(v_f)
+    g_f[:, 2] = gamma
+    C_bf = np.swapaxes(rot.to_matrix(attitude(ch)), -1, -2)
+    omega = np.einsum("nij,nj->ni", C_bf, w_ie + w_ef) + _body_rate_from_euler(ch)
+    force = np.einsum("nij,nj->ni", C_bf, v_dot + np.cross(2.0 * w_ie + w_ef, v_f) - g_f)
     weights = dt * WEIGHTS[:, None]
     return (omega.reshape(-1, 4, 3) * weights).sum(axis=1), (force.reshape(-1, 4, 3) * weights).sum(axis=1)

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from navsim.earth.wgs84 import radii
+from navsim.earth.wander import ned_offset
 from navsim.kinds import load_scenario
 from navsim.truth.segments import Profile
 from startrack import rotation as rot
@@ -15,9 +15,7 @@ SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 def position_errors(log, truth, every=1):
     """(north, east, down) position errors [m] (K, 3) of a log against the truth samples it logged."""
-    lat, lon, h = truth.lat[::every], truth.lon[::every], truth.h[::every]
-    r_m, r_n = radii(lat)
-    return np.stack([(log.lat - lat) * (r_m + h), (log.lon - lon) * (r_n + h) * np.cos(lat), -(log.h - h)], axis=-1)
+    return ned_offset(log.lat, log.lon, log.h, truth.lat[::every], truth.lon[::every], truth.h[::every])
 
 
 def attitude_errors(log, truth, every=1):

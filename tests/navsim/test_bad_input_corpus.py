@@ -21,11 +21,12 @@ from tests.support import run_cli
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
 BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid", "navigation",
-                                                              "sins_cns", "sins_cns_photometry")}
+                                                              "route", "sins_cns", "sins_cns_photometry")}
 STUDY = ROOT / "scenarios" / "paper003_precision.toml"
 #: Which base scenario reaches the keys below each table of the attitude and the navigation schema
 #: (the first match wins; the schema's default otherwise).
-NAV_BASE_OF = (("star_sensor.photometry", "sins_cns_photometry"), ("star_sensor", "sins_cns"), ("faults", "sins_cns"))
+NAV_BASE_OF = (("star_sensor.photometry", "sins_cns_photometry"), ("star_sensor", "sins_cns"), ("faults", "sins_cns"),
+               ("trajectory.route", "route"))
 BASE_OF = (("truth.sinusoidal_axis", "image"), ("truth.rate_segments", "segments"), ("truth.rigid_body", "rigid"),
            ("star_sensor.image", "image"), ("faults.attitude_jumps", "image"), ("faults.false_star_storms", "image"),
            ("faults.tracking_failure_probes", "image"))
@@ -148,7 +149,8 @@ REQUIRED = [("duration_s", "constant"), ("truth.profile", "constant"), ("gyro.ra
             ("truth.sinusoidal_axis.amplitude_deg", "image"), ("truth.rigid_body.inertia_kg_m2", "rigid"),
             ("name", "navigation"), ("trajectory.start.lat_deg", "navigation"), ("trajectory.segments", "navigation"),
             ("imu.rate_hz", "navigation"), ("baro.rate_hz", "navigation"), ("aiding.position.sigma_ned_m", "navigation"),
-            ("gravity.model", "navigation"), ("star_sensor.photometry.aperture_mm", "sins_cns_photometry")]
+            ("gravity.model", "navigation"), ("star_sensor.photometry.aperture_mm", "sins_cns_photometry"),
+            ("trajectory.route.waypoints", "route")]
 
 
 @pytest.mark.parametrize("key, base", REQUIRED)

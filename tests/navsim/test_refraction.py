@@ -136,10 +136,12 @@ def test_the_fraction_sigma_adds_the_pressure_and_temperature_parts():
 
 
 def _nav_state(rng):
-    """A random strapdown state's first ten entries (L, λ, h, v_n, q_nb)."""
-    nav = np.zeros(10)
-    nav[0], nav[1], nav[2] = rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1), rng.uniform(0.0, 2e4)
-    nav[6:10] = rot.from_rotation_vector(rng.normal(size=3))
+    """A random strapdown solution row (q_ew, h, v_w, q_wb) at rest."""
+    from navsim.earth.wander import q_ew
+    nav = np.zeros(12)
+    nav[0:4] = q_ew(rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1), rng.uniform(-3.1, 3.1))
+    nav[4] = rng.uniform(0.0, 2e4)
+    nav[8:12] = rot.from_rotation_vector(rng.normal(size=3))
     return nav
 
 

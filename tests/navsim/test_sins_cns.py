@@ -257,24 +257,26 @@ def test_psins_settings_estimate_the_mounting_after_the_turns(tmp_path, capsys):
 
 def test_the_attitude_difference_jacobian_against_finite_errors():
     """δθ_b = A x (eq. 1 of navsim.estimation.celestial_kernels): the inertial attitude of an INS state
-    with errors φ, δL, δλ (C_nb,est = (I − [φ×]) C_nb,true), q_IB,true = q_IB,est ⊗ δq(δθ_b),
-    against A evaluated at the estimate, for random states and errors of 1e-4 rad (second order left:
-    < 1e-3 of the error)."""
+    with errors φ, δθ (C_wb,est = (I − [φ×]) C_wb,true, C_ew,est = C_ew,true (I + [δθ×]), δθ horizontal),
+    q_IB,true = q_IB,est ⊗ δq(δθ_b), against A evaluated at the estimate, for random states (the poles among
+    them) and errors of 1e-4 rad (second order left: < 1e-3 of the error)."""
+    from navsim.earth.wander import q_ew
     from navsim.estimation.celestial_kernels import attitude_jacobian, inertial_attitude
     from navsim.estimation.nav_kernels import DP
     from startrack import rotation as rot
 
     rng = np.random.default_rng(11)
     q_ie = rot.from_rotation_vector(rng.normal(size=3))
-    for _ in range(20):
-        truth = np.zeros(10)
-        truth[0], truth[1], truth[2] = rng.uniform(-1.4, 1.4), rng.uniform(-3.1, 3.1), rng.uniform(0.0, 3e4)
-        truth[6:10] = rot.from_rotation_vector(rng.normal(size=3))
+    for lat in [*rng.uniform(-1.4, 1.4, size=18), 0.5 * np.pi, -0.5 * np.pi]:
+        truth = np.zeros(12)
+        truth[0:4] = q_ew(lat, rng.uniform(-3.1, 3.1), rng.uniform(-3.1, 3.1))
+        truth[4] = rng.uniform(0.0, 3e4)
+        truth[8:12] = rot.from_rotation_vector(rng.normal(size=3))
         x = np.zeros(15)
         x[0:3], x[DP:DP + 2] = rng.normal(scale=1e-4, size=3), rng.normal(scale=1e-4, size=2)
         estimate = truth.copy()
-        estimate[0:2] += x[DP:DP + 2]
-        estimate[6:10] = rot.multiply(rot.from_rotation_vector(-x[0:3]), truth[6:10])
+        estimate[0:4] = rot.multiply(truth[0:4], rot.from_rotation_vector([x[DP], x[DP + 1], 0.0]))
+        estimate[8:12] = rot.multiply(rot.from_rotation_vector(-x[0:3]), truth[8:12])
         delta = rot.to_rotation_vector(rot.multiply(rot.conjugate(inertial_attitude(estimate, q_ie)),
                                                     inertial_attitude(truth, q_ie)))
         np.testing.assert_allclose(attitude_jacobian(estimate, 15) @ x, delta, atol=1e-3 * np.abs(x).max())

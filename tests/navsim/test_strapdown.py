@@ -74,6 +74,39 @@ def test_accelerometer_bias_gives_the_schuler_oscillation(equator_rest):
     assert amplitude == pytest.approx(r_m * bias / g, rel=0.02)
 
 
+@pytest.mark.parametrize("lat_deg", [90.0, 89.99, -90.0, 0.0])
+def test_accelerometer_bias_gives_the_schuler_oscillation_anywhere(lat_deg):
+    """At a pole and beside it, the same closed form as on the equator with the Foucault term: at rest the
+    horizontal error z = δN + i δE of a north accelerometer bias ∇ obeys z̈ − 2i f ż + ω_s² z = ∇ (f = ω_ie sin L,
+    from −2ω_ie^n × δv), so z = ∇/ω_s² + e^(ift)(A cos Ωt + B sin Ωt), Ω = √(ω_s² + f²). Fitted with f known: the
+    period 2π/Ω within 0.5 % and the offset R∇/g within 3 % (the issue's mid-latitude tolerances), and the
+    ellipse's axes (A, B)·(1, f/Ω) as the closed form's. 3 h at 10 Hz; wander-azimuth mechanization throughout."""
+    from navsim.earth.wgs84 import OMEGA_IE
+    truth = trajectory.generate(Profile(Start(lat_deg, 30.0, 0.0), (Hold(3 * 3600.0),)), 10.0)
+    bias = 1e-4
+    dv = truth.dv + np.array([bias, 0.0, 0.0]) * truth.dt  # body x is north (heading 0, level)
+    log = strapdown.run(_start(truth), truth.dtheta, dv, truth.dt, baro_h=truth.h[1:], every=10)
+    lat = np.radians(lat_deg)
+    r = np.sqrt(np.prod(radii(lat)))
+    g, f = normal_gravity(lat, 0.0), OMEGA_IE * np.sin(lat)
+    t, e = truth.t[::10], position_errors(log, truth, every=10)
+    z = e[:, 0] + 1j * e[:, 1]
+
+    def residual(omega):
+        basis = np.stack([np.ones_like(t), np.exp(1j * f * t) * np.cos(omega * t), np.exp(1j * f * t) * np.sin(omega * t)], -1)
+        c = np.linalg.lstsq(basis, z, rcond=None)[0]
+        return np.sum(np.abs(basis @ c - z) ** 2), c
+
+    omegas = np.sqrt(g / r) * np.linspace(0.97, 1.03, 601)
+    omega = omegas[np.argmin([residual(w)[0] for w in omegas])]
+    (offset, a, b) = residual(omega)[1]
+    expected = np.sqrt(g / r + f * f)
+    assert 2 * np.pi / omega == pytest.approx(2 * np.pi / expected, rel=0.005)
+    assert abs(offset) == pytest.approx(r * bias / g, rel=0.03)
+    assert a == pytest.approx(-offset, abs=0.03 * abs(offset))
+    assert b == pytest.approx(1j * f / expected * offset, abs=0.03 * abs(offset))  # ż(0) = 0
+
+
 def test_initial_tilt_gives_the_schuler_oscillation(equator_rest):
     """An initial tilt φ_N about north: δE(t) = −R φ_N (1 − cos ω_s t). (About north, because on the
     equator the east-tilt channel also exchanges with the heading error at the Earth rate.)"""
