@@ -22,7 +22,7 @@ from navsim.earth.frames import OMEGA_IE, c_en, q_en
 from navsim.earth.wgs84 import E2, A, radii
 from startrack import rotation as rot
 from startrack.jit import njit
-from startrack.rotation_jit import quat_to_matrix
+from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix
 
 
 @njit
@@ -35,17 +35,42 @@ def radii_of_sine(s):
 
 
 @njit
+def parallel_curvature(s, h):
+    """(1/(R_N + h), k) [1/m] of eq. 2 at sin L = ``s`` and h [m]: D = I/(R_N + h) + k c cᵀ."""
+    r_m, r_n, _, _ = radii_of_sine(s)
+    return 1.0 / (r_n + h), r_n * E2 / ((1.0 - E2 * s * s) * (r_m + h) * (r_n + h))
+
+
+@njit
 def curvature(C, h):
     """(D (2, 2) [1/m], k [1/m], s, c (2,)) of eq. 2 at the position C_ew (3, 3), h [m]."""
     s = -C[2, 2]
     c = np.array([C[2, 0], C[2, 1]])
-    r_m, r_n, _, _ = radii_of_sine(s)
-    k = r_n * E2 / ((1.0 - E2 * s * s) * (r_m + h) * (r_n + h))
+    iso, k = parallel_curvature(s, h)
     D = np.empty((2, 2))
     for i in range(2):
         for j in range(2):
-            D[i, j] = k * c[i] * c[j] + (1.0 / (r_n + h) if i == j else 0.0)
+            D[i, j] = k * c[i] * c[j] + (iso if i == j else 0.0)
     return D, k, s, c
+
+
+@njit
+def axis_of(q):
+    """(c0, c1, c2) = C_ew[2, :], the Earth's axis in w (eq. 1: ω_ie^w = ω_ie C_ew[2, :]ᵀ; c0, c1 the c of eq. 2 and
+    c2 = −sin L), of the unit quaternion q_ew (4,) or 4-tuple, as scalars (the third row of
+    :func:`startrack.rotation_jit.quat_to_matrix`, without allocating it)."""
+    x, y, z, w = q[0], q[1], q[2], q[3]
+    return 2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit
+def transport_of_axis(c0, c1, c2, h, v0, v1):
+    """(g_y, −g_x) [rad/s], the horizontal part of ω_ew^w (eq. 2; g = D v_h = v_h/(R_N + h) + k c (c · v_h)), at the
+    axis (c0, c1, c2) of :func:`axis_of`, h [m] and the horizontal ground velocity (v0, v1) [m/s] in w (scalars: no
+    allocation)."""
+    iso, k = parallel_curvature(-c2, h)
+    projection = k * (c0 * v0 + c1 * v1)
+    return iso * v1 + projection * c1, -(iso * v0 + projection * c0)
 
 
 @njit
@@ -56,11 +81,9 @@ def earth_rate_w(C):
 
 @njit
 def transport_rate_w(C, h, v):
-    """ω_ew^w (3,) [rad/s] at C_ew, h [m] for the ground velocity v (3,) [m/s] in w (eq. 2)."""
-    D, _, _, _ = curvature(C, h)
-    gx = D[0, 0] * v[0] + D[0, 1] * v[1]
-    gy = D[1, 0] * v[0] + D[1, 1] * v[1]
-    return np.array([gy, -gx, 0.0])
+    """ω_ew^w (3,) [rad/s] at C_ew, h [m] for the ground velocity v (3,) [m/s] in w (eq. 2; :func:`transport_of_axis`)."""
+    x, y = transport_of_axis(C[2, 0], C[2, 1], C[2, 2], h, v[0], v[1])
+    return np.array([x, y, 0.0])
 
 
 def q_ew(lat, lon, alpha=0.0):
@@ -97,13 +120,29 @@ def geodetic(q):
     return out[..., 0], out[..., 1], out[..., 2]
 
 
+@njit
+def _ned_rows(q, v_w, q_wb):
+    """[L, λ [rad], v_n (3), q_nb (4)] (K, 9) of the rows q_ew (K, 4), v_w (K, 3), q_wb (K, 4) (:func:`to_ned`)."""
+    out = np.empty((q.shape[0], 9))
+    for i in range(q.shape[0]):
+        out[i, 0], out[i, 1], alpha = frame_angles(quat_to_matrix(q[i]))
+        q_nw = quat_from_rotation_vector(np.array([0.0, 0.0, alpha]))
+        C_nw = quat_to_matrix(q_nw)
+        for r in range(3):
+            out[i, 2 + r] = C_nw[r, 0] * v_w[i, 0] + C_nw[r, 1] * v_w[i, 1] + C_nw[r, 2] * v_w[i, 2]
+        out[i, 5:9] = quat_multiply(q_nw, q_wb[i])
+    return out
+
+
 def to_ned(q, v_w, q_wb):
-    """(L, λ, v_n, q_nb) of the w-frame solution q_ew (..., 4), v_w (..., 3), q_wb (..., 4): v_n = C_nw v_w,
-    q_nb = q_z(α) ⊗ q_wb."""
-    lat, lon, alpha = geodetic(q)
-    zero = np.zeros_like(alpha)
-    q_nw = rot.from_rotation_vector(np.stack([zero, zero, alpha], axis=-1))
-    return lat, lon, rot.rotate(q_nw, v_w), rot.multiply(q_nw, q_wb)
+    """(L, λ, v_n, q_nb) of the w-frame solution q_ew (..., 4), v_w (..., 3), q_wb (..., 4): L, λ and α of
+    :func:`frame_angles`, v_n = C_nw v_w, q_nb = q_z(α) ⊗ q_wb (one compiled pass over the rows)."""
+    q = np.ascontiguousarray(q, dtype=float)
+    shape = q.shape[:-1]
+    out = _ned_rows(q.reshape(-1, 4), np.ascontiguousarray(v_w, dtype=float).reshape(-1, 3),
+                    np.ascontiguousarray(q_wb, dtype=float).reshape(-1, 4))
+    out = out.reshape(shape + (9,))
+    return out[..., 0], out[..., 1], out[..., 2:5], out[..., 5:9]
 
 
 def normal(lat, lon):

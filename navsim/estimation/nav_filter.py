@@ -294,9 +294,11 @@ class NavFilter:
             raise ValueError("this navigation filter has no star sensor")
         return self.star_sensor.orientation.index(self.t)
 
-    def _observer_velocity(self, j):
+    def _observer_velocity(self, j, ned):
+        """v_I (3,) [m/s]: the INS's velocity relative to the barycentre at frame ``j``, of its NED solution ``ned``
+        (:meth:`_ned`)."""
         o = self.star_sensor.orientation
-        lat, lon, v_n, _ = self._ned()
+        lat, lon, v_n, _ = ned
         return observer_velocity(o.c_ie[j], o.v_earth[j], lat, lon, self._nav[4], v_n)
 
     def sensor_prior(self):
@@ -333,8 +335,9 @@ class NavFilter:
     def _seen(self, j):
         """The processing's map of catalog unit vectors (N, 3) to (aberrated, apparent) directions at frame ``j``
         (:meth:`_apparent`; their difference is the refraction it corrects)."""
-        v = self._observer_velocity(j) if self.star_sensor.correct_aberration else None
-        air = self._air(j)
+        ned = self._ned()
+        v = self._observer_velocity(j, ned) if self.star_sensor.correct_aberration else None
+        air = self._air(j, ned)
 
         def seen(u):
             aberrated = np.ascontiguousarray(u if v is None else aberrate(u, v))
@@ -342,23 +345,25 @@ class NavFilter:
 
         return seen
 
-    def _air(self, j):
-        """(up_I (3,), A, B) of the processing's refraction correction at frame ``j`` and the INS's position, or None."""
+    def _air(self, j, ned):
+        """(up_I (3,), A, B) of the processing's refraction correction at frame ``j`` and the INS's position (of its NED
+        solution ``ned``, :meth:`_ned`), or None."""
         air = self.star_sensor.refraction
         if air is None:
             return None
-        lat, lon, _, _ = self._ned()
+        lat, lon, _, _ = ned
         a, b = air.coefficients(self._nav[4])
         return local_up(self.star_sensor.orientation.c_ie[j], lat, lon), a, b
 
     def _corrected_fix(self, q_IS, j):
         """The fix turned back by the rotation of its boresight to its apparent direction, as far as the processing
         corrects it (aberration with the INS's velocity, refraction with its model air)."""
-        correct, air = self.star_sensor.correct_aberration, self._air(j)
+        ned = self._ned()
+        correct, air = self.star_sensor.correct_aberration, self._air(j, ned)
         if not correct and air is None:
             return q_IS
         boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
-        v = self._observer_velocity(j) if correct else np.zeros(3)
+        v = self._observer_velocity(j, ned) if correct else np.zeros(3)
         return rot.normalize(rot.multiply(fix_rotation(boresight, v, air), q_IS))
 
     def process_record(self, samples, ratio, dt, record):

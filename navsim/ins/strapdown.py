@@ -32,12 +32,11 @@ from typing import NamedTuple
 import numpy as np
 
 from navsim.earth.gravity import normal_gravity_of_sine
-from navsim.earth.wander import earth_rate_w, geodetic, q_ew, to_ned, transport_rate_w
-from navsim.earth.wgs84 import GAMMA_E, A
+from navsim.earth.wander import axis_of, geodetic, q_ew, to_ned, transport_of_axis
+from navsim.earth.wgs84 import GAMMA_E, OMEGA_IE, A
 from startrack import rotation as rot
 from startrack.errors import InputError
 from startrack.jit import njit
-from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix
 
 SIZE = 19
 #: Length of a solution row (q_ew, h, v_w, q_wb): what a log keeps of ``nav``.
@@ -96,26 +95,63 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit
-def _velocity_change(C, h, v0, v1, v2, u0, u1, u2, dt):
-    """(Δv_w (3), ζ (3)) over dt with the rates at (C_ew, h, v): Δv_w = Δv_sf^w + [g_w − (2ω_ie^w + ω_ew^w)
-    × v] dt, Δv_sf^w = u − ½ ζ × u (steps 3-4 for u = C_wb Δv_b), ζ = (ω_ie^w + ω_ew^w) dt."""
-    e = earth_rate_w(C)
-    t = transport_rate_w(C, h, np.array([v0, v1, v2]))
-    z0, z1, z2 = (e[0] + t[0]) * dt, (e[1] + t[1]) * dt, (e[2] + t[2]) * dt
+def _exp(t0, t1, t2):
+    """exp(θ/2), the quaternion of the rotation vector θ = (t0, t1, t2) [rad] as a scalar-last 4-tuple (the series
+    below 1e-4 rad of :func:`startrack.rotation_jit.quat_from_rotation_vector`; no allocation)."""
+    angle = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    k = 0.5 - angle * angle / 48.0 if angle < 1e-4 else np.sin(0.5 * angle) / angle
+    return k * t0, k * t1, k * t2, np.cos(0.5 * angle)
+
+
+@njit
+def _product(p, q):
+    """Hamilton product p ⊗ q of scalar-last 4-tuples (:func:`startrack.rotation_jit.quat_multiply`; no
+    allocation)."""
+    return (p[3] * q[0] + p[0] * q[3] + p[1] * q[2] - p[2] * q[1],
+            p[3] * q[1] - p[0] * q[2] + p[1] * q[3] + p[2] * q[0],
+            p[3] * q[2] + p[0] * q[1] - p[1] * q[0] + p[2] * q[3],
+            p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2])
+
+
+@njit
+def _unit(q):
+    """The 4-tuple q divided by its norm."""
+    norm = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
+
+
+@njit
+def _rotated(q, a0, a1, a2):
+    """R(q) a for the unit 4-tuple q = (u, w) and a by its components: a + w t + u × t, t = 2 u × a
+    (:func:`startrack.rotation.rotate`; no allocation)."""
+    t0, t1, t2 = _cross(q[0], q[1], q[2], 2.0 * a0, 2.0 * a1, 2.0 * a2)
+    s0, s1, s2 = _cross(q[0], q[1], q[2], t0, t1, t2)
+    return a0 + q[3] * t0 + s0, a1 + q[3] * t1 + s1, a2 + q[3] * t2 + s2
+
+
+@njit
+def _velocity_change(c, h, v0, v1, v2, u0, u1, u2, dt):
+    """(Δv_w (3), ζ (3)) over dt with the rates at the position of axis c = C_ew[2, :]
+    (:func:`navsim.earth.wander.axis_of`), h and v: Δv_w = Δv_sf^w + [g_w − (2ω_ie^w + ω_ew^w) × v] dt,
+    Δv_sf^w = u − ½ ζ × u (steps 3-4 for u = C_wb Δv_b), ζ = (ω_ie^w + ω_ew^w) dt, ω_ie^w = ω_ie c (eq. 1 of
+    :mod:`navsim.earth.wander`)."""
+    e0, e1, e2 = OMEGA_IE * c[0], OMEGA_IE * c[1], OMEGA_IE * c[2]
+    t0, t1 = transport_of_axis(c[0], c[1], c[2], h, v0, v1)
+    z0, z1, z2 = (e0 + t0) * dt, (e1 + t1) * dt, e2 * dt
     r0, r1, r2 = _cross(z0, z1, z2, u0, u1, u2)
-    c0, c1, c2 = _cross(2.0 * e[0] + t[0], 2.0 * e[1] + t[1], 2.0 * e[2] + t[2], v0, v1, v2)
-    g = normal_gravity_of_sine(-C[2, 2], h)
-    return (u0 - 0.5 * r0 - c0 * dt, u1 - 0.5 * r1 - c1 * dt, u2 - 0.5 * r2 + (g - c2) * dt), (z0, z1, z2)
+    k0, k1, k2 = _cross(2.0 * e0 + t0, 2.0 * e1 + t1, 2.0 * e2, v0, v1, v2)
+    g = normal_gravity_of_sine(-c[2], h)
+    return (u0 - 0.5 * r0 - k0 * dt, u1 - 0.5 * r1 - k1 * dt, u2 - 0.5 * r2 + (g - k2) * dt), (z0, z1, z2)
 
 
 @njit
 def _body_increment(dtheta, dv, dtheta_prev, dv_prev):
-    """(α, Δv_b): the coning-corrected rotation vector and the rotation/sculling-corrected velocity
+    """(α, Δv_b) (3-tuples): the coning-corrected rotation vector and the rotation/sculling-corrected velocity
     increment in the body frame at the start of the interval (steps 1-2)."""
     t0, t1, t2 = dtheta[0], dtheta[1], dtheta[2]
     v0, v1, v2 = dv[0], dv[1], dv[2]
     c0, c1, c2 = _cross(dtheta_prev[0], dtheta_prev[1], dtheta_prev[2], t0, t1, t2)
-    alpha = np.array([t0 + c0 / 12.0, t1 + c1 / 12.0, t2 + c2 / 12.0])
+    alpha = (t0 + c0 / 12.0, t1 + c1 / 12.0, t2 + c2 / 12.0)
     r0, r1, r2 = _cross(t0, t1, t2, v0, v1, v2)
     s0, s1, s2 = _cross(t0, t1, t2, r0, r1, r2)
     p0, p1, p2 = _cross(dtheta_prev[0], dtheta_prev[1], dtheta_prev[2], v0, v1, v2)
@@ -127,42 +163,36 @@ def _body_increment(dtheta, dv, dtheta_prev, dv_prev):
 
 
 @njit
-def _moved(q, C, h, v, span):
-    """(q_ew, C_ew) turned by the transport rate at (C, h, v) over ``span`` [s]: q ⊗ q(ω_ew^w span)."""
-    t = transport_rate_w(C, h, v)
-    p = quat_multiply(q, quat_from_rotation_vector(np.array([t[0] * span, t[1] * span, 0.0])))
-    p = p / np.sqrt(np.sum(p * p))
-    return p, quat_to_matrix(p)
+def _moved(q, c, h, v0, v1, span):
+    """q_ew (4-tuple) turned by the transport rate at (c, h, v) over ``span`` [s]: q ⊗ q(ω_ew^w span), normalised;
+    c the axis (:func:`navsim.earth.wander.axis_of`) where the rate is taken, (v0, v1) the horizontal velocity."""
+    r0, r1 = transport_of_axis(c[0], c[1], c[2], h, v0, v1)
+    return _unit(_product(q, _exp(r0 * span, r1 * span, 0.0)))
 
 
 @njit
 def step(nav, dtheta, dv, dt):
-    """Advance ``nav`` in place by one interval of increments Δθ, Δv (3,) and length dt [s]."""
-    q, h, v0, v1, v2 = nav[0:4], nav[4], nav[5], nav[6], nav[7]
-    C_ew = quat_to_matrix(q)
+    """Advance ``nav`` in place by one interval of increments Δθ, Δv (3,) and length dt [s] (no allocation)."""
+    q, h, v0, v1, v2 = (nav[0], nav[1], nav[2], nav[3]), nav[4], nav[5], nav[6], nav[7]
+    c = axis_of(q)
     alpha, dv_b = _body_increment(dtheta, dv, nav[12:15], nav[15:18])
-    C = quat_to_matrix(nav[8:12])
-    u0 = C[0, 0] * dv_b[0] + C[0, 1] * dv_b[1] + C[0, 2] * dv_b[2]
-    u1 = C[1, 0] * dv_b[0] + C[1, 1] * dv_b[1] + C[1, 2] * dv_b[2]
-    u2 = C[2, 0] * dv_b[0] + C[2, 1] * dv_b[1] + C[2, 2] * dv_b[2]
+    q_wb = (nav[8], nav[9], nav[10], nav[11])
+    u0, u1, u2 = _rotated(q_wb, dv_b[0], dv_b[1], dv_b[2])
     # predictor with the rates at the start, corrector with the rates at the midpoint
-    a, _ = _velocity_change(C_ew, h, v0, v1, v2, u0, u1, u2, dt)
-    m = np.array([v0 + 0.5 * a[0], v1 + 0.5 * a[1], v2 + 0.5 * a[2]])
-    h_mid = h - 0.5 * dt * m[2]
-    _, C_mid = _moved(q, C_ew, h_mid, m, 0.5 * dt)
-    a, zeta = _velocity_change(C_mid, h_mid, m[0], m[1], m[2], u0, u1, u2, dt)
+    a, _ = _velocity_change(c, h, v0, v1, v2, u0, u1, u2, dt)
+    m0, m1, m2 = v0 + 0.5 * a[0], v1 + 0.5 * a[1], v2 + 0.5 * a[2]
+    h_mid = h - 0.5 * dt * m2
+    c_mid = axis_of(_moved(q, c, h_mid, m0, m1, 0.5 * dt))
+    a, zeta = _velocity_change(c_mid, h_mid, m0, m1, m2, u0, u1, u2, dt)
     w0, w1, w2 = v0 + a[0], v1 + a[1], v2 + a[2]
     h_new = h - 0.5 * dt * (v2 + w2)
-    mean = np.array([0.5 * (v0 + w0), 0.5 * (v1 + w1), 0.5 * (v2 + w2)])
-    h_mean = 0.5 * (h + h_new)
-    _, C_half = _moved(q, C_ew, h_mean, mean, 0.5 * dt)
-    q_new, _ = _moved(q, C_half, h_mean, mean, dt)
-    minus_zeta = np.array([-zeta[0], -zeta[1], -zeta[2]])
-    p = quat_multiply(quat_from_rotation_vector(minus_zeta), quat_multiply(nav[8:12], quat_from_rotation_vector(alpha)))
-    norm = np.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3])
+    mean0, mean1, h_mean = 0.5 * (v0 + w0), 0.5 * (v1 + w1), 0.5 * (h + h_new)
+    c_half = axis_of(_moved(q, c, h_mean, mean0, mean1, 0.5 * dt))
+    q_new = _moved(q, c_half, h_mean, mean0, mean1, dt)
+    p = _unit(_product(_exp(-zeta[0], -zeta[1], -zeta[2]), _product(q_wb, _exp(alpha[0], alpha[1], alpha[2]))))
     for i in range(4):
         nav[i] = q_new[i]
-        nav[8 + i] = p[i] / norm
+        nav[8 + i] = p[i]
     nav[4], nav[5], nav[6], nav[7] = h_new, w0, w1, w2
     for i in range(3):
         nav[12 + i] = dtheta[i]

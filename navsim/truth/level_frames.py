@@ -20,8 +20,8 @@ from typing import NamedTuple
 import numpy as np
 
 from navsim.earth.frames import OMEGA_IE, earth_rate_n, transport_rate_n
-from navsim.earth.wander import geodetic, q_ew, radii_of_sine
-from navsim.earth.wgs84 import E2, radii
+from navsim.earth.wander import axis_of, geodetic, q_ew, transport_of_axis
+from navsim.earth.wgs84 import radii
 from startrack import units
 from startrack.jit import njit
 
@@ -124,21 +124,11 @@ class FreeAzimuth:
 
 
 @njit
-def _axis(x, y, z, w):
-    """The third row (C20, C21, C22) of C_ef of q_ef = (x, y, z, w): the Earth's axis in f, cos L times the north in
-    f's horizontal components and −sin L down (ω_ie^f = ω_ie times it)."""
-    return 2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)
-
-
-@njit
 def _transport(x, y, z, w, h, v0, v1):
     """ω_ef^f (x, y; z = 0) [rad/s] at q_ef = (x, y, z, w), h [m], horizontal velocity (v0, v1) [m/s]
-    (:mod:`navsim.earth.wander` eq. 2)."""
-    c0, c1, c2 = _axis(x, y, z, w)
-    r_m, r_n, _, _ = radii_of_sine(-c2)
-    k = r_n * E2 / ((1.0 - E2 * c2 * c2) * (r_m + h) * (r_n + h))
-    projection = k * (c0 * v0 + c1 * v1)
-    return v1 / (r_n + h) + projection * c1, -(v0 / (r_n + h) + projection * c0)
+    (:func:`navsim.earth.wander.transport_of_axis`)."""
+    c0, c1, c2 = axis_of((x, y, z, w))
+    return transport_of_axis(c0, c1, c2, h, v0, v1)
 
 
 @njit
@@ -212,7 +202,7 @@ def _node_rates(q, rate, h_nodes, v_nodes, dt):
     for j in range(m):
         k, i = j // 4, j % 4
         x, y, z, w = _at_node(q[k], rate[k], q[k + 1], rate[k + 1], i, dt)
-        c0, c1, c2 = _axis(x, y, z, w)
+        c0, c1, c2 = axis_of((x, y, z, w))
         w_ie[j, 0], w_ie[j, 1], w_ie[j, 2] = OMEGA_IE * c0, OMEGA_IE * c1, OMEGA_IE * c2
         w_ef[j, 0], w_ef[j, 1] = _transport(x, y, z, w, h_nodes[j], v_nodes[j, 0], v_nodes[j, 1])
         sine[j] = -c2
