@@ -1,4 +1,4 @@
-"""Read and write star-sensor frames: PNG/TIFF/JPEG (pillow) and NumPy .npy.
+"""Read and write star-sensor frames: PNG/TIFF/JPEG (pillow), FITS (:mod:`startrack.fits_io`) and NumPy .npy.
 
 Frames are 2-D arrays [DN].  Integer greyscale images come back as uint16 (8-bit files are widened),
 floating ones as float64.  Colour images (RGB, RGBA, palette, CMYK, YCbCr: colour JPEGs from ordinary
@@ -10,7 +10,8 @@ array.
 files (colour included); for 16-bit files the smallest of 2^8, 2^10, 2^12, 2^14, 2^16 above the
 largest value, less the step of the data -- 12-bit data scaled by 16 (every value but a clipped
 65535 a multiple of 16) saturates at 65520, not at each of its values; none for floating data.
-A pixel at or above the full scale is saturated (:func:`startrack.detection.detect`).
+A pixel at or above the full scale is saturated (:func:`startrack.detection.detect`).  A FITS frame may
+also bring a mask of pixels without data and the epoch of its observation.
 """
 
 from dataclasses import dataclass
@@ -20,8 +21,9 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from startrack.errors import InputError
+from startrack.fits_io import FITS_SUFFIXES
 
-IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy")
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy") + FITS_SUFFIXES
 #: Greyscale pillow modes read as they are.
 _GREY_MODES = ("L", "I;16", "I;16B", "I;16L", "I", "F", "1")
 #: ITU-R BT.601 luma weights of R, G, B.
@@ -30,19 +32,25 @@ LUMA_WEIGHTS = np.array([0.299, 0.587, 0.114])
 
 @dataclass(frozen=True)
 class Frame:
-    """A frame read from a file: ``image`` (H, W) [DN] and its ``full_scale`` [DN] (None: unknown)."""
+    """A frame read from a file: ``image`` (H, W) [DN] and its ``full_scale`` [DN] (None: unknown); ``mask``
+    (H, W) True where the file has no data (None: none), ``epoch`` of the observation [Julian year] or None,
+    ``hdu`` the index of a FITS file's HDU read (None: not FITS)."""
 
     image: np.ndarray
     full_scale: float | None
+    mask: np.ndarray | None = None
+    epoch: float | None = None
+    hdu: int | None = None
 
 
 def read_image(path):
-    """2-D frame from a PNG, TIFF, JPEG or .npy file (uint16 for integer data, float64 otherwise)."""
+    """2-D frame from a PNG, TIFF, JPEG, FITS or .npy file (uint16 for integer data, float64 otherwise)."""
     return read_frame(path).image
 
 
-def read_frame(path) -> Frame:
-    """The :class:`Frame` of a PNG, TIFF, JPEG or .npy file (module text)."""
+def read_frame(path, hdu=None) -> Frame:
+    """The :class:`Frame` of a PNG, TIFF, JPEG, FITS (its first image HDU, or ``hdu``) or .npy file (module
+    text)."""
     path = Path(path)
     if path.is_dir():
         raise InputError(f"image file {path} is a directory")
@@ -51,6 +59,14 @@ def read_frame(path) -> Frame:
     suffix = path.suffix.lower()
     if suffix not in IMAGE_SUFFIXES:
         raise InputError(f"image file {path} has suffix {path.suffix!r}; expected one of {', '.join(IMAGE_SUFFIXES)}")
+    if hdu is not None and suffix not in FITS_SUFFIXES:
+        raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is not one")
+    if suffix in FITS_SUFFIXES:
+        from startrack.fits_io import read_fits
+
+        array, mask, saturate, epoch, index = read_fits(path, hdu)
+        image = _checked(path, array)
+        return Frame(image, saturate if saturate is not None else full_scale(image), mask, epoch, index)
     if suffix == ".npy":
         try:
             array = np.load(path, allow_pickle=False)
@@ -113,7 +129,8 @@ def full_scale(image):
 
 
 def write_image(path, image):
-    """Write a frame: 16-bit greyscale PNG (.png, values rounded and clipped to 0..65535) or .npy (as is)."""
+    """Write a frame: 16-bit greyscale PNG (.png, values rounded and clipped to 0..65535), FITS or .npy (as
+    is)."""
     path = Path(path)
     array = np.asarray(image)
     if array.ndim != 2 or array.size == 0:
@@ -121,11 +138,17 @@ def write_image(path, image):
     suffix = path.suffix.lower()
     if suffix == ".npy":
         np.save(path, array, allow_pickle=False)
+    elif suffix in FITS_SUFFIXES:
+        from astropy.io import fits
+
+        from startrack.fits_io import write_hdus
+
+        write_hdus(path, fits.HDUList([fits.PrimaryHDU(array)]), "image file")
     elif suffix == ".png":
         if not np.all(np.isfinite(array)):
             raise InputError(f"cannot write {path}: the frame contains NaN or infinite values")
         data = np.clip(np.rint(array), 0, 65535).astype(np.uint16)
         Image.fromarray(data).save(path)
     else:
-        raise InputError(f"output file {path} must end in .png (16-bit) or .npy")
+        raise InputError(f"output file {path} must end in .png (16-bit), {', '.join(FITS_SUFFIXES)} or .npy")
     return path

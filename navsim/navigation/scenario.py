@@ -244,7 +244,7 @@ def validate(data, source):
         raise InputError(f"{source}: {error}") from None
     imu_hz = checked["imu"]["rate_hz"]
     if checked["duration_s"] is None:
-        checked["duration_s"] = flown
+        checked["duration_s"] = route.flight_time(checked["trajectory"])
     if checked["duration_s"] > flown + 1e-9:
         raise InputError(f"{source}: duration_s: {checked['duration_s']:g} s is longer than the trajectory "
                          f"({flown:g} s)")

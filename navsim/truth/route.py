@@ -190,6 +190,14 @@ def profile_of(table, where="trajectory"):
     return _profile(json.dumps(table, sort_keys=True), where)
 
 
+def flight_time(table, where="trajectory"):
+    """The default run length [s] of a checked ``[trajectory]`` table: a profile's sum of segments, a route's
+    flown time to the millisecond below (1 ns above one counts as it) -- its Newton solve's last digits are
+    the machine's and the code's, and a campaign's scenario must compare equal when it resumes."""
+    flown = profile_of(table, where).duration
+    return math.floor(flown * 1000.0 + 1e-6) / 1000.0 if "route" in table else flown
+
+
 @functools.lru_cache(maxsize=16)
 def _profile(text, where):
     table = json.loads(text)

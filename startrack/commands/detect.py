@@ -15,6 +15,8 @@ pixels (outlier, edge, saturated, failed) or another detection's light reaches i
 import json
 import time
 
+import numpy as np
+
 from startrack.errors import InputError, check_range
 
 #: Largest grey level accepted on the command line [DN] (a 32-bit float frame's useful range).
@@ -56,12 +58,23 @@ def detection_options(args) -> dict:
 
 def detect_frame(frame, options):
     """:func:`startrack.detection.detect` of a :class:`startrack.image_io.Frame` with ``options``
-    (:func:`detection_options`; saturation at the frame's full scale unless given)."""
+    (:func:`detection_options`; saturation at the frame's full scale unless given); a frame's pixels
+    without data (its mask) take no star within :data:`startrack.fits_io.MASK_MARGIN_PX` of them."""
     from startrack.detection import detect
 
     if options["saturation_dn"] is None:
         options = {**options, "saturation_dn": frame.full_scale}
-    return detect(frame.image, **options)
+    found = detect(frame.image, **options)
+    if frame.mask is None or not len(found):
+        return found
+    from scipy.ndimage import binary_dilation
+
+    from startrack.fits_io import MASK_MARGIN_PX
+
+    near = binary_dilation(frame.mask, iterations=MASK_MARGIN_PX)
+    rows = np.clip(np.rint(found.v).astype(int), 0, near.shape[0] - 1)
+    cols = np.clip(np.rint(found.u).astype(int), 0, near.shape[1] - 1)
+    return found.select(~near[rows, cols])
 
 
 def add_fit_options(parser):
@@ -127,7 +140,8 @@ def register(subparsers):
         help="detect stars in an image and print their centroids",
         description="Detect and centroid star images (threshold, connected components, centre of gravity).",
     )
-    parser.add_argument("image", help="frame: .png, .tif/.tiff, .jpg/.jpeg or .npy")
+    parser.add_argument("image", help="frame: .png, .tif/.tiff, .jpg/.jpeg, .fits/.fit/.fts or .npy")
+    parser.add_argument("--hdu", type=int, default=None, help="the HDU of a FITS image (the first image HDU)")
     add_detection_options(parser)
     add_fit_options(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -138,7 +152,7 @@ def run(args):
     from startrack.image_io import read_frame
 
     options, fitting = detection_options(args), fit_options(args)
-    frame = read_frame(args.image)
+    frame = read_frame(args.image, args.hdu)
     image = frame.image
     start = time.perf_counter()
     found = detect_frame(frame, options)

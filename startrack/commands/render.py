@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from startrack.errors import InputError, check_range
+from startrack.fits_io import FITS_SUFFIXES
 from startrack.paths import check_file
 from startrack.units import DEG
 
@@ -45,7 +46,7 @@ def register(subparsers):
     parser.add_argument("--epoch", type=float, default=2000.0, help="epoch of the star positions [Julian year]")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the noise (0)")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
-    parser.add_argument("-o", "--output", required=True, help="output file: .png (16-bit) or .npy")
+    parser.add_argument("-o", "--output", required=True, help="output file: .png (16-bit), .fits or .npy")
     parser.set_defaults(func=run)
 
 
@@ -66,7 +67,7 @@ def run(args):
     for option, value in (("--width", args.width), ("--height", args.height)):
         if not 8 <= value <= 16384:
             raise InputError(f"option {option} = {value} is not an image size in [8, 16384] px")
-    check_file(args.output, "-o", (".png", ".npy"))
+    check_file(args.output, "-o", (".png", ".npy") + FITS_SUFFIXES)
     omega = _rate(args.rate_deg_s)
 
     camera = Camera.from_fov(args.fov_deg * DEG, args.width, args.height)

@@ -1,6 +1,7 @@
 """``startrack solve``: identify the stars of frames and print their attitude (docs/design.md contract).
 
-INPUT is one or more images (.png/.tif/.tiff/.jpg/.jpeg/.npy: detected first, size from the file) or
+INPUT is one or more images (.png/.tif/.tiff/.jpg/.jpeg/.fits/.fit/.fts/.npy: detected first, size from the
+file; a FITS image's first image HDU or ``--hdu N``, its DATE-OBS the epoch unless ``--epoch``) or
 centroid CSV files (``u,v[,flux]`` per line [px], header optional; ``--width``/``--height`` give the
 image size); ``--batch PATH`` takes a JSON Lines file (``{"id": ..., "centroids": [[u, v, flux], ...]}``
 per line), a folder of images or a list of image paths (:mod:`startrack.commands.solve_input`).  One
@@ -27,7 +28,9 @@ frame (+z through the principal point), ``ra_deg``, ``dec_deg``, ``roll_deg`` of
 ``center`` (the pointing of the image centre, as plate solvers report it), ``camera`` (the camera the
 attitude refers to: ``source`` given, fitted or refined, and for a fitted or refined camera its sigma),
 ``matches`` [[centroid index, hip], ...], residuals, ``false_match_probability``, ``method``,
-``solve_ms`` and, for images, ``detection``.  Exit status: 0 when every frame is identified, 1 when some
+``solve_ms``, ``epoch`` (of the star positions) and, for images, ``detection``.  ``--wcs``, ``--new-fits``
+and ``--corr`` write each identified frame's FITS WCS, image with it, and matched stars
+(:mod:`startrack.commands.solve_outputs`).  Exit status: 0 when every frame is identified, 1 when some
 is not, 2 for bad options or an unreadable INPUT.
 """
 
@@ -42,6 +45,7 @@ import numpy as np
 from startrack.commands.detect import add_detection_options, detection_options
 from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame
 from startrack.commands.solve_modes import FrameSolver, centroid_sigma, parse_refit
+from startrack.commands.solve_outputs import add_output_options, check_output_options, write_outputs
 from startrack.errors import InputError, check_range
 from startrack.units import DEG
 
@@ -54,7 +58,8 @@ def register(subparsers):
                     "--fov-deg for an ideal pinhole) as a star tracker, or from an unknown camera, whose focal "
                     "length, principal point and distortion are then fitted.",
     )
-    parser.add_argument("input", nargs="*", help="images (.png/.tif/.tiff/.jpg/.jpeg/.npy) or centroid CSV files")
+    parser.add_argument("input", nargs="*",
+                        help="images (.png/.tif/.tiff/.jpg/.jpeg/.fits/.fit/.fts/.npy) or centroid CSV files")
     parser.add_argument("--batch", metavar="PATH", help="frames: a .jsonl file, a folder of images or a list of images")
     parser.add_argument("--camera", metavar="FILE",
                         help="the calibrated camera (a camera file, e.g. from --write-camera): identify with it")
@@ -78,7 +83,9 @@ def register(subparsers):
     parser.add_argument("--mag", type=float, default=None,
                         help="faintest catalog star [V mag]: of a given camera's catalog (default from the field's "
                              "size: V 6 at 16 deg) or of the plate solver's verification (8)")
-    parser.add_argument("--epoch", type=float, default=2000.0, help="epoch of the star positions [Julian year] (2000)")
+    parser.add_argument("--epoch", type=float, default=None,
+                        help="epoch of the star positions [Julian year] (a FITS image's observation, else 2000)")
+    parser.add_argument("--hdu", type=int, default=None, help="the HDU of FITS images to solve (the first image HDU)")
     parser.add_argument("--centroid-sigma-px", type=float, default=None,
                         help="centroid sigma [px] of centroid lists and of a given camera's gates (the camera "
                              "file's fit RMS, else 0.3; images weight stars by their detections')")
@@ -86,6 +93,7 @@ def register(subparsers):
     parser.add_argument("--max-false-match", type=float, default=1e-6,
                         help="largest accepted false-match probability (1e-6)")
     add_detection_options(parser)
+    add_output_options(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per frame (JSON Lines)")
     parser.set_defaults(func=run)
 
@@ -148,7 +156,10 @@ def _frame_solver(args):
     fov_range = _fov_range(args)
     if args.centroid_sigma_px is not None:
         check_range("--centroid-sigma-px", args.centroid_sigma_px, 1e-3, 100.0)
-    check_range("--epoch", args.epoch, 1000.0, 3000.0)
+    if args.epoch is not None:
+        check_range("--epoch", args.epoch, 1000.0, 3000.0)
+    if args.hdu is not None:
+        check_range("--hdu", args.hdu, 0, 10_000)
     check_range("--time-budget-s", args.time_budget_s, 1e-3, 3600.0)
     check_range("--boresight-error-deg", args.boresight_error_deg, 0.0, 180.0)
     check_range("--max-false-match", args.max_false_match, 1e-300, 1.0)
@@ -159,7 +170,7 @@ def _frame_solver(args):
     if camera_file is not None or args.fov_deg is not None:  # a refit or a diagnosis searches near the given field
         given = camera_file.camera.angular_width if camera_file is not None else args.fov_deg * DEG
         fov_range = (max(0.5 * DEG, given / GIVEN_FOV_SPREAD), min(90.0 * DEG, given * GIVEN_FOV_SPREAD))
-    plate = {"fov_range": fov_range, "epoch": args.epoch, "threshold": args.max_false_match,
+    plate = {"fov_range": fov_range, "threshold": args.max_false_match,
              "time_budget_s": args.time_budget_s, "mag_limit": args.mag, "progress": True}
     return FrameSolver(camera_file, None if args.fov_deg is None else args.fov_deg * DEG, refit,
                        centroid_sigma(args.centroid_sigma_px, camera_file), plate,
@@ -181,12 +192,12 @@ def _frames(args, options, camera_file):
     if camera_file is not None and width is None and height is None:
         width, height = camera_file.camera.width, camera_file.camera.height
     if args.batch is not None:
-        yield from batch_frames(args.batch, options, width, height)
+        yield from batch_frames(args.batch, options, width, height, args.hdu)
         return
     single = len(args.input) == 1
     for path in args.input:
         try:
-            yield input_frame(path, options, width, height)
+            yield input_frame(path, options, width, height, args.hdu)
         except InputError as error:
             if single:
                 raise
@@ -241,6 +252,7 @@ def run(args):
 
     options = detection_options(args)
     solver = _frame_solver(args)
+    check_output_options(args, None if args.batch is not None else len(args.input))
     boresight = None if args.boresight_deg is None else _parse_boresight(args.boresight_deg, args.boresight_error_deg)
     frames = _frames(args, options, solver.camera_file)
     first = next(frames, None)  # a single INPUT's read error surfaces before the catalogs are loaded
@@ -251,6 +263,9 @@ def run(args):
         if result.calibration is not None and (best is None or len(result.matches) > len(best[1].matches)):
             best = (frame.frame_id, result)
         record = result.to_dict(frame.frame_id)
+        if frame.reason is None:
+            record["epoch"] = solver.epoch_of(frame)
+            write_outputs(args, frame, result, record["epoch"])
         if frame.detection is not None:
             record["detection"] = frame.detection
         print(json.dumps(record) if args.json else _line(frame.frame_id, result), flush=True)

@@ -4,8 +4,9 @@ Every source yields :class:`SolveFrame` records; a frame that cannot be read in 
 with a reason (its status is "error"), so the other frames are still solved.  A single INPUT that
 cannot be read is bad input (one line, exit 2).
 
-* image (.png/.tif/.tiff/.jpg/.jpeg/.npy): detected and centroided (:mod:`startrack.commands.detect`);
-  its size is the file's;
+* image (.png/.tif/.tiff/.jpg/.jpeg/.fits/.fit/.fts/.npy): detected and centroided
+  (:mod:`startrack.commands.detect`); its size is the file's; a FITS image's first image HDU (or ``--hdu``),
+  with its observation's epoch;
 * centroid CSV: ``u,v[,flux]`` per line [px], header line optional; ``--width``/``--height`` give
   the image size;
 * JSON Lines (``--batch FILE.jsonl``): ``{"id": ..., "centroids": [[u, v, flux], ...]}`` per line;
@@ -29,7 +30,8 @@ from startrack.image_io import IMAGE_SUFFIXES
 class SolveFrame:
     """One frame to solve: ``uv`` (n, 2) [px], ``flux`` (n,) or None, ``sigma`` (n,) centroid sigma [px]
     or None, image ``width`` x ``height`` [px]; ``reason`` when it could not be read; ``detection`` a
-    summary of the detection (images)."""
+    summary of the detection (images); an image's ``image`` (H, W) [DN], ``epoch`` of its observation
+    [Julian year] or None, and ``hdu``, the HDU read of a FITS file."""
 
     frame_id: object
     uv: np.ndarray | None = None
@@ -39,6 +41,9 @@ class SolveFrame:
     height: int | None = None
     reason: str | None = None
     detection: dict | None = None
+    image: np.ndarray | None = None
+    epoch: float | None = None
+    hdu: int | None = None
 
 
 def read_centroid_csv(path):
@@ -116,12 +121,13 @@ def batch_jsonl(path, width, height):
         raise InputError(f"batch file {path} holds no frame (every line is empty).")
 
 
-def image_frame(path, options, width=None, height=None):
-    """The SolveFrame of an image file: read, size checked against the given one, detected."""
+def image_frame(path, options, width=None, height=None, hdu=None):
+    """The SolveFrame of an image file (a FITS file's HDU ``hdu``): read, size checked against the given one,
+    detected."""
     from startrack.commands.detect import detect_frame
     from startrack.image_io import read_frame
 
-    frame = read_frame(path)
+    frame = read_frame(path, hdu)
     rows, cols = frame.image.shape
     if (width is not None and width != cols) or (height is not None and height != rows):
         wanted = f"{cols if width is None else width} x {rows if height is None else height}"
@@ -131,7 +137,8 @@ def image_frame(path, options, width=None, height=None):
                "threshold_dn": found.threshold, "full_scale_dn": frame.full_scale}
     sigma = np.hypot(found.sigma_u, found.sigma_v) / np.sqrt(2.0)
     sigma = np.where(found.saturated, 3.0 * sigma, sigma)  # a clipped peak biases the centroid
-    return SolveFrame(str(path), found.uv, found.flux, sigma, cols, rows, detection=summary)
+    return SolveFrame(str(path), found.uv, found.flux, sigma, cols, rows, detection=summary, image=frame.image,
+                      epoch=frame.epoch, hdu=frame.hdu)
 
 
 def _listed_images(path):
@@ -148,22 +155,24 @@ def _listed_images(path):
     return [path.parent / line.strip() for line in lines if line.strip() and not line.lstrip().startswith("#")]
 
 
-def batch_frames(path, options, width, height):
+def batch_frames(path, options, width, height, hdu=None):
     """SolveFrame records of ``--batch PATH``: JSON Lines, a folder of images or a list of images."""
     path = Path(path)
     if not path.exists():
         raise InputError(f"batch input {path} does not exist.")
     if path.is_file() and path.suffix.lower() == ".jsonl":
+        if hdu is not None:
+            raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is a JSON Lines batch of centroids.")
         yield from batch_jsonl(path, width, height)
         return
     for image in _listed_images(path):
         try:
-            yield image_frame(image, options)
+            yield image_frame(image, options, hdu=hdu)
         except InputError as error:
             yield SolveFrame(str(image), reason=str(error))
 
 
-def input_frame(path, options, width, height):
+def input_frame(path, options, width, height, hdu=None):
     """The SolveFrame of one INPUT: an image or a centroid CSV."""
     path = Path(path)
     if path.is_dir():
@@ -171,6 +180,8 @@ def input_frame(path, options, width, height):
     if not path.is_file():
         raise InputError(f"input file {path} does not exist.")
     if path.suffix.lower() in IMAGE_SUFFIXES:
-        return image_frame(path, options, width, height)
+        return image_frame(path, options, width, height, hdu)
+    if hdu is not None:
+        raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is a centroid list.")
     uv, flux = read_centroid_csv(path)
     return SolveFrame(str(path), uv, flux, None, width, height)

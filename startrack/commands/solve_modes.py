@@ -26,6 +26,9 @@ from startrack.errors import InputError
 #: Centroid sigma [px] of centroid lists and of a given camera's gates when neither the option nor the
 #: camera file's fit gives one.
 DEFAULT_CENTROID_SIGMA_PX = 0.3
+#: A frame's own epoch is rounded to this step [Julian years] (8.8 h: 0.005" of the fastest proper motion,
+#: 10"/yr), so that the frames of a night share one solver.
+EPOCH_STEP_YEARS = 0.001
 
 
 def parse_refit(text):
@@ -55,48 +58,59 @@ class FrameSolver:
     camera_file: a :class:`startrack.camera_file.CameraFile` or None; fov: the field of view [rad] of an
     ideal pinhole of the frame's size, or None; refit: intrinsics refitted (None: the camera is used as
     given); sigma_px: centroid sigma of centroid lists and of the given camera's gates [px]; plate:
-    keyword arguments of the plate solver; fov_hint [rad] or None; mag_limit, epoch, threshold as the
-    solvers take them.
+    keyword arguments of the plate solver (but the epoch); fov_hint [rad] or None; mag_limit, threshold as
+    the solvers take them; epoch [Julian year] of the star positions, or None: each frame's own
+    (:meth:`epoch_of`).
     """
 
     def __init__(self, camera_file, fov, refit, sigma_px, plate, fov_hint, mag_limit, epoch, threshold):
         self.camera_file, self.fov, self.refit, self.sigma_px = camera_file, fov, refit, sigma_px
         self.plate_options, self.fov_hint = plate, fov_hint
         self.mag_limit, self.epoch, self.threshold = mag_limit, epoch, threshold
-        self._plate, self._calibrated = None, {}
+        self._plates, self._calibrated = {}, {}
 
     @property
     def given(self):
         """True when the frames come with their camera."""
         return self.camera_file is not None or self.fov is not None
 
+    def epoch_of(self, frame):
+        """The epoch of a frame's star positions [Julian year]: the given one, else the frame's observation's
+        to :data:`EPOCH_STEP_YEARS` (one solver per step), else J2000."""
+        if self.epoch is not None:
+            return self.epoch
+        if frame.epoch is None:
+            return 2000.0
+        return round(frame.epoch / EPOCH_STEP_YEARS) * EPOCH_STEP_YEARS
+
     def solve(self, frame, boresight):
         """The :class:`startrack.identify.result.IdentificationResult` of a readable ``SolveFrame``."""
         sigma = frame.sigma if frame.sigma is not None else np.full(len(frame.uv), self.sigma_px)
+        epoch = self.epoch_of(frame)
         if not self.given:
-            return self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma, fov_hint=self.fov_hint,
+            return self.plate(epoch).solve(frame.uv, frame.width, frame.height, frame.flux, sigma, fov_hint=self.fov_hint,
                                     boresight=boresight)
         known = self._camera_file(frame.width, frame.height)
         if self.refit is not None:
-            return self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma, camera=known,
+            return self.plate(epoch).solve(frame.uv, frame.width, frame.height, frame.flux, sigma, camera=known,
                                     refit=self.refit, boresight=boresight)
         weights = None  # centroid lists: the stated sigma of the identifier's gates
         if frame.sigma is not None:  # a detection's sigma leaves out the PSF's and pixels' own errors
             from startrack.identify.plate_solver import SIGMA_FLOOR_PX
 
             weights = np.hypot(frame.sigma, SIGMA_FLOOR_PX)
-        result = self._calibrated_solver(known.camera).solve(frame.uv, frame.width, frame.height, frame.flux, weights,
+        result = self._calibrated_solver(known.camera, epoch).solve(frame.uv, frame.width, frame.height, frame.flux, weights,
                                                               boresight=boresight)
-        return self._diagnosed(result, frame, known, sigma, boresight) if result.status == "no_match" else result
+        return self._diagnosed(result, frame, known, sigma, boresight, epoch) if result.status == "no_match" else result
 
     # ------------------------------------------------------------------ internals
-    @property
-    def plate(self):
-        if self._plate is None:
+    def plate(self, epoch):
+        """The plate solver of the star positions at ``epoch``."""
+        if epoch not in self._plates:
             from startrack.identify.plate_solver import PlateSolver
 
-            self._plate = PlateSolver(**self.plate_options)
-        return self._plate
+            self._plates[epoch] = PlateSolver(**self.plate_options, epoch=epoch)
+        return self._plates[epoch]
 
     def _camera_file(self, width, height):
         if self.camera_file is not None:
@@ -106,18 +120,18 @@ class FrameSolver:
 
         return CameraFile(Camera.from_fov(self.fov, width, height))
 
-    def _calibrated_solver(self, camera):
-        key = (camera.width, camera.height)
+    def _calibrated_solver(self, camera, epoch):
+        key = (camera.width, camera.height, epoch)
         if key not in self._calibrated:
             from startrack.identify.calibrated import CalibratedSolver
 
-            self._calibrated[key] = CalibratedSolver(camera, self.mag_limit, self.epoch, self.sigma_px, self.threshold,
+            self._calibrated[key] = CalibratedSolver(camera, self.mag_limit, epoch, self.sigma_px, self.threshold,
                                                      progress=True)
         return self._calibrated[key]
 
-    def _diagnosed(self, result, frame, known, sigma, boresight):
+    def _diagnosed(self, result, frame, known, sigma, boresight, epoch):
         """``result`` (no_match with the given camera) with what a solve as an unknown camera finds."""
-        unknown = self.plate.solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
+        unknown = self.plate(epoch).solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
                                    fov_hint=known.camera.angular_width, boresight=boresight)
         if not unknown.ok:
             return result

@@ -11,6 +11,7 @@ from geographiclib.geodesic import Geodesic
 from navsim import cli
 from navsim.earth.wander import ned_offset
 from navsim.ins import strapdown
+from navsim.truth import route as route_module
 from navsim.truth import trajectory
 from navsim.truth.route import MISS, Route, Waypoint
 from startrack import units
@@ -70,6 +71,19 @@ def test_perfect_sensors_over_the_pole_exactly():
     k = np.arange(0, truth.t.size, 500)
     error = ned_offset(log.lat, log.lon, log.h, truth.lat[k], truth.lon[k], truth.h[k])
     assert np.abs(error[:, :2]).max() < 1e-3
+
+
+def test_a_routes_default_duration_is_whole_milliseconds():
+    """A route's run length defaults to its flown time to the millisecond below, so a campaign written by one
+    build of the Newton solve resumes under another; a profile of segments keeps its exact sum."""
+    waypoints = [{"lat_deg": p.lat_deg, "lon_deg": p.lon_deg, "height_m": p.height_m, "speed_m_per_s": p.speed_m_per_s}
+                 for p in _polar_route().waypoints]
+    table = {"route": {"bank_deg": 25.0, "waypoints": waypoints}}
+    flown = route_module.profile_of(table).duration
+    assert route_module.flight_time(table) * 1000.0 == math.floor(flown * 1000.0)
+    segments = {"start": {"lat_deg": 45.0, "lon_deg": 7.0, "height_m": 0.0, "speed_m_per_s": 100.0, "heading_deg": 0.0},
+                "segments": [{"kind": "straight", "duration_s": 12.3456789}]}
+    assert route_module.flight_time(segments) == route_module.profile_of(segments).duration
 
 
 BAD_ROUTES = {

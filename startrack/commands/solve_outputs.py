@@ -1,0 +1,116 @@
+"""The files ``startrack solve`` writes per solved frame for the astronomers' tools (FITS, astropy.io.fits).
+
+* ``--wcs FILE``: the solution's WCS (:func:`startrack.wcs.tan_sip`: TAN with SIP of the order the camera
+  model needs) as the header of a FITS file without data, as astrometry.net's ``.wcs`` files;
+* ``--new-fits FILE``: the input image with that header -- a FITS input keeps its HDUs and header, its
+  earlier celestial WCS replaced; another image is written as the frame read (grey levels);
+* ``--corr FILE``: the matched stars as a FITS table: ``field_x``, ``field_y`` (FITS pixels, 1-based),
+  ``field_ra``, ``field_dec`` (the WCS's direction of the star's centroid), ``index_ra``, ``index_dec``
+  (the catalog's, at the epoch) [deg], ``index_id`` (HIP), ``field_id`` (the centroid's index), ``mag``
+  (Hipparcos V).
+
+With several frames (INPUTs or ``--batch``) a FILE must hold ``{stem}``, replaced by each image's file name
+without its suffix (a JSON Lines frame's id).  Every file is written whole or not at all
+(:func:`startrack.fits_io.write_hdus`); a frame not identified writes none.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from startrack.errors import InputError
+from startrack.fits_io import FITS_SUFFIXES, WCS_KEYWORDS, write_hdus
+from startrack.paths import check_file
+
+#: The options, and the file suffixes each takes (astrometry.net's .wcs, .new and .corr are FITS files too).
+OUTPUTS = {"wcs": ("--wcs", FITS_SUFFIXES + (".wcs",)), "new_fits": ("--new-fits", FITS_SUFFIXES + (".new",)),
+           "corr": ("--corr", FITS_SUFFIXES + (".corr",))}
+
+
+def add_output_options(parser):
+    """``--wcs``, ``--new-fits``, ``--corr`` (module text)."""
+    group = parser.add_argument_group("FITS outputs (per identified frame; {stem} names each of several frames)")
+    group.add_argument("--wcs", metavar="FILE", help="write the solution's FITS WCS header (TAN-SIP) to FILE")
+    group.add_argument("--new-fits", metavar="FILE", help="write the image with the solution's WCS header to FILE")
+    group.add_argument("--corr", metavar="FILE", help="write the matched stars (pixel, catalog RA/Dec, HIP, V) to FILE")
+
+
+def check_output_options(args, frames):
+    """Refuse, before any work, a FILE without ``{stem}`` for several frames (``frames``: the number of
+    INPUTs, or None for a batch), with another suffix, or where it cannot be written
+    (:func:`startrack.paths.check_file`)."""
+    for name, (option, suffixes) in OUTPUTS.items():
+        template = getattr(args, name)
+        if template is None:
+            continue
+        if (frames is None or frames > 1) and "{stem}" not in template:
+            raise InputError(f"{option} {template}: several frames need {{stem}} in the file name (e.g. out/{{stem}}.fits)")
+        check_file(template, option, suffixes)
+
+
+def write_outputs(args, frame, result, epoch):
+    """Write the files of the options for the identified ``frame`` (a SolveFrame) and its ``result``."""
+    if not result.ok or not any(getattr(args, name) for name in OUTPUTS):
+        return
+    from astropy.io import fits
+
+    from startrack.wcs import tan_sip
+
+    solution = tan_sip(result.camera, result.q_IS)
+    stem = _stem(frame.frame_id)
+    header = fits.Header(solution.cards())
+    header.add_comment(f"startrack solve: {len(result.matches)} Hipparcos-2 stars at epoch J{epoch:.3f}, "
+                       f"SIP order {solution.order} within {solution.max_error_px:.1e} px of the camera model")
+    if args.wcs:
+        write_hdus(args.wcs.replace("{stem}", stem), fits.HDUList([fits.PrimaryHDU(header=header)]), "--wcs")
+    if args.new_fits:
+        write_hdus(args.new_fits.replace("{stem}", stem), _new_fits(frame, header), "--new-fits")
+    if args.corr:
+        write_hdus(args.corr.replace("{stem}", stem), _corr(frame, result, solution, epoch), "--corr")
+
+
+def _stem(frame_id):
+    text = str(frame_id)
+    return Path(text).stem if Path(text).suffix else text
+
+
+def _new_fits(frame, header):
+    """The HDUList of the input with the WCS: a FITS input's own HDUs (the image HDU's old WCS removed),
+    else the frame read."""
+    from astropy.io import fits
+
+    path = Path(str(frame.frame_id))
+    if path.suffix.lower() in FITS_SUFFIXES:
+        hdus = fits.open(path, memmap=False)
+        image = hdus[frame.hdu]
+        for keyword in [k for k in image.header if WCS_KEYWORDS.match(k)]:
+            del image.header[keyword]
+        image.header.extend(header, unique=True)
+        return hdus
+    if frame.image is None:
+        raise InputError(f"--new-fits needs an image; {frame.frame_id} is a list of centroids")
+    return fits.HDUList([fits.PrimaryHDU(frame.image, header=header)])
+
+
+def _corr(frame, result, solution, epoch):
+    """The BINTABLE of the matched stars (module text)."""
+    from astropy.io import fits
+    from astropy.wcs import WCS
+
+    from startrack.sphere import vector_to_radec
+    from startrack.star_catalog import load_star_catalog
+
+    index = result.matches[:, 0]
+    pixels = frame.uv[index] + 1.0
+    ra, dec = np.degrees(vector_to_radec(result.ref_I))
+    field_ra, field_dec = WCS(fits.Header(solution.cards())).all_pix2world(pixels[:, 0], pixels[:, 1], 1)
+    stars = load_star_catalog(epoch)
+    mag = stars.v_mag[np.searchsorted(stars.hip, result.matched_hip)]
+    columns = [fits.Column("field_x", "D", array=pixels[:, 0]), fits.Column("field_y", "D", array=pixels[:, 1]),
+               fits.Column("field_ra", "D", "deg", array=field_ra), fits.Column("field_dec", "D", "deg", array=field_dec),
+               fits.Column("index_ra", "D", "deg", array=ra % 360.0), fits.Column("index_dec", "D", "deg", array=dec),
+               fits.Column("index_id", "K", array=result.matched_hip), fits.Column("field_id", "K", array=index),
+               fits.Column("mag", "E", "mag", array=mag)]
+    return fits.HDUList([fits.PrimaryHDU(), fits.BinTableHDU.from_columns(columns, name="CORR")])

@@ -1,0 +1,142 @@
+"""The FITS world coordinate system of a solved frame: gnomonic (TAN) with SIP distortion polynomials.
+
+A camera of :mod:`startrack.camera` at the attitude ``q_IS`` maps a pixel (u, v) (0-based, origin at the
+centre of the first pixel) to a direction; the FITS WCS of that map (Calabretta & Greisen 2002, eqs. 54-55
+for TAN with LONPOLE 180; the SIP convention of Shupe et al. 2005) is, with FITS pixels p = u + 1, q = v + 1
+and the reference pixel CRPIX at the principal point (cx + 1, cy + 1):
+
+* intermediate world coordinates [deg] (x, y) = CD (U + A(U, V), V + B(U, V)), U = p - CRPIX1,
+  V = q - CRPIX2 -- the standard coordinates (xi, eta) of the star about CRVAL (xi towards east,
+  eta towards north), tangent plane to the sphere at the boresight;
+* the pinhole part is exact and linear: (xi, eta) = M (x_n, y_n), with M the sensor's x and y axes seen
+  on the tangent plane's east and north axes, so CD = (180 / pi) M / f [deg/px];
+* Brown's radial distortion is the polynomial A, B of order 2..N: U + A = f x_n(U, V) with x_n the
+  undistorted coordinate (:meth:`startrack.camera.Camera.undistort`), fitted by least squares on a grid
+  over the image; AP, BP the inverse, U = U' + AP(U', V') on the undistorted offsets U' = f x_n.
+
+The order N is the smallest (0 for a pinhole, else 2..:data:`MAX_ORDER`) whose fit misses the camera model
+by at most ``tolerance_arcsec`` (0.02") everywhere on the grid, the inverse likewise; the header states what it
+reached (``max_error_px``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from startrack.errors import InputError
+from startrack.rotation import to_matrix
+from startrack.units import ARCSEC
+
+#: Highest SIP order tried (the distortion of a fisheye's corners needs the most terms).
+MAX_ORDER = 9
+#: Grid points per image side on which the polynomials are fitted and checked.
+GRID = 41
+
+
+@dataclass(frozen=True)
+class TanSip:
+    """A TAN(-SIP) WCS: ``crpix`` (2,) FITS px, ``crval`` (2,) [deg], ``cd`` (2, 2) [deg/px], the forward
+    polynomial coefficients ``a``, ``b`` and the inverse ``ap``, ``bp`` as {(p, q): value} (empty for a
+    pinhole), ``order``, ``max_error_px`` of forward and inverse on the grid, image ``width`` x ``height``."""
+
+    crpix: np.ndarray
+    crval: np.ndarray
+    cd: np.ndarray
+    a: dict
+    b: dict
+    ap: dict
+    bp: dict
+    order: int
+    max_error_px: float
+    width: int
+    height: int
+
+    def cards(self):
+        """[(keyword, value, comment)] of the FITS header (module text); SIP keywords when ``order``."""
+        sip = bool(self.order)
+        suffix = "-SIP" if sip else ""
+        cards = [("WCSAXES", 2, "2-D image"),
+                 ("CTYPE1", "RA---TAN" + suffix, "gnomonic projection" + (", SIP distortion" if sip else "")),
+                 ("CTYPE2", "DEC--TAN" + suffix, "gnomonic projection" + (", SIP distortion" if sip else "")),
+                 ("CUNIT1", "deg", ""), ("CUNIT2", "deg", ""),
+                 ("RADESYS", "ICRS", "astrometric directions of the catalog"),
+                 ("CRPIX1", float(self.crpix[0]), "principal point, FITS pixels"),
+                 ("CRPIX2", float(self.crpix[1]), "principal point, FITS pixels"),
+                 ("CRVAL1", float(self.crval[0]), "RA of the principal point [deg]"),
+                 ("CRVAL2", float(self.crval[1]), "Dec of the principal point [deg]"),
+                 ("LONPOLE", 180.0, ""), ("LATPOLE", float(self.crval[1]), ""),
+                 ("CD1_1", float(self.cd[0, 0]), ""), ("CD1_2", float(self.cd[0, 1]), ""),
+                 ("CD2_1", float(self.cd[1, 0]), ""), ("CD2_2", float(self.cd[1, 1]), ""),
+                 ("IMAGEW", self.width, "image width [px]"), ("IMAGEH", self.height, "image height [px]")]
+        if sip:
+            for name, terms in (("A", self.a), ("B", self.b), ("AP", self.ap), ("BP", self.bp)):
+                cards.append((f"{name}_ORDER", self.order, "SIP polynomial order"))
+                cards += [(f"{name}_{p}_{q}", float(value), "") for (p, q), value in sorted(terms.items())]
+        return cards
+
+
+def tangent_axes(boresight):
+    """(east, north) unit vectors (2, 3) of the tangent plane at the unit vector ``boresight``; at a pole
+    east is the +y axis (RA 90 deg), north towards RA 180 deg (north pole) or 0 deg (south pole)."""
+    z = np.asarray(boresight, dtype=float)
+    east = np.cross([0.0, 0.0, 1.0], z)
+    norm = np.linalg.norm(east)
+    east = east / norm if norm > 1e-15 else np.array([0.0, 1.0, 0.0])
+    return np.array([east, np.cross(z, east)])
+
+
+def standard_coordinates(vectors, boresight):
+    """(xi, eta) (N, 2) [rad] of unit vectors about ``boresight`` (gnomonic: the tangent plane's east and
+    north components over the boresight's)."""
+    vectors = np.atleast_2d(vectors)
+    return vectors @ tangent_axes(boresight).T / (vectors @ boresight)[:, None]
+
+
+def _terms(order):
+    """(p, q) exponents of the SIP terms of total order 2..``order``."""
+    return [(p, n - p) for n in range(2, order + 1) for p in range(n, -1, -1)]
+
+
+def _fit(U, V, target, order, scale):
+    """{(p, q): coefficient} of the least-squares polynomial of ``order`` in (U, V) [px] to ``target`` (N, 2),
+    fitted on (U, V) / scale for conditioning; and the largest miss [px]."""
+    if order == 0:
+        return {}, {}, float(np.abs(target).max())
+    terms = _terms(order)
+    X = np.stack([(U / scale) ** p * (V / scale) ** q for p, q in terms], axis=1)
+    coef, *_ = np.linalg.lstsq(X, target, rcond=None)
+    miss = float(np.abs(X @ coef - target).max())
+    unscale = np.array([scale ** -(p + q) for p, q in terms])[:, None]
+    coef = coef * unscale
+    return ({t: c for t, c in zip(terms, coef[:, 0])}, {t: c for t, c in zip(terms, coef[:, 1])}, miss)
+
+
+def tan_sip(camera, q_IS, tolerance_arcsec=0.02):
+    """The :class:`TanSip` of ``camera`` (:class:`startrack.camera.Camera`) at attitude ``q_IS`` (S -> I,
+    scalar last): CD exact, the SIP polynomials of the lowest order that reproduces the camera model within
+    ``tolerance_arcsec`` (as pixels at the focal length) on a grid over the image (module text); raises
+    InputError if no order up to :data:`MAX_ORDER` does."""
+    tolerance_px = tolerance_arcsec * ARCSEC * camera.focal_px
+    R = to_matrix(np.asarray(q_IS, dtype=float))
+    boresight = R[:, 2]
+    axes = tangent_axes(boresight)
+    M = axes @ R[:, :2]  # (east, north) components of the sensor's x and y axes
+    cd = np.degrees(M) / camera.focal_px
+    ra, dec = math.atan2(boresight[1], boresight[0]) % (2.0 * math.pi), math.asin(np.clip(boresight[2], -1.0, 1.0))
+    u, v = np.meshgrid(np.linspace(-0.5, camera.width - 0.5, GRID), np.linspace(-0.5, camera.height - 0.5, GRID))
+    U, V = (u.ravel() - camera.cx), (v.ravel() - camera.cy)
+    ideal = camera.focal_px * camera.undistort(np.stack([U, V], axis=1) / camera.focal_px)  # f x_n, f y_n
+    scale = max(np.abs(U).max(), np.abs(V).max())
+    pinhole = camera.k1 == 0.0 and camera.k2 == 0.0
+    for order in [0] if pinhole else range(2, MAX_ORDER + 1):
+        a, b, forward = _fit(U, V, ideal - np.stack([U, V], axis=1), order, scale)
+        ap, bp, inverse = _fit(ideal[:, 0], ideal[:, 1], np.stack([U, V], axis=1) - ideal, order, scale)
+        if max(forward, inverse) <= tolerance_px:
+            return TanSip(np.array([camera.cx + 1.0, camera.cy + 1.0]), np.degrees([ra, dec]), cd, a, b, ap, bp,
+                          order, max(forward, inverse), camera.width, camera.height)
+    raise InputError(f"the camera's distortion (k1 {camera.k1:+.4g}, k2 {camera.k2:+.4g}) is not reproduced by SIP "
+                     f"polynomials up to order {MAX_ORDER} within {tolerance_arcsec:g} arcsec (largest miss "
+                     f"{max(forward, inverse):.3g} px)")
