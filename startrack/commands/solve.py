@@ -4,7 +4,8 @@ INPUT is one or more images (.png/.tif/.tiff/.jpg/.jpeg/.fits/.fit/.fts/.npy: de
 file; a FITS image's first image HDU or ``--hdu N``, its DATE-OBS the epoch unless ``--epoch``) or
 centroid CSV files (``u,v[,flux]`` per line [px], header optional; ``--width``/``--height`` give the
 image size); ``--batch PATH`` takes a JSON Lines file (``{"id": ..., "centroids": [[u, v, flux], ...]}``
-per line), a folder of images or a list of image paths (:mod:`startrack.commands.solve_input`).  One
+per line), a folder of images or a list of image paths (:mod:`startrack.commands.solve_input`), or ``-``:
+standard input as a stream, each line's answer printed as soon as it is solved (a camera pipeline's solver).  One
 process solves them all: the start-up (catalogs, compiled kernels) is paid once.
 
 Two uses (:mod:`startrack.commands.solve_modes`):
@@ -60,7 +61,9 @@ def register(subparsers):
     )
     parser.add_argument("input", nargs="*",
                         help="images (.png/.tif/.tiff/.jpg/.jpeg/.fits/.fit/.fts/.npy) or centroid CSV files")
-    parser.add_argument("--batch", metavar="PATH", help="frames: a .jsonl file, a folder of images or a list of images")
+    parser.add_argument("--batch", metavar="PATH",
+                        help="frames: a .jsonl file, a folder of images, a list of images, or - for standard input "
+                             "read as a stream (per line an image path or a JSON centroid record)")
     parser.add_argument("--camera", metavar="FILE",
                         help="the calibrated camera (a camera file, e.g. from --write-camera): identify with it")
     parser.add_argument("--fov-deg", type=float,
@@ -253,6 +256,8 @@ def run(args):
     options = detection_options(args)
     solver = _frame_solver(args)
     check_output_options(args, None if args.batch is not None else len(args.input))
+    if args.batch == "-":
+        solver.prepare()
     boresight = None if args.boresight_deg is None else _parse_boresight(args.boresight_deg, args.boresight_error_deg)
     frames = _frames(args, options, solver.camera_file)
     first = next(frames, None)  # a single INPUT's read error surfaces before the catalogs are loaded

@@ -11,12 +11,16 @@ cannot be read is bad input (one line, exit 2).
   the image size;
 * JSON Lines (``--batch FILE.jsonl``): ``{"id": ..., "centroids": [[u, v, flux], ...]}`` per line;
 * folder (``--batch DIR``): its image files, sorted by name;
-* list (``--batch FILE.txt``): one image path per line (relative to the list's folder; # comments).
+* list (``--batch FILE.txt``): one image path per line (relative to the list's folder; # comments);
+* stream (``--batch -``): standard input read as it comes, per line an image path or a JSON centroid
+  record, each answer printed (and flushed) before the next line is read: a camera pipeline's solver
+  that pays the start-up once.
 """
 
 from __future__ import annotations
 
 import json
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -102,23 +106,45 @@ def batch_jsonl(path, width, height):
             if not raw.strip():
                 continue
             frames += 1
-            frame_id = number
-            try:
-                record = json.loads(raw.decode("utf-8"))  # a line of bad bytes is that frame's error only
-                if not isinstance(record, dict):
-                    raise ValueError("the line is not a JSON object")
-                frame_id = record.get("id", number)
-                unknown = set(record) - {"id", "centroids"}
-                if unknown:
-                    raise ValueError(f"unknown key(s) {', '.join(sorted(unknown))}")
-                if "centroids" not in record:
-                    raise ValueError('the key "centroids" is missing')
-                uv, flux = _centroid_rows(record["centroids"])
-                yield SolveFrame(frame_id, uv, flux, None, width, height)
-            except ValueError as error:  # json.JSONDecodeError and UnicodeDecodeError are ValueErrors
-                yield SolveFrame(frame_id, reason=f"batch file {path.name} line {number}: {error}")
+            yield _json_frame(raw, number, width, height, f"batch file {path.name}")
     if not frames:
         raise InputError(f"batch file {path} holds no frame (every line is empty).")
+
+
+def _json_frame(raw, number, width, height, source):
+    """The SolveFrame of one JSON line (bytes or text) ``{"id": ..., "centroids": [...]}``, or its error record
+    (``source`` and ``number`` name the line)."""
+    frame_id = number
+    try:
+        record = json.loads(raw.decode("utf-8") if isinstance(raw, bytes) else raw)  # bad bytes: this frame's error
+        if not isinstance(record, dict):
+            raise ValueError("the line is not a JSON object")
+        frame_id = record.get("id", number)
+        unknown = set(record) - {"id", "centroids"}
+        if unknown:
+            raise ValueError(f"unknown key(s) {', '.join(sorted(unknown))}")
+        if "centroids" not in record:
+            raise ValueError('the key "centroids" is missing')
+        uv, flux = _centroid_rows(record["centroids"])
+        return SolveFrame(frame_id, uv, flux, None, width, height)
+    except ValueError as error:  # json.JSONDecodeError and UnicodeDecodeError are ValueErrors
+        return SolveFrame(frame_id, reason=f"{source} line {number}: {error}")
+
+
+def stream_frames(lines, options, width, height, hdu=None):
+    """SolveFrame records of a stream read as it comes (``--batch -``: standard input, a camera pipeline's
+    frames): per non-empty line a JSON centroid record (a line starting with "{") or an image path."""
+    for number, line in enumerate(lines, 1):
+        text = line.strip()
+        if not text:
+            continue
+        if text.startswith("{"):
+            yield _json_frame(text, number, width, height, "standard input")
+            continue
+        try:
+            yield image_frame(Path(text), options, hdu=hdu)
+        except InputError as error:
+            yield SolveFrame(text, reason=str(error))
 
 
 def image_frame(path, options, width=None, height=None, hdu=None):
@@ -156,7 +182,11 @@ def _listed_images(path):
 
 
 def batch_frames(path, options, width, height, hdu=None):
-    """SolveFrame records of ``--batch PATH``: JSON Lines, a folder of images or a list of images."""
+    """SolveFrame records of ``--batch PATH``: JSON Lines, a folder of images, a list of images, or ``-``:
+    standard input as a stream (:func:`stream_frames`)."""
+    if path == "-":
+        yield from stream_frames(sys.stdin, options, width, height, hdu)
+        return
     path = Path(path)
     if not path.exists():
         raise InputError(f"batch input {path} does not exist.")

@@ -74,6 +74,15 @@ class FrameSolver:
         """True when the frames come with their camera."""
         return self.camera_file is not None or self.fov is not None
 
+    def prepare(self):
+        """Build the solver of the frames to come now (catalogs, compiled kernels), for a stream whose first
+        frame must not wait for them: the epoch given or J2000 (a frame of another epoch builds its own)."""
+        epoch = 2000.0 if self.epoch is None else self.epoch
+        if not self.given or self.refit is not None:
+            self.plate(epoch)
+        elif self.camera_file is not None:
+            self._calibrated_solver(self.camera_file.camera, epoch)
+
     def epoch_of(self, frame):
         """The epoch of a frame's star positions [Julian year]: the given one, else the frame's observation's
         to :data:`EPOCH_STEP_YEARS` (one solver per step), else J2000."""

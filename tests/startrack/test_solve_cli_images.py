@@ -1,6 +1,7 @@
 """``startrack solve`` on images: batches of folders and lists in one process, JPEG and colour input,
 bad input (missing, corrupt, empty, all-dark, NaN frames; wrong options) answered with one line."""
 
+import io
 import json
 import shutil
 from pathlib import Path
@@ -54,6 +55,23 @@ def test_batch_list_of_images_and_several_inputs(tmp_path, capsys):
     status, out, _ = _run(capsys, ["solve", str(FRAMES[0]), str(tmp_path / "missing.tiff"), "--json"])
     records = [json.loads(line) for line in out.splitlines()]
     assert status == 1 and [r["status"] for r in records] == ["ok", "error"]
+
+
+def test_a_stream_on_standard_input_answers_each_line_as_it_comes(tmp_path, capsys, monkeypatch):
+    """``--batch -``: image paths and JSON centroid records on stdin, one answer per line in order; a bad
+    line is that frame's error, not the stream's end."""
+    solved = json.loads(_run(capsys, ["solve", str(FRAMES[0]), "--json"])[1])
+    detected = json.loads(_run(capsys, ["detect", str(FRAMES[1]), "--json"])[1])
+    centroids = [[s["u"], s["v"], s["flux_dn"]] for s in detected["stars"]]
+    lines = [str(FRAMES[0]), "", json.dumps({"id": "list", "centroids": centroids}), str(tmp_path / "gone.png"),
+             "{not json"]
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    status, out, err = _run(capsys, ["solve", "--batch", "-", "--width", "1024", "--height", "768", "--json"])
+    records = [json.loads(line) for line in out.splitlines()]
+    assert status == 1 and err == ""
+    assert [r["status"] for r in records] == ["ok", "ok", "error", "error"]
+    assert records[0]["q_IS"] == solved["q_IS"] and records[1]["id"] == "list"
+    assert "does not exist" in records[2]["reason"] and "standard input line 5" in records[3]["reason"]
 
 
 @pytest.mark.parametrize("mode, quality", [("L", 90), ("RGB", 85)])
