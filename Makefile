@@ -1,10 +1,10 @@
 # Two commands for a newcomer: `make demo` and `make test` (both set up .venv first).
 # The set-up installs the locked versions (requirements/*.txt, exact versions with hashes, Python 3.11 on
 # Linux x86-64) with uv, itself installed hash-checked by pip: `make demo` what the product runs
-# (requirements/run.txt), `make test` also the test tools (requirements/test.txt, the same versions) and
-# byte-compiles everything installed (a machine with PYTHONDONTWRITEBYTECODE would otherwise compile every
-# module of scipy & co. in every process of the suite: +3.5 s each; a demo is one process, which compiles
-# them once in memory in less time than compiling all of them ahead would take).
+# (requirements/run.txt), `make test` also the test tools (requirements/test.txt, the same versions); both
+# byte-compile everything in the venv (compileall: what an earlier step or another tool installed too), since
+# a machine with PYTHONDONTWRITEBYTECODE would otherwise compile numpy, scipy & co. in every process: +2-4 s
+# for each `startrack solve` or `navsim` call and each process of the suite (measured, issue 32).
 # `make lock` regenerates the locks from pyproject.toml's ranges (README).
 PYTHON ?= python3
 VENV := .venv
@@ -40,11 +40,12 @@ $(UV): requirements/bootstrap.txt
 $(RUN_STAMP): pyproject.toml requirements/run.txt $(UV)
 	$(INSTALL) -r requirements/run.txt
 	$(UV) pip install --quiet --python $(PY) --no-deps --no-build-isolation -e .
+	$(PY) -m compileall -q -j 0 $(VENV)/lib startrack navsim > /dev/null
 	touch $(RUN_STAMP)
 
 $(TEST_STAMP): requirements/test.txt $(RUN_STAMP)
-	$(INSTALL) --compile-bytecode -r requirements/test.txt
-	$(PY) -m compileall -q startrack navsim > /dev/null
+	$(INSTALL) -r requirements/test.txt
+	$(PY) -m compileall -q -j 0 $(VENV)/lib startrack navsim > /dev/null
 	touch $(TEST_STAMP)
 
 demo: setup-run

@@ -23,10 +23,12 @@ database for 8-30 deg, V <= 8 built once from the same Hipparcos-2 stars (``gene
 defaults), its 5 s timeout, once without and once with its distortion search (-0.2, 0.1).  startrack
 runs with its defaults (5-40 deg, 1 s budget).
 
-One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (median of 5), and, with
+One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (median of 20), and, with
 ``--baseline DIR`` (a checkout of the code before issue 18: ``git archive <commit> | tar -x -C DIR``),
 that code's ``startrack solve IMAGE --fov-deg 11.42 --width 1024 --height 768`` (it needed the
-geometry) in the same run.  Measures, never asserts.
+geometry) in the same run.  A camera pipeline's latency: ``startrack solve --batch - --json`` fed the
+image's path on stdin 20 times, per frame from the line written to the answer read, beside the same
+detection and solve called in process.  Measures, never asserts.
 
 Run:  python benchmarks/real_solve.py [--synthetic 60] [--jpeg 20] [--crowds 20] [--seed 0] [--baseline DIR]
 Writes benchmarks/results/real_solve.json; frames and raw results under benchmarks/work/real_solve/.
@@ -256,7 +258,7 @@ def per_frame(frames, results):
 
 
 # ----------------------------------------------------------------------------------- one-shot wall time
-def one_shot_ms(command, env=None, repeats=5):
+def one_shot_ms(command, env=None, repeats=20):
     """Median wall time [ms] of ``command`` in new processes, after one warm-up run (warm caches)."""
     subprocess.run(command, capture_output=True, env=env)
     times = []
@@ -282,6 +284,42 @@ def one_shot(image, baseline):
     return out
 
 
+def stream_latency(image, frames=20):
+    """Per-frame wall time [ms] of ``startrack solve --batch - --json`` (a long-lived solver fed IMAGE's path
+    on stdin, from the line written to the answer read: median over ``frames`` after a first one), beside
+    the same detection and solve called in this process (median): the stream's own cost is the difference."""
+    from startrack.cli import build_parser
+    from startrack.commands.detect import detection_options
+    from startrack.commands.solve import _frame_solver
+    from startrack.commands.solve_input import image_frame
+
+    args = build_parser().parse_args(["solve", str(image)])
+    solver, options = _frame_solver(args), detection_options(args)
+    solver.solve(image_frame(image, options), None)
+    inside = []
+    for _ in range(frames):
+        start = time.perf_counter()
+        solver.solve(image_frame(image, options), None)
+        inside.append(1e3 * (time.perf_counter() - start))
+    command = [str(Path(sys.executable).parent / "startrack"), "solve", "--batch", "-", "--json"]
+    stream = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
+    times = []
+    for k in range(frames + 1):
+        start = time.perf_counter()
+        stream.stdin.write(f"{image}\n")
+        stream.stdin.flush()
+        answer = json.loads(stream.stdout.readline())
+        if k:
+            times.append(1e3 * (time.perf_counter() - start))
+        if answer["status"] != "ok":
+            break
+    stream.stdin.close()
+    stream.wait()
+    return {"image": image.name, "frames": frames, "stream_ms": float(np.median(times)) if times else None,
+            "in_process_ms": float(np.median(inside)),
+            "overhead_ms": float(np.median(times) - np.median(inside)) if times else None}
+
+
 # ----------------------------------------------------------------------------------- main
 def _print(scores, one):
     sets = list(next(iter(scores.values())).keys())
@@ -296,8 +334,14 @@ def _print(scores, one):
             print(f"{name:<34} {set_name:<10} {m['answerable']:>3}/{m['frames']:<3} {m['success']:>8} {m['wrong']:>6} "
                   f"{fmt(ms['median'], '.2f'):>8} {fmt(ms['p95'], '.2f'):>8} {fmt(ms['max'], '.1f'):>9} "
                   f"{fmt(c['median'], '.1f'):>9}/{fmt(c['max'], '<9.1f')} {fmt(f['median'], '.4f'):>9}/{fmt(f['max'], '<9.4f')}")
-    print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 5): after {one['after_ms']} ms"
+    print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): after {one['after_ms']} ms"
           + (f", before (issue 17 code, with --fov-deg/--width/--height) {one['before_ms']} ms" if one["before_ms"] else ""))
+
+
+def _print_stream(stream):
+    print(f"stream `startrack solve --batch - --json` fed {stream['image']} {stream['frames']} times: "
+          f"{stream['stream_ms']:.2f} ms per frame (median), detection + solve in process {stream['in_process_ms']:.2f} ms, "
+          f"the stream's own {stream['overhead_ms']:+.2f} ms")
 
 
 def main():
@@ -334,7 +378,9 @@ def main():
     scores = {name: score(frames, records) for name, records in results.items()}
     real = {name: per_frame(frames, records) for name, records in results.items()}
     one = one_shot(REALSKY / "2019-07-29T204726_Alt60_Azi135_Try1.tiff", args.baseline)
+    stream = stream_latency(REALSKY / "2019-07-29T204726_Alt60_Azi135_Try1.tiff")
     _print(scores, one)
+    _print_stream(stream)
     for name, rows in real.items():
         print(f"\n{name}, real frames: centre error [arcsec], FOV error [%] vs cedar-solve's reference")
         for frame_id, row in rows.items():
@@ -346,7 +392,7 @@ def main():
               "machine": {"python": platform.python_version(), "platform": platform.platform(), "cpus": os.cpu_count()},
               "config": {"synthetic": args.synthetic, "jpeg": args.jpeg, "crowds": args.crowds, "seed": args.seed,
                          "success_arcsec": {"real": 120.0, "other": 60.0}, "wrong_deg": 0.1},
-              "solvers": solvers, "results": scores, "real_frames": real, "one_shot": one}
+              "solvers": solvers, "results": scores, "real_frames": real, "one_shot": one, "stream": stream}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(output, indent=1, allow_nan=False) + "\n")
     print(f"\nwrote {args.out}")
