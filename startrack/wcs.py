@@ -78,21 +78,21 @@ class TanSip:
         return cards
 
 
-def tangent_axes(boresight):
-    """(east, north) unit vectors (2, 3) of the tangent plane at the unit vector ``boresight``; at a pole
-    east is the +y axis (RA 90 deg), north towards RA 180 deg (north pole) or 0 deg (south pole)."""
+#: CRVAL1 [deg] of a reference point at a celestial pole, where the RA is undefined: the orientation
+#: astrometry.net's TAN assumes there whatever CRVAL1 says, and wcslib's (astropy's) for this CRVAL1.
+POLE_RA_DEG = 270.0
+
+
+def reference(boresight):
+    """(RA, Dec) [deg] of the unit vector ``boresight`` and the (east, north) unit vectors (2, 3) of the tangent
+    plane there; at a pole the limit along the meridian of :data:`POLE_RA_DEG` (east along +x)."""
     z = np.asarray(boresight, dtype=float)
     east = np.cross([0.0, 0.0, 1.0], z)
     norm = np.linalg.norm(east)
-    east = east / norm if norm > 1e-15 else np.array([0.0, 1.0, 0.0])
-    return np.array([east, np.cross(z, east)])
-
-
-def standard_coordinates(vectors, boresight):
-    """(xi, eta) (N, 2) [rad] of unit vectors about ``boresight`` (gnomonic: the tangent plane's east and
-    north components over the boresight's)."""
-    vectors = np.atleast_2d(vectors)
-    return vectors @ tangent_axes(boresight).T / (vectors @ boresight)[:, None]
+    at_pole = norm <= 1e-15
+    east = np.array([1.0, 0.0, 0.0]) if at_pole else east / norm
+    ra = POLE_RA_DEG if at_pole else math.degrees(math.atan2(z[1], z[0])) % 360.0
+    return np.array([ra, math.degrees(math.asin(np.clip(z[2], -1.0, 1.0)))]), np.array([east, np.cross(z, east)])
 
 
 def _terms(order):
@@ -121,11 +121,8 @@ def tan_sip(camera, q_IS, tolerance_arcsec=0.02):
     InputError if no order up to :data:`MAX_ORDER` does."""
     tolerance_px = tolerance_arcsec * ARCSEC * camera.focal_px
     R = to_matrix(np.asarray(q_IS, dtype=float))
-    boresight = R[:, 2]
-    axes = tangent_axes(boresight)
-    M = axes @ R[:, :2]  # (east, north) components of the sensor's x and y axes
-    cd = np.degrees(M) / camera.focal_px
-    ra, dec = math.atan2(boresight[1], boresight[0]) % (2.0 * math.pi), math.asin(np.clip(boresight[2], -1.0, 1.0))
+    crval, axes = reference(R[:, 2])
+    cd = np.degrees(axes @ R[:, :2]) / camera.focal_px  # the sensor's x and y axes on east and north, over f
     u, v = np.meshgrid(np.linspace(-0.5, camera.width - 0.5, GRID), np.linspace(-0.5, camera.height - 0.5, GRID))
     U, V = (u.ravel() - camera.cx), (v.ravel() - camera.cy)
     ideal = camera.focal_px * camera.undistort(np.stack([U, V], axis=1) / camera.focal_px)  # f x_n, f y_n
@@ -135,7 +132,7 @@ def tan_sip(camera, q_IS, tolerance_arcsec=0.02):
         a, b, forward = _fit(U, V, ideal - np.stack([U, V], axis=1), order, scale)
         ap, bp, inverse = _fit(ideal[:, 0], ideal[:, 1], np.stack([U, V], axis=1) - ideal, order, scale)
         if max(forward, inverse) <= tolerance_px:
-            return TanSip(np.array([camera.cx + 1.0, camera.cy + 1.0]), np.degrees([ra, dec]), cd, a, b, ap, bp,
+            return TanSip(np.array([camera.cx + 1.0, camera.cy + 1.0]), crval, cd, a, b, ap, bp,
                           order, max(forward, inverse), camera.width, camera.height)
     raise InputError(f"the camera's distortion (k1 {camera.k1:+.4g}, k2 {camera.k2:+.4g}) is not reproduced by SIP "
                      f"polynomials up to order {MAX_ORDER} within {tolerance_arcsec:g} arcsec (largest miss "

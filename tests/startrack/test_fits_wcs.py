@@ -39,7 +39,8 @@ CAMERAS = {  # (fov [deg], width, height, cx, cy, k1, k2)
     "pincushion": (20.0, 1280, 960, 630.0, 470.0, 0.05, 0.0),
     "wide": (40.0, 2000, 1500, 1003.0, 748.0, -0.2, 0.02),
 }
-ATTITUDES = {"mid": [0.3, -1.1, 0.7], "pole": [0.0, 0.0, 0.0], "ra0": [1.5, 2.0, -0.2]}
+ATTITUDES = {"mid": [0.3, -1.1, 0.7], "north pole": [0.0, 0.0, 0.0], "south pole": [math.pi, 0.0, 0.0],
+             "ra0": [1.5, 2.0, -0.2]}
 
 
 def _camera(name):
