@@ -25,6 +25,8 @@ import numpy as np
 from startrack.errors import InputError
 
 FITS_SUFFIXES = (".fits", ".fit", ".fts")
+#: File names read as FITS: those suffixes, gzipped, or tile-compressed (.fz, fpack).
+FITS_NAMES = FITS_SUFFIXES + tuple(s + ".gz" for s in FITS_SUFFIXES) + (".fz",)
 #: Detections closer than this to a pixel without data are dropped [px] (a cut edge looks like a star).
 MASK_MARGIN_PX = 3
 #: J2000.0 as a Julian date, and the days of a Julian year.
@@ -33,6 +35,21 @@ JD_J2000, JULIAN_YEAR_DAYS = 2451545.0, 365.25
 WCS_KEYWORDS = re.compile(r"^(WCSAXES|CTYPE\d|CUNIT\d|CRPIX\d|CRVAL\d|CDELT\d|CROTA\d|CD\d_\d|PC\d_\d|PV\d_\d+|"
                           r"PS\d_\d+|LONPOLE|LATPOLE|RADESYS|RADECSYS|EQUINOX|IMAGEW|IMAGEH|"
                           r"(A|B|AP|BP)_(ORDER|DMAX|\d+_\d+))$")
+
+
+def is_fits(path):
+    """True for a file name astropy reads as FITS (:data:`FITS_NAMES`)."""
+    return Path(path).name.lower().endswith(FITS_NAMES)
+
+
+def fits_stem(path):
+    """The file name without its FITS suffixes ("m42.fits.gz" -> "m42")."""
+    name = Path(path).name
+    for suffix in sorted(FITS_NAMES, key=len, reverse=True):
+        if name.lower().endswith(suffix):
+            name = name[:-len(suffix)]
+            break
+    return name[:-5] if name.lower().endswith(".fits") else name
 
 
 def read_fits(path, hdu=None):

@@ -21,7 +21,7 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from startrack.errors import InputError
-from startrack.fits_io import FITS_SUFFIXES
+from startrack.fits_io import FITS_SUFFIXES, is_fits
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy") + FITS_SUFFIXES
 #: Greyscale pillow modes read as they are.
@@ -57,11 +57,11 @@ def read_frame(path, hdu=None) -> Frame:
     if not path.is_file():
         raise InputError(f"image file {path} does not exist")
     suffix = path.suffix.lower()
-    if suffix not in IMAGE_SUFFIXES:
+    if suffix not in IMAGE_SUFFIXES and not is_fits(path):
         raise InputError(f"image file {path} has suffix {path.suffix!r}; expected one of {', '.join(IMAGE_SUFFIXES)}")
-    if hdu is not None and suffix not in FITS_SUFFIXES:
+    if hdu is not None and not is_fits(path):
         raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is not one")
-    if suffix in FITS_SUFFIXES:
+    if is_fits(path):
         from startrack.fits_io import read_fits
 
         array, mask, saturate, epoch, index = read_fits(path, hdu)

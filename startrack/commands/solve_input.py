@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from startrack.errors import InputError
+from startrack.fits_io import is_fits
 from startrack.image_io import IMAGE_SUFFIXES
 
 
@@ -170,7 +171,7 @@ def image_frame(path, options, width=None, height=None, hdu=None):
 def _listed_images(path):
     """Image paths of a folder (sorted) or of a list file (one per line, relative to the list)."""
     if path.is_dir():
-        images = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
+        images = sorted(p for p in path.iterdir() if (p.suffix.lower() in IMAGE_SUFFIXES or is_fits(p)) and p.is_file())
         if not images:
             raise InputError(f"batch folder {path} holds no image ({', '.join(IMAGE_SUFFIXES)}).")
         return images
@@ -209,7 +210,7 @@ def input_frame(path, options, width, height, hdu=None):
         raise InputError(f"input {path} is a directory; give an image or centroid file, or --batch for a folder.")
     if not path.is_file():
         raise InputError(f"input file {path} does not exist.")
-    if path.suffix.lower() in IMAGE_SUFFIXES:
+    if path.suffix.lower() in IMAGE_SUFFIXES or is_fits(path):
         return image_frame(path, options, width, height, hdu)
     if hdu is not None:
         raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is a centroid list.")

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from startrack.errors import InputError
-from startrack.fits_io import FITS_SUFFIXES, WCS_KEYWORDS, write_hdus
+from startrack.fits_io import FITS_SUFFIXES, WCS_KEYWORDS, fits_stem, is_fits, write_hdus
 from startrack.paths import check_file
 
 #: The options, and the file suffixes each takes (astrometry.net's .wcs, .new and .corr are FITS files too).
@@ -73,7 +73,7 @@ def write_outputs(args, frame, result, epoch):
 
 def _stem(frame_id):
     text = str(frame_id)
-    return Path(text).stem if Path(text).suffix else text
+    return fits_stem(text) if is_fits(text) else Path(text).stem if Path(text).suffix else text
 
 
 def _new_fits(frame, header):
@@ -82,7 +82,7 @@ def _new_fits(frame, header):
     from astropy.io import fits
 
     path = Path(str(frame.frame_id))
-    if path.suffix.lower() in FITS_SUFFIXES:
+    if is_fits(path):
         hdus = fits.open(path, memmap=False)
         image = hdus[frame.hdu]
         for keyword in [k for k in image.header if WCS_KEYWORDS.match(k)]:

@@ -145,6 +145,23 @@ def test_pixels_without_data_are_masked(rendered, tmp_path, capsys):
     assert status == 0 and records[0]["status"] == "ok", err
 
 
+def test_gzipped_and_tile_compressed_fits_read_as_the_plain_file(rendered, tmp_path, capsys):
+    """m42.fits.gz (gzip) and m42.fits.fz (fpack's lossless Rice tiles in HDU 1) give the plain file's detections;
+    --wcs with {stem} names the outputs without the suffixes."""
+    image = fits.getdata(rendered)
+    fits.PrimaryHDU(image).writeto(tmp_path / "m42.fits.gz")
+    fits.HDUList([fits.PrimaryHDU(), fits.CompImageHDU(image)]).writeto(tmp_path / "m43.fits.fz")
+    stars = []
+    for path in (rendered, tmp_path / "m42.fits.gz", tmp_path / "m43.fits.fz"):
+        assert main(["detect", str(path), "--json"]) == 0
+        stars.append(json.loads(capsys.readouterr().out)["stars"])
+    assert stars[1] == stars[0] and stars[2] == stars[0]
+    status, err, records = _solve(capsys, tmp_path / "m42.fits.gz", tmp_path / "m43.fits.fz", "--wcs",
+                                  tmp_path / "{stem}.wcs")
+    assert status == 0, err
+    assert (tmp_path / "m42.wcs").is_file() and (tmp_path / "m43.wcs").is_file()
+
+
 @pytest.mark.parametrize("name", sorted(REFERENCE))
 def test_real_frames_as_fits_solve_to_the_reference(name, tmp_path, capsys):
     """The real frames converted to FITS (16-bit, a second HDU selected by --hdu) solve to the same image centre
