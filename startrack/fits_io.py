@@ -43,13 +43,11 @@ def is_fits(path):
 
 
 def fits_stem(path):
-    """The file name without its FITS suffixes ("m42.fits.gz" -> "m42")."""
+    """The file name without its FITS suffixes ("m42.fits.gz", "m42.fits.fz" -> "m42")."""
     name = Path(path).name
-    for suffix in sorted(FITS_NAMES, key=len, reverse=True):
-        if name.lower().endswith(suffix):
-            name = name[:-len(suffix)]
-            break
-    return name[:-5] if name.lower().endswith(".fits") else name
+    while is_fits(name):
+        name = name[:-len(next(s for s in FITS_NAMES if name.lower().endswith(s)))]
+    return name
 
 
 def read_fits(path, hdu=None):

@@ -66,9 +66,10 @@ def write_outputs(args, frame, result, epoch):
     if args.wcs:
         write_hdus(args.wcs.replace("{stem}", stem), fits.HDUList([fits.PrimaryHDU(header=header)]), "--wcs")
     if args.new_fits:
-        write_hdus(args.new_fits.replace("{stem}", stem), _new_fits(frame, header), "--new-fits")
+        with _new_fits(frame, header) as hdus:
+            write_hdus(args.new_fits.replace("{stem}", stem), hdus, "--new-fits")
     if args.corr:
-        write_hdus(args.corr.replace("{stem}", stem), _corr(frame, result, solution, epoch), "--corr")
+        write_hdus(args.corr.replace("{stem}", stem), _corr(frame, result, header, epoch), "--corr")
 
 
 def _stem(frame_id):
@@ -94,7 +95,7 @@ def _new_fits(frame, header):
     return fits.HDUList([fits.PrimaryHDU(frame.image, header=header)])
 
 
-def _corr(frame, result, solution, epoch):
+def _corr(frame, result, header, epoch):
     """The BINTABLE of the matched stars (module text)."""
     from astropy.io import fits
     from astropy.wcs import WCS
@@ -105,7 +106,7 @@ def _corr(frame, result, solution, epoch):
     index = result.matches[:, 0]
     pixels = frame.uv[index] + 1.0
     ra, dec = np.degrees(vector_to_radec(result.ref_I))
-    field_ra, field_dec = WCS(fits.Header(solution.cards())).all_pix2world(pixels[:, 0], pixels[:, 1], 1)
+    field_ra, field_dec = WCS(header).all_pix2world(pixels[:, 0], pixels[:, 1], 1)
     stars = load_star_catalog(epoch)
     mag = stars.v_mag[np.searchsorted(stars.hip, result.matched_hip)]
     columns = [fits.Column("field_x", "D", array=pixels[:, 0]), fits.Column("field_y", "D", array=pixels[:, 1]),
