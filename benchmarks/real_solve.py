@@ -27,10 +27,12 @@ One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (
 ``--baseline DIR`` (a checkout of the code before issue 18: ``git archive <commit> | tar -x -C DIR``),
 that code's ``startrack solve IMAGE --fov-deg 11.42 --width 1024 --height 768`` (it needed the
 geometry) in the same run.  A camera pipeline's latency: ``startrack solve --batch - --json`` fed the
-image's path on stdin 20 times, per frame from the line written to the answer read, beside the same
-detection and solve called in process.  Measures, never asserts.
+image's path on stdin 200 times, per frame from the line written to the answer read, interleaved with the
+same detection and solve called in process (the median of the pairs' differences is the stream's own cost).
+Measures, never asserts.
 
 Run:  python benchmarks/real_solve.py [--synthetic 60] [--jpeg 20] [--crowds 20] [--seed 0] [--baseline DIR]
+      python benchmarks/real_solve.py --latency-only   (the one-shot and the stream alone)
 Writes benchmarks/results/real_solve.json; frames and raw results under benchmarks/work/real_solve/.
 """
 
@@ -143,6 +145,23 @@ def crowd_frames(n, seed):
 
 
 # ----------------------------------------------------------------------------------- solvers
+def startrack_record(solver, frame, warm_up=False):
+    """The result record of a :class:`startrack.identify.plate_solver.PlateSolver` on a frame's centroids, the
+    solve call timed alone (``warm_up``: solved once before, lazy initialisation is not a solve)."""
+    c = np.array(frame["centroids"], dtype=float).reshape(-1, 4)
+    call = (c[:, :2], frame["width"], frame["height"], c[:, 2], c[:, 3])
+    if warm_up:
+        solver.solve(*call)
+    begin = time.perf_counter_ns()
+    result = solver.solve(*call)
+    record = {"id": frame["id"], "status": result.status, "solve_ms": (time.perf_counter_ns() - begin) / 1e6}
+    if result.ok:
+        camera = result.calibration.camera
+        record.update(R_IC=matrix_from_radec_roll(*camera.center_radec_roll(result.q_IS)).tolist(),
+                      fov_deg=math.degrees(camera.angular_width), matches=result.matches.tolist())
+    return record
+
+
 def run_startrack(frames):
     """Results of :class:`startrack.identify.plate_solver.PlateSolver` (defaults), the solve call timed alone."""
     from startrack.identify.plate_solver import PlateSolver
@@ -150,22 +169,7 @@ def run_startrack(frames):
     start = time.perf_counter()
     solver = PlateSolver()
     setup_ms = 1e3 * (time.perf_counter() - start)
-    results = []
-    for n, frame in enumerate(frames):
-        c = np.array(frame["centroids"], dtype=float).reshape(-1, 4)
-        call = (c[:, :2], frame["width"], frame["height"], c[:, 2], c[:, 3])
-        if n == 0:
-            solver.solve(*call)
-        begin = time.perf_counter_ns()
-        result = solver.solve(*call)
-        ms = (time.perf_counter_ns() - begin) / 1e6
-        record = {"id": frame["id"], "status": result.status, "solve_ms": ms}
-        if result.ok:
-            R = matrix_from_radec_roll(*result.calibration.camera.center_radec_roll(result.q_IS))
-            record.update(R_IC=R.tolist(), fov_deg=math.degrees(result.calibration.camera.angular_width),
-                          matches=result.matches.tolist())
-        results.append(record)
-    return results, setup_ms
+    return [startrack_record(solver, frame, n == 0) for n, frame in enumerate(frames)], setup_ms
 
 
 def run_cedar(frames_path, out_path, database, distortion):
@@ -182,19 +186,21 @@ def run_cedar(frames_path, out_path, database, distortion):
         return [json.loads(line) for line in stream if line.strip()], None
 
 
-def cedar_database(work, epoch):
-    """The cedar-solve database for 8-30 deg, V <= 8 from the benchmark's Hipparcos-2 file (built once)."""
+def cedar_database(work, epoch, fov_range_deg=(8.0, 30.0)):
+    """The cedar-solve database for the field-of-view range [deg], V <= 8 from the benchmark's Hipparcos-2
+    file (built once)."""
     import star_id
 
-    path = work / "cedar-fov8-30-v8.npz"
+    low, high = fov_range_deg
+    path = work / f"cedar-fov{low:g}-{high:g}-v8.npz"
     if not path.is_file():
         catalog = star_id.write_peer_catalogs(work, epoch) / "hip_main.dat"
         code = ("import logging, sys, tetra3; logging.disable(logging.INFO); tetra3.Tetra3(load_database=None)"
-                ".generate_database(max_fov=30, min_fov=8, star_catalog=sys.argv[1], star_max_magnitude=8.0, "
-                "epoch_proper_motion=None, save_as=sys.argv[2])")
+                ".generate_database(max_fov=float(sys.argv[3]), min_fov=float(sys.argv[4]), star_catalog=sys.argv[1], "
+                "star_max_magnitude=8.0, epoch_proper_motion=None, save_as=sys.argv[2])")
         print(f"  cedar-solve: building its database {path.name} (once)", flush=True)
         subprocess.run([str(HERE / ".venv-cedar" / "bin" / "python"), "-c", code, str(catalog),
-                        str(path.with_suffix(""))], check=True)
+                        str(path.with_suffix("")), str(high), str(low)], check=True)
     return path
 
 
@@ -284,10 +290,11 @@ def one_shot(image, baseline):
     return out
 
 
-def stream_latency(image, frames=20):
+def stream_latency(image, frames=200):
     """Per-frame wall time [ms] of ``startrack solve --batch - --json`` (a long-lived solver fed IMAGE's path
-    on stdin, from the line written to the answer read: median over ``frames`` after a first one), beside
-    the same detection and solve called in this process (median): the stream's own cost is the difference."""
+    on stdin, from the line written to the answer read) beside the same detection and solve called in this
+    process, interleaved frame by frame (``frames`` pairs after one warm-up each, so that the machine's
+    drifts fall on both alike): medians and the median of the pairs' differences, the stream's own cost."""
     from startrack.cli import build_parser
     from startrack.commands.detect import detection_options
     from startrack.commands.solve import _frame_solver
@@ -295,29 +302,36 @@ def stream_latency(image, frames=20):
 
     args = build_parser().parse_args(["solve", str(image)])
     solver, options = _frame_solver(args), detection_options(args)
-    solver.solve(image_frame(image, options), None)
-    inside = []
-    for _ in range(frames):
-        start = time.perf_counter()
-        solver.solve(image_frame(image, options), None)
-        inside.append(1e3 * (time.perf_counter() - start))
     command = [str(Path(sys.executable).parent / "startrack"), "solve", "--batch", "-", "--json"]
     stream = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
-    times = []
-    for k in range(frames + 1):
+
+    def in_process():
+        start = time.perf_counter()
+        solver.solve(image_frame(image, options), None)
+        return 1e3 * (time.perf_counter() - start)
+
+    def streamed():
         start = time.perf_counter()
         stream.stdin.write(f"{image}\n")
         stream.stdin.flush()
         answer = json.loads(stream.stdout.readline())
-        if k:
-            times.append(1e3 * (time.perf_counter() - start))
-        if answer["status"] != "ok":
+        return 1e3 * (time.perf_counter() - start), answer["status"]
+
+    in_process(), streamed()
+    inside, times = [], []
+    for _ in range(frames):
+        inside.append(in_process())
+        ms, status = streamed()
+        if status != "ok":
             break
+        times.append(ms)
     stream.stdin.close()
     stream.wait()
-    return {"image": image.name, "frames": frames, "stream_ms": float(np.median(times)) if times else None,
+    pairs = np.array(times) - np.array(inside[:len(times)])
+    return {"image": image.name, "frames": len(times), "stream_ms": float(np.median(times)) if times else None,
             "in_process_ms": float(np.median(inside)),
-            "overhead_ms": float(np.median(times) - np.median(inside)) if times else None}
+            "overhead_ms": float(np.median(pairs)) if times else None,
+            "overhead_ms_quartiles": [float(q) for q in np.percentile(pairs, [25, 75])] if times else None}
 
 
 # ----------------------------------------------------------------------------------- main
@@ -339,9 +353,25 @@ def _print(scores, one):
 
 
 def _print_stream(stream):
-    print(f"stream `startrack solve --batch - --json` fed {stream['image']} {stream['frames']} times: "
-          f"{stream['stream_ms']:.2f} ms per frame (median), detection + solve in process {stream['in_process_ms']:.2f} ms, "
-          f"the stream's own {stream['overhead_ms']:+.2f} ms")
+    low, high = stream["overhead_ms_quartiles"]
+    print(f"stream `startrack solve --batch - --json` fed {stream['image']} {stream['frames']} times, interleaved with "
+          f"the same detection + solve in process: {stream['stream_ms']:.2f} ms vs {stream['in_process_ms']:.2f} ms "
+          f"per frame (medians), the stream's own {stream['overhead_ms']:+.2f} ms (median of the pairs, "
+          f"quartiles {low:+.2f} / {high:+.2f})")
+
+
+def latency_only(args):
+    """The one-shot and stream measurements alone, written over those entries of ``args.out``."""
+    image = REALSKY / "2019-07-29T204726_Alt60_Azi135_Try1.tiff"
+    one, stream = one_shot(image, args.baseline), stream_latency(image)
+    print(f"one-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): {one['after_ms']} ms")
+    _print_stream(stream)
+    output = json.loads(args.out.read_text()) if args.out.is_file() else {}
+    output.update(one_shot=one, stream=stream,
+                  latency_utc=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"))
+    args.out.write_text(json.dumps(output, indent=1, allow_nan=False) + "\n")
+    print(f"wrote {args.out}")
+    return 0
 
 
 def main():
@@ -353,8 +383,12 @@ def main():
     parser.add_argument("--baseline", help="checkout of the code before issue 18, for the one-shot 'before'")
     parser.add_argument("--out", type=Path, default=HERE / "results" / "real_solve.json")
     parser.add_argument("--work", type=Path, default=HERE / "work" / "real_solve")
+    parser.add_argument("--latency-only", action="store_true",
+                        help="measure only the one-shot and the stream (their entries of --out replaced)")
     args = parser.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
+    if args.latency_only:
+        return latency_only(args)
     print("frames: real, synthetic, jpeg, crowd (detected once, the same centroids for every solver)", flush=True)
     frames = real_frames() + synthetic_frames(args.synthetic, args.seed, False) + synthetic_frames(args.jpeg, args.seed, True) \
         + crowd_frames(args.crowds, args.seed)

@@ -56,6 +56,39 @@ def fold_radius_squared(k1, k2):
     return best
 
 
+def ideal_radius(rd, k1, k2):
+    """Ideal normalised radius r of distorted radii ``rd``: r (1 + k1 r^2 + k2 r^4) = rd by Newton's method
+    to machine precision (Brown 1971; broadcasts over rd, k1, k2)."""
+    rd = np.asarray(rd, dtype=float)
+    r = rd.copy()
+    for _ in range(_NEWTON_ITERATIONS):
+        r2 = r * r
+        step = (r * (1.0 + k1 * r2 + k2 * r2 * r2) - rd) / (1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2)
+        r = r - step
+        if np.all(np.abs(step) <= 1e-16 * np.maximum(r, 1.0)):
+            break
+    return r
+
+
+def _ideal_scale(rd, k1, k2):
+    """r / r_d of distorted radii ``rd`` (1 at the centre)."""
+    r = ideal_radius(rd, k1, k2)
+    return np.where(rd > 0.0, r / np.where(rd > 0.0, rd, 1.0), 1.0)
+
+
+def width_angle(focal_px, cx, cy, k1, k2, width, height):
+    """Angle [rad] the image width subtends through its middle row, between the outer edges of its end
+    pixels, distortion removed (broadcasts over the camera parameters: one call for many cameras)."""
+    middle = (height - 1) / 2.0
+    ends = []
+    for u in (-0.5, width - 0.5):
+        x_d, y_d = np.broadcast_arrays((u - np.asarray(cx, float)) / focal_px, (middle - np.asarray(cy, float)) / focal_px)
+        scale = _ideal_scale(np.hypot(x_d, y_d), k1, k2)
+        ends.append(np.stack([x_d * scale, y_d * scale, np.ones_like(x_d)], axis=-1))
+    left, right = ends
+    return np.arctan2(np.linalg.norm(np.cross(left, right), axis=-1), np.sum(left * right, axis=-1))
+
+
 @dataclass(frozen=True)
 class Camera:
     """Pinhole camera: W x H pixels, focal length in pixels, principal point, k1, k2."""
@@ -127,10 +160,8 @@ class Camera:
     def angular_width(self):
         """Angle [rad] the image width subtends through its middle row (outer pixel edges, distortion
         included): the field of view a plate solver measures; fov_x for an undistorted camera with its
-        principal point at the centre.  Computed once per camera (two undistortions: 0.3 ms)."""
-        middle = (self.height - 1) / 2.0
-        left, right = self.unproject([[-0.5, middle], [self.width - 0.5, middle]])
-        return float(np.arctan2(np.linalg.norm(np.cross(left, right)), np.dot(left, right)))
+        principal point at the centre (:func:`width_angle`)."""
+        return float(width_angle(self.focal_px, self.cx, self.cy, self.k1, self.k2, self.width, self.height))
 
     @property
     def fov_diagonal(self):
@@ -168,28 +199,12 @@ class Camera:
         return xy_n * self._radial_factor(np.sum(xy_n * xy_n, axis=-1))[..., None]
 
     def undistort(self, xy_d):
-        """Distorted normalised (x_d, y_d) -> ideal (x_n, y_n), Newton on the radius.
-
-        Solves r_d = r (1 + k1 r^2 + k2 r^4) for r per point, then scales
-        (x_d, y_d) by r / r_d; converges to machine precision in a few steps.
-        """
+        """Distorted normalised (x_d, y_d) -> ideal (x_n, y_n): each point scaled by r / r_d
+        (:func:`ideal_radius`)."""
         xy_d = np.asarray(xy_d, dtype=float)
         if self.k1 == 0.0 and self.k2 == 0.0:
             return xy_d.copy()
-        rd = np.sqrt(np.sum(xy_d * xy_d, axis=-1))
-        r = rd.copy()
-        for _ in range(_NEWTON_ITERATIONS):
-            r2 = r * r
-            g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd
-            dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2
-            step = g / dg
-            r = r - step
-            if np.all(np.abs(step) <= 1e-16 * np.maximum(r, 1.0)):
-                break
-        scale = np.ones_like(rd)
-        nonzero = rd > 0.0
-        scale[nonzero] = r[nonzero] / rd[nonzero]
-        return xy_d * scale[..., None]
+        return xy_d * _ideal_scale(np.sqrt(np.sum(xy_d * xy_d, axis=-1)), self.k1, self.k2)[..., None]
 
     # ----------------------------------------------------------------- projection
     def _project(self, v_S):

@@ -23,13 +23,12 @@ max(1, chi^2 / dof): the stated sigma_i are a lower bound of the real centroid e
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.camera import fold_radius_squared
+from startrack.camera import fold_radius_squared, width_angle
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_to_matrix
 
@@ -217,12 +216,12 @@ class CameraCalibration:
         covariance = self.covariance[3:, 3:]
         spread = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
         out = dict(zip(("focal_px", "cx", "cy", "k1", "k2"), (float(s) for s in spread)))
-        gradient = np.zeros(5)
-        for k, name in enumerate(("focal_px", "cx", "cy", "k1", "k2")):
-            step = 1e-3 * spread[k]
-            if step > 0.0:
-                moved = dataclasses.replace(self.camera, **{name: getattr(self.camera, name) + step})
-                gradient[k] = (moved.angular_width - self.camera.angular_width) / step
+        camera = self.camera
+        base = np.array([camera.focal_px, camera.cx, camera.cy, camera.k1, camera.k2])
+        step = 1e-3 * spread
+        moved = base + np.diag(step)
+        widths = width_angle(*moved.T, camera.width, camera.height)
+        gradient = np.where(step > 0.0, (widths - camera.angular_width) / np.where(step > 0.0, step, 1.0), 0.0)
         out["fov_deg"] = math.degrees(math.sqrt(max(gradient @ covariance @ gradient, 0.0)))
         return out
 

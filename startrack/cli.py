@@ -11,7 +11,7 @@ import sys
 from startrack.errors import ArgumentParser, run_command
 
 #: Sub-command modules under ``startrack.commands``, in the order ``--help`` lists them.
-COMMANDS = ("catalog", "address", "render", "detect", "solve")
+COMMANDS = ("catalog", "address", "render", "detect", "solve", "serve")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -26,7 +26,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    return run_command("startrack", build_parser, argv)
+    """The command; a ``solve`` is handed to a running ``startrack serve`` of the same code when there is one
+    (:mod:`startrack.serve_client`, standard library only: nothing else is imported on that path)."""
+    from startrack.serve_client import forward
+
+    try:
+        status = forward(argv)
+    except KeyboardInterrupt:
+        print("startrack: interrupted", file=sys.stderr)
+        return 130
+    return run_command("startrack", build_parser, argv) if status is None else status
 
 
 if __name__ == "__main__":

@@ -32,11 +32,12 @@ class ArgumentParser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def run_command(prog, build_parser, argv=None) -> int:
-    """Build the parser, parse ``argv`` and call ``args.func(args)``; every failure is one line on stderr."""
+def run_command(prog, build_parser, argv=None, call=None) -> int:
+    """Build the parser, parse ``argv`` and call ``args.func(args)`` (or ``call(args)``); every failure is one
+    line on stderr."""
     try:
         args = build_parser().parse_args(argv)
-        return int(args.func(args) or 0)
+        return int((call or args.func)(args) or 0)
     except InputError as error:
         return _fail(prog, error, 2)
     except KeyboardInterrupt:

@@ -250,11 +250,12 @@ def _line(frame_id, result):
     return text
 
 
-def run(args):
+def run(args, frame_solver=_frame_solver):
+    """The command; ``frame_solver(args)`` gives the solver (``startrack serve`` passes one that keeps them)."""
     from startrack.camera_file import write_camera_file
 
     options = detection_options(args)
-    solver = _frame_solver(args)
+    solver = frame_solver(args)
     check_output_options(args, None if args.batch is not None else len(args.input))
     if args.batch == "-":
         solver.prepare()
