@@ -23,7 +23,8 @@ database for 8-30 deg, V <= 8 built once from the same Hipparcos-2 stars (``gene
 defaults), its 5 s timeout, once without and once with its distortion search (-0.2, 0.1).  startrack
 runs with its defaults (5-40 deg, 1 s budget).
 
-One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (median of 20), and, with
+One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (median of 20), the same
+command handed to a running ``startrack serve`` (median of 20), and, with
 ``--baseline DIR`` (a checkout of the code before issue 18: ``git archive <commit> | tar -x -C DIR``),
 that code's ``startrack solve IMAGE --fov-deg 11.42 --width 1024 --height 768`` (it needed the
 geometry) in the same run.  A camera pipeline's latency: ``startrack solve --batch - --json`` fed the
@@ -46,6 +47,7 @@ import os
 import platform
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -68,7 +70,8 @@ DEFAULT_SUCCESS_ANGLE = 60.0 * ARCSEC
 WRONG_ANGLE = 0.1 * DEG
 #: startrack solve's default detection.
 DETECTION = {"background": None, "sigma_n": None, "a": 5.0, "centroider": "threshold", "min_pixels": 1,
-             "mesh_px": 64, "reject_single_pixels": True, "saturation_dn": None}
+             "mesh_px": 64, "reject_single_pixels": True, "reject_extended": True,
+             "saturation_dn": None}
 CEDAR_CONFIGS = {"cedar-solve": "0", "cedar-solve (distortion search)": "-0.2,0.1"}
 
 
@@ -278,10 +281,20 @@ def one_shot_ms(command, env=None, repeats=20):
 
 
 def one_shot(image, baseline):
-    """One-shot wall times of ``startrack solve IMAGE`` now and, with a baseline checkout, before issue 18."""
+    """One-shot wall times of ``startrack solve IMAGE``: in its own process (``after_ms``), handed to a running
+    ``startrack serve`` (``served_ms``) and, with a baseline checkout, before issue 18."""
     startrack = [str(Path(sys.executable).parent / "startrack"), "solve", str(image)]
-    after, failure = one_shot_ms(startrack)
+    after, failure = one_shot_ms(startrack, {**os.environ, "STARTRACK_USE_SERVER": "0"})
     out = {"image": image.name, "after_ms": after, "after_error": failure, "before_ms": None}
+    with tempfile.TemporaryDirectory(prefix="st", dir="/tmp") as folder:
+        env = {**os.environ, "STARTRACK_SERVE_SOCKET": str(Path(folder) / "serve.sock")}
+        server = subprocess.Popen(startrack[:1] + ["serve"], env=env, stderr=subprocess.PIPE, text=True)
+        try:
+            server.stderr.readline()  # "listening on ..."
+            out["served_ms"], out["served_error"] = one_shot_ms(startrack, env)
+        finally:
+            server.terminate()
+            server.wait()
     if baseline is not None:
         env = {**os.environ, "PYTHONPATH": str(Path(baseline).resolve())}
         command = [sys.executable, "-m", "startrack.cli", "solve", str(image), "--fov-deg", "11.42", "--width", "1024",
@@ -348,7 +361,8 @@ def _print(scores, one):
             print(f"{name:<34} {set_name:<10} {m['answerable']:>3}/{m['frames']:<3} {m['success']:>8} {m['wrong']:>6} "
                   f"{fmt(ms['median'], '.2f'):>8} {fmt(ms['p95'], '.2f'):>8} {fmt(ms['max'], '.1f'):>9} "
                   f"{fmt(c['median'], '.1f'):>9}/{fmt(c['max'], '<9.1f')} {fmt(f['median'], '.4f'):>9}/{fmt(f['max'], '<9.4f')}")
-    print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): after {one['after_ms']} ms"
+    print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): after {one['after_ms']} ms, "
+          f"handed to a running `startrack serve` {one['served_ms']} ms"
           + (f", before (issue 17 code, with --fov-deg/--width/--height) {one['before_ms']} ms" if one["before_ms"] else ""))
 
 
@@ -364,7 +378,8 @@ def latency_only(args):
     """The one-shot and stream measurements alone, written over those entries of ``args.out``."""
     image = REALSKY / "2019-07-29T204726_Alt60_Azi135_Try1.tiff"
     one, stream = one_shot(image, args.baseline), stream_latency(image)
-    print(f"one-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): {one['after_ms']} ms")
+    print(f"one-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): {one['after_ms']} ms; "
+          f"handed to a running `startrack serve`: {one['served_ms']} ms")
     _print_stream(stream)
     output = json.loads(args.out.read_text()) if args.out.is_file() else {}
     output.update(one_shot=one, stream=stream,

@@ -143,26 +143,31 @@ def cloud(exposure, level, rng):
     exposure.sky_e = exposure.sky_e + 20.0 * SKY_E_PER_S * exposure.sensor.exposure_s * opacity
 
 
+def _saturation_e(sensor):
+    """Charge [e-] that brings a pixel from the bias to the saturation level."""
+    return (sensor.saturation_dn - sensor.bias_dn) * sensor.gain_e_per_dn
+
+
 def light_pollution(exposure, level, rng):
-    """A town's glow rising to ``level`` x the full well at the frame edge nearest the horizon (a random
-    side), falling quadratically across the frame."""
+    """A town's glow rising to ``level`` x the saturation charge at the frame edge nearest the horizon (a
+    random side), falling quadratically across the frame."""
     u, v = _grid()
     angle = rng.uniform(0.0, 2.0 * math.pi)
     s = (np.cos(angle) * (u - WIDTH / 2) + np.sin(angle) * (v - HEIGHT / 2))
     s = (s - s.min()) / (s.max() - s.min())
-    exposure.sky_e = exposure.sky_e + level * exposure.sensor.full_well_e * s**2
+    exposure.sky_e = exposure.sky_e + level * _saturation_e(exposure.sensor) * s**2
 
 
 def moonlight(exposure, level, rng):
-    """A bright sky of ``level`` x the full well at the frame centre, with the glare of a Moon just outside
-    the frame (a random side) rising to 3 times that at the nearest edge."""
+    """A bright sky of ``level`` x the saturation charge at the frame centre, with the glare of a Moon just
+    outside the frame (a random side) rising to 3 times that at the nearest edge."""
     u, v = _grid()
     angle = rng.uniform(0.0, 2.0 * math.pi)
     mu, mv = WIDTH / 2 + 0.7 * WIDTH * math.cos(angle), HEIGHT / 2 + 0.7 * WIDTH * math.sin(angle)
     distance = np.hypot(u - mu, v - mv)
     glare = (distance.min() / distance) ** 2
     sky = 1.0 + 2.0 * glare
-    exposure.sky_e = exposure.sky_e + level * exposure.sensor.full_well_e * sky / sky[HEIGHT // 2, WIDTH // 2]
+    exposure.sky_e = exposure.sky_e + level * _saturation_e(exposure.sensor) * sky / sky[HEIGHT // 2, WIDTH // 2]
 
 
 def defocus(exposure, level, rng):
@@ -230,8 +235,8 @@ IMPAIRMENTS = {
     "hot_pixels": Impairment("pixels", hot_pixels, "pixels", (100, 1000, 10000)),
     "streaks": Impairment("pixels", streaks, "streaks", (1, 3, 10)),
     "cloud": Impairment("pixels", cloud, "fraction covered", (0.25, 0.5, 0.75)),
-    "light_pollution": Impairment("pixels", light_pollution, "edge sky / full well", (0.05, 0.2, 0.5)),
-    "moonlight": Impairment("pixels", moonlight, "centre sky / full well", (0.02, 0.1, 0.3)),
+    "light_pollution": Impairment("pixels", light_pollution, "edge sky / saturation", (0.1, 0.3, 0.6)),
+    "moonlight": Impairment("pixels", moonlight, "centre sky / saturation", (0.03, 0.1, 0.25)),
     "defocus": Impairment("pixels", defocus, "PSF sigma px", (1.5, 3.0, 5.0)),
     "trees": Impairment("pixels", trees, "fraction covered", (0.2, 0.4, 0.6)),
     "jpeg": Impairment("pixels", jpeg, "quality", (90, 70, 50, 30, 10)),

@@ -11,8 +11,9 @@ Pipeline (one pass, vectorised):
    centroid (u, v) by the chosen centroider, flux = sum(I - b), peak grey,
    pixel count, SNR = (peak - b)/sigma_n (eq. 1 of 004), and the flags
    ``saturated`` (peak at the saturation level), ``edge`` (touches the
-   image or window border, so the centroid is biased) and ``single_pixel``;
-5. optionally, components flagged ``single_pixel`` are dropped.
+   image or window border, so the centroid is biased), ``single_pixel`` and
+   ``extended``;
+5. optionally, components flagged ``single_pixel`` or ``extended`` are dropped.
 
 Single-pixel events (hot pixels, cosmic-ray hits, JPEG block noise): the optics spread a star over
 several pixels, so the 8 pixels around a star's peak hold a large fraction of the peak's own excess --
@@ -22,6 +23,17 @@ frame's own stars set the cut (:func:`_ring_cut`: half the median ratio of its b
 at least :data:`MIN_RING_RATIO`); a detection whose ring ratio R / (I_peak - b) lies below the cut by
 more than 3 times its noise (sqrt(8) sigma_n / (I_peak - b)) is flagged: at high SNR a hot pixel is
 told from a star with certainty, near the threshold the test keeps the detection.
+
+Extended detections (clouds lit from below, satellite and aircraft streaks, nebulae): a star is the
+image of a point, as large as the frame's other stars and round.  The second moments of the
+component's light, M = sum w (x - c)(x - c)^T / sum w with w = I - b, give its size s = sqrt(tr M / 2)
+[px] (sigma for a Gaussian image without its wings below the threshold) and its elongation
+sqrt(lambda_max / lambda_min) (1 for a round image; a streak of length L and width sigma_w:
+L / (sqrt(12) sigma_w)).  A detection is flagged ``extended`` when it is longer than
+:data:`MAX_ELONGATION` with at least :data:`MIN_SHAPE_PIXELS` pixels (fewer pixels do not measure a
+shape), or larger than :data:`EXTENDED_SIZE` times the median size of the frame's bright (SNR >= 20)
+unsaturated stars when it has 5 of them.  A saturated star's flat top widens it by about 1.5 for a
+peak 100 times the saturation level, well inside the cut.
 
 Centroiders (strategy objects, all over the component's pixels, u = column,
 v = row, image convention of docs/design.md):
@@ -43,6 +55,10 @@ from startrack.errors import InputError
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 #: Smallest ring ratio of a star image (module text).
 MIN_RING_RATIO = 0.4
+#: Largest axis ratio of a star image; fewest pixels that measure it (module text).
+MAX_ELONGATION, MIN_SHAPE_PIXELS = 3.0, 10
+#: Largest size of a star image over the median of the frame's bright stars (module text).
+EXTENDED_SIZE = 3.0
 
 
 class GreyCentroid:
@@ -83,9 +99,10 @@ class Detections:
     """Detected star images, brightest (largest flux) first.
 
     u, v [px]; flux = sum(I - b) [DN]; peak [DN]; npix; snr (eq. 1 of 004);
-    saturated, edge, single_pixel (bool, module text); the background b, noise
-    sigma_n and threshold [DN] used (medians over the frame for a mesh); sigma_u,
-    sigma_v [px]: the centroid's σ from the pixel noise (:func:`_centroid_sigma`).
+    saturated, edge, single_pixel, extended (bool, module text); the background b,
+    noise sigma_n and threshold [DN] used (medians over the frame for a mesh); sigma_u,
+    sigma_v [px]: the centroid's σ from the pixel noise (:func:`_centroid_sigma`);
+    size [px], elongation: the shape of the image's light (module text).
     """
 
     u: np.ndarray
@@ -102,6 +119,9 @@ class Detections:
     sigma_u: np.ndarray
     sigma_v: np.ndarray
     single_pixel: np.ndarray
+    size: np.ndarray
+    elongation: np.ndarray
+    extended: np.ndarray
 
     def __len__(self):
         return len(self.u)
@@ -115,7 +135,8 @@ class Detections:
         """The detections where ``mask`` (bool or indices) holds, same order."""
         fields = ("u", "v", "flux", "peak", "npix", "snr", "saturated", "edge")
         return Detections(*(getattr(self, f)[mask] for f in fields), self.background, self.sigma_n, self.threshold,
-                          self.sigma_u[mask], self.sigma_v[mask], self.single_pixel[mask])
+                          *(getattr(self, f)[mask] for f in ("sigma_u", "sigma_v", "single_pixel", "size", "elongation",
+                                                             "extended")))
 
     def to_dict(self):
         """Plain dict (lists) for JSON output."""
@@ -128,7 +149,8 @@ class Detections:
                     "u": float(self.u[i]), "v": float(self.v[i]), "flux_dn": float(self.flux[i]),
                     "peak_dn": float(self.peak[i]), "npix": int(self.npix[i]), "snr": float(self.snr[i]),
                     "saturated": bool(self.saturated[i]), "edge": bool(self.edge[i]),
-                    "single_pixel": bool(self.single_pixel[i]),
+                    "single_pixel": bool(self.single_pixel[i]), "extended": bool(self.extended[i]),
+                    "size_px": float(self.size[i]), "elongation": float(self.elongation[i]),
                     "sigma_u": float(self.sigma_u[i]), "sigma_v": float(self.sigma_v[i]),
                 }
                 for i in range(len(self))
@@ -139,7 +161,7 @@ class Detections:
 def _empty(background, sigma_n, threshold):
     f = np.zeros(0)
     b = np.zeros(0, dtype=bool)
-    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f, b)
+    return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f, b, f, f, b)
 
 
 def _validate(image, name="image"):
@@ -212,11 +234,39 @@ def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, mi
             excess = peak - b_peak
             ratio = (ring(peaks) - 8.0 * b_peak) / excess
             single = ratio < _ring_cut(ratio, snr, npix, saturated) - 3.0 * np.sqrt(8.0) * s_peak / excess
+    size, elongation = _shape(index, n, values - background, u_coord, v_coord)
+    with np.errstate(invalid="ignore"):
+        extended = ((elongation > MAX_ELONGATION) & (npix >= MIN_SHAPE_PIXELS)) | (
+            size > EXTENDED_SIZE * _star_size(size, snr, saturated, npix))
     keep = np.flatnonzero(npix >= min_pixels)
     keep = keep[np.argsort(-flux[keep], kind="stable")]
     summary = (float(np.median(level)) for level in levels)
     return Detections(u[keep], v[keep], flux[keep], peak[keep], npix[keep], snr[keep], saturated[keep],
-                      edge[keep], *summary, sigma_u[keep], sigma_v[keep], single[keep])
+                      edge[keep], *summary, sigma_u[keep], sigma_v[keep], single[keep], size[keep], elongation[keep],
+                      extended[keep])
+
+
+def _shape(index, n, excess, u_coord, v_coord):
+    """(size s [px], elongation) of the n components from the second moments of their light, weights
+    w = max(I - b, 0) (module text)."""
+    w = np.maximum(excess, 0.0)
+    sums = [np.bincount(index, weights=w * term, minlength=n) for term in
+            (1.0, u_coord, v_coord, u_coord * u_coord, v_coord * v_coord, u_coord * v_coord)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        total = np.where(sums[0] > 0, sums[0], np.nan)
+        cu, cv = sums[1] / total, sums[2] / total
+        muu, mvv, muv = sums[3] / total - cu * cu, sums[4] / total - cv * cv, sums[5] / total - cu * cv
+        half_trace, half_gap = 0.5 * (muu + mvv), np.hypot(0.5 * (muu - mvv), muv)
+        size = np.sqrt(np.maximum(half_trace, 0.0))
+        elongation = np.sqrt((half_trace + half_gap) / np.maximum(half_trace - half_gap, 1e-12))
+    return size, elongation
+
+
+def _star_size(size, snr, saturated, npix):
+    """Median size [px] of the frame's bright (SNR >= 20) unsaturated detections of 2 pixels or more when
+    there are 5 of them, else infinite (no size cut)."""
+    bright = (snr >= 20.0) & (npix >= 2) & ~saturated & np.isfinite(size)
+    return float(np.median(size[bright])) if np.count_nonzero(bright) >= 5 else np.inf
 
 
 def _ring_cut(ratio, snr, npix, saturated):
@@ -295,16 +345,16 @@ def _ring_sums(array):
 
 
 def detect(image, background=None, sigma_n=None, a=5.0, threshold=None, centroider="threshold",
-           saturation_dn=None, min_pixels=1, mesh_px=None, reject_single_pixels=False):
+           saturation_dn=None, min_pixels=1, mesh_px=None, reject_single_pixels=False, reject_extended=False):
     """Detect and centroid the star images of a frame (module docstring).
 
     image: 2-D array [DN].  background, sigma_n [DN]: estimated from the frame when None -- on a mesh of
     ``mesh_px`` cells if given, else one level for the frame.  threshold: V_th, default b + a sigma_n
     (eq. 4 of 004).  centroider: "grey", "threshold", "square" or an object with
     ``weights(values, background, threshold)``.  saturation_dn: grey level at which a pixel is saturated
-    (None: no flag).  min_pixels: smallest component kept.  reject_single_pixels: drop the detections
-    flagged ``single_pixel``.  Returns :class:`Detections` (empty when nothing exceeds the threshold).
-    NaN pixels raise InputError.
+    (None: no flag).  min_pixels: smallest component kept.  reject_single_pixels, reject_extended: drop
+    the detections flagged ``single_pixel``, ``extended``.  Returns :class:`Detections` (empty when
+    nothing exceeds the threshold).  NaN pixels raise InputError.
     """
     array = _validate(image)
     found = _background(array, background, sigma_n, mesh_px)
@@ -321,7 +371,9 @@ def detect(image, background=None, sigma_n=None, a=5.0, threshold=None, centroid
     detections = _measure(values, labels, n, on_border, _levels(found, a, threshold, rows, cols), centroider,
                           saturation_dn, min_pixels, cols.astype(float), rows.astype(float),
                           ring=lambda peaks: ring_of(rows[peaks], cols[peaks]))
-    return detections.select(~detections.single_pixel) if reject_single_pixels else detections
+    drop = (detections.single_pixel if reject_single_pixels else False) | (
+        detections.extended if reject_extended else False)
+    return detections.select(~drop) if np.any(drop) else detections
 
 
 def detect_windows(window_images, row0, col0, background, sigma_n, a=5.0, threshold=None,

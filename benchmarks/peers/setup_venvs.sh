@@ -1,8 +1,11 @@
 #!/bin/sh
-# Create the peer virtualenvs of benchmarks/star_id.py (idempotent: a venv whose stamp names the
-# same requirement is left alone).  Each peer lives in its own venv because cedar-solve pins numpy<2.
+# Set up the peers of the star-identification and plate-solving benchmarks (idempotent: a venv whose
+# stamp names the same requirement is left alone).  Each Python peer lives in its own venv because
+# cedar-solve pins numpy<2; astrometry.net comes from Debian.
 #   benchmarks/.venv-cedar     cedar-solve==0.5.1 (imports as `tetra3`)
 #   benchmarks/.venv-tetra3rs  tetra3rs==0.14.0 (Rust core, binary wheel)
+#   astrometry.net             Debian packages astrometry.net and astrometry-data-tycho2-10-19 (installed
+#                              here when run as root with apt-get, else named for the administrator)
 # Usage: sh benchmarks/peers/setup_venvs.sh [PYTHON]   (PYTHON defaults to python3)
 set -eu
 PYTHON=${1:-python3}
@@ -23,3 +26,12 @@ make_venv() {
 
 make_venv "$HERE/.venv-cedar" "cedar-solve==0.5.1"
 make_venv "$HERE/.venv-tetra3rs" "tetra3rs==0.14.0"
+
+ASTROMETRY="astrometry.net astrometry-data-tycho2-10-19"
+if ! command -v solve-field >/dev/null 2>&1 || ! ls /usr/share/astrometry/index-tycho2-1* >/dev/null 2>&1; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -q $ASTROMETRY
+    else
+        echo "astrometry.net not installed: as root, apt-get install $ASTROMETRY (its benchmarks report it missing)"
+    fi
+fi

@@ -1,7 +1,8 @@
 """``startrack detect IMAGE``: star centroids of a frame (PNG/TIFF/JPEG/NPY).
 
 Background and noise on a mesh of cells (or given), threshold V_th = b + a sigma_n (eq. 4 of 004),
-8-connected components and a centre-of-gravity centroider, single-pixel events (hot pixels) dropped,
+8-connected components and a centre-of-gravity centroider, single-pixel events (hot pixels) and
+extended or elongated detections (clouds, streaks) dropped,
 saturation at the full scale of the file's bit depth (:mod:`startrack.image_io`); prints one line
 per star, brightest first, or JSON.  The same detection, with the same options
 (:func:`add_detection_options`), is the image front end of ``startrack solve``.
@@ -36,6 +37,8 @@ def add_detection_options(parser):
     group.add_argument("--min-pixels", type=int, default=1, help="smallest star image kept [px] (1)")
     group.add_argument("--keep-single-pixels", action="store_true",
                        help="keep single-pixel events (hot pixels, cosmic rays), which are dropped by default")
+    group.add_argument("--keep-extended", action="store_true",
+                       help="keep extended and elongated detections (clouds, streaks), which are dropped by default")
     group.add_argument("--saturation-dn", type=float, default=None,
                        help="grey level of a saturated pixel [DN] (default: the full scale of the file's bit depth)")
 
@@ -53,7 +56,8 @@ def detection_options(args) -> dict:
         raise InputError(f"option --mesh-px = {args.mesh_px} must be 0 or a cell size in [8, 4096] px")
     return {"background": args.background_dn, "sigma_n": args.sigma_n_dn, "a": args.a, "centroider": args.centroider,
             "min_pixels": args.min_pixels, "mesh_px": args.mesh_px or None,
-            "reject_single_pixels": not args.keep_single_pixels, "saturation_dn": args.saturation_dn}
+            "reject_single_pixels": not args.keep_single_pixels, "reject_extended": not args.keep_extended,
+            "saturation_dn": args.saturation_dn}
 
 
 def detect_frame(frame, options):

@@ -6,7 +6,8 @@ verification stars (the same Hipparcos-2 stars, V <= its magnitude limit, at the
 declination-zone index).  ``solve`` orders the detections brightest first, thins them into pattern
 candidates, measures the local density of the detections (a grid of the frame, the false-match
 model of :mod:`startrack.identify.self_calibration`), and runs the compiled search
-(:func:`startrack.identify.scale_free.search`) in chunks of combinations until a hypothesis is
+(:func:`startrack.identify.scale_free.search`) in chunks of combinations (one at first, growing while
+the budget holds them) until a hypothesis is
 accepted, the combinations are exhausted or the time budget is spent.  The answer carries the
 calibrated camera (:class:`startrack.camera_fit.CameraCalibration`) with its sigma.
 
@@ -34,8 +35,10 @@ from startrack.units import DEG
 
 #: Default acceptance threshold of the false-match probability.
 DEFAULT_THRESHOLD = 1e-6
-#: Combinations searched per compiled call between two looks at the clock.
+#: Most combinations searched per compiled call between two looks at the clock.
 CHUNK = 48
+#: Most hypotheses verified per compiled call.
+MAX_TRIED = 1000
 #: Cells of the detection-density grid along each image axis.
 DENSITY_CELLS = 8
 #: Detections and predicted stars of the first verification pass.
@@ -161,17 +164,27 @@ class PlateSolver:
                        f"({tried} hypotheses)", start)
 
     def _search(self, frame, region, start):
-        """(verify_calibrate's tuple, hypotheses verified, combinations searched) of the compiled search in
-        chunks of :data:`CHUNK` combinations, stopped by the time budget."""
+        """(verify_calibrate's tuple, hypotheses verified, combinations searched) of the compiled search,
+        stopped by the time budget.  Each call's work is sized from the pace measured so far, to a quarter
+        of the budget left: its combinations (one at first, at most :data:`CHUNK`) and the hypotheses it may
+        verify (one at first; a crowded frame verifies many per combination, ~10 ms each), so that the
+        budget is overrun by at most about one hypothesis's verification or one combination's look-ups."""
         uv, sigma, candidates, order, focal, f_range, params, settings, n_hypotheses = frame
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
-        done, tried = 0, 0
+        done, skip, tried, chunk, cap = 0, 0, 0, 1, 1
         while done < n_combinations:
-            result, count, done = search(uv, sigma, candidates, done, done + CHUNK, self._arrays, order, focal,
-                                         self.vectors, f_range, params, region, self.field, settings, n_hypotheses)
+            begin, first = time.perf_counter(), done
+            result, count, done, skip = search(uv, sigma, candidates, done, done + chunk, skip, cap, self._arrays, order,
+                                               focal, self.vectors, f_range, params, region, self.field, settings,
+                                               n_hypotheses)
             tried += count
-            if result[0] or time.perf_counter() - start > self.time_budget_s:
+            now = time.perf_counter()
+            if result[0] or now - start > self.time_budget_s:
                 return result, tried, done
+            left = 0.25 * (self.time_budget_s - (now - start))
+            chunk = int(np.clip(left * max(done - first, 1) / max(now - begin, 1e-9), 1, CHUNK))
+            if count:
+                cap = int(np.clip(left * count / max(now - begin, 1e-9), 1, MAX_TRIED))
         return result, tried, done
 
     # ------------------------------------------------------------------ internals

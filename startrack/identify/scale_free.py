@@ -20,8 +20,10 @@ with star n + 1 (:data:`COMBINATIONS`) -- and each is looked up in every level o
 6. :func:`startrack.identify.self_calibration.verify_calibrate`; the first accepted hypothesis ends
    the search.
 
-One compiled call searches the combinations [start, stop); the caller checks the time budget between
-calls.  N_h, the hypotheses the search can make, counts every combination of the candidates times
+One compiled call searches the combinations [start, stop), from candidate ``skip`` of the first, and
+returns after at most ``max_tried`` verified hypotheses with the place to resume (the same order of
+hypotheses whatever the calls' sizes); the caller checks the time budget between calls.  N_h, the
+hypotheses the search can make, counts every combination of the candidates times
 the expected catalog candidates per look-up of each level (:func:`expected_candidates`).
 """
 
@@ -223,17 +225,18 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
 
 
 @njit
-def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal, vectors, f_range, camera, region,
-           field, settings, n_hypotheses):  # pragma: no cover  (compiled)
-    """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text);
-    the catalog candidates of a combination are verified in order of their ratio mismatch.
+def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, level_order, level_focal, vectors, f_range,
+           camera, region, field, settings, n_hypotheses):  # pragma: no cover  (compiled)
+    """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text),
+    the first from its ``skip``-th catalog candidate; the catalog candidates of a combination are verified
+    in order of their ratio mismatch, at most ``max_tried`` of them in this call.
 
     uv (n, 2), sigma (n,): detections brightest first [px]; ``levels``: tuple of
     :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`, looked up in ``level_order`` with
     the focal lengths ``level_focal`` [px]; ``vectors`` the pattern stars' unit vectors; f_range (2,)
     [px]; ``camera`` (f, cx, cy, W, H, k1, k2, circular) the start of the calibration (f replaced);
-    ``region`` for :func:`_gather`.  Returns (verify_calibrate's tuple, hypotheses verified, next
-    combination)."""
+    ``region`` for :func:`_gather`.  Returns (verify_calibrate's tuple, hypotheses verified, the
+    combination and candidate to resume at)."""
     cx, cy = camera[1], camera[2]
     near = np.empty(field[0].shape[0], np.int64)
     stars = np.empty(4, np.int64)
@@ -250,7 +253,9 @@ def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal,
                 largest_px = max(largest_px, math.hypot(uv[stars[i], 0] - uv[stars[j], 0], uv[stars[i], 1] - uv[stars[j], 1]))
         count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors,
                                           cx, cy, region, found)
-        for k in argsort(mismatch):
+        ranked = argsort(mismatch)
+        for n in range(skip if c == start else 0, ranked.size):
+            k = ranked[n]
             l, eps = found[k, 0], eps_of[k]
             cat = levels[l][0][found[k, 1]]
             ok, R_IS, focal = _hypothesis(uv, stars, cat, vectors, cx, cy, level_focal[l], f_range, eps)
@@ -264,8 +269,10 @@ def search(uv, sigma, candidates, start, stop, levels, level_order, level_focal,
             params[0] = focal
             result = verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypotheses)
             if result[0]:
-                return result, tried, c + 1
-    return _nothing(camera), tried, stop
+                return result, tried, c + 1, 0
+            if tried >= max_tried:
+                return _nothing(camera), tried, c, n + 1
+    return _nothing(camera), tried, stop, 0
 
 
 @njit

@@ -70,3 +70,47 @@ def test_uniform_background_detection_is_unchanged_by_a_given_level():
     given = detect(frame, background=sensor.background_dn, sigma_n=sensor.noise_dn)
     assert given.background == sensor.background_dn and given.sigma_n == sensor.noise_dn
     assert len(given) >= 15
+
+
+def _gaussian(shape, u, v, sigma_u, sigma_v, peak):
+    rows, cols = np.mgrid[0:shape[0], 0:shape[1]]
+    return peak * np.exp(-0.5 * (((cols - u) / sigma_u) ** 2 + ((rows - v) / sigma_v) ** 2))
+
+
+def test_second_moments_give_a_gaussian_image_its_sigma_and_axis_ratio():
+    """Noise 1 DN, peaks 1e5 DN: the threshold cuts the wings beyond ~4.3 sigma, so the moments give sigma and
+    the axis ratio to within 1 %."""
+    rng = np.random.default_rng(34)
+    frame = 100.0 + _gaussian((200, 300), 80.3, 100.6, 2.0, 2.0, 1e5) + _gaussian((200, 300), 200.2, 90.1, 3.0, 1.0, 1e5)
+    found = detect(frame + rng.normal(0.0, 1.0, frame.shape), background=100.0, sigma_n=1.0)
+    round_ = int(np.argmin(np.hypot(found.u - 80.3, found.v - 100.6)))
+    long_ = 1 - round_
+    assert len(found) == 2 and found.size[round_] == pytest.approx(2.0, rel=0.01)
+    assert found.elongation[round_] == pytest.approx(1.0, abs=0.01)
+    assert found.size[long_] == pytest.approx(np.sqrt((9.0 + 1.0) / 2.0), rel=0.01)
+    assert found.elongation[long_] == pytest.approx(3.0, rel=0.01)
+
+
+def test_streaks_and_cloud_lumps_are_extended_stars_even_saturated_are_not():
+    """60 stars (PSF sigma 0.8 px, 8 of them 20-200 times the saturation level), a satellite streak across
+    the frame, three aircraft dashes (sigma 6 x 0.8 px) and three lumps of lit cloud (sigma 12 px): every
+    streak, dash and lump is flagged ``extended``, no star is, and reject_extended drops exactly those."""
+    sensor = SensorModel()
+    rng = np.random.default_rng(35)
+    uv = rng.uniform(40, 472, (60, 2))
+    flux = np.r_[rng.uniform(2e3, 5e4, 52), rng.uniform(20.0, 200.0, 8) * 2 * np.pi * 0.8**2 * sensor.full_well_e]
+    frame = render(sensor, 512, 512, [Sources(uv, flux, 0.8)], rng).astype(float)
+    rows, cols = np.mgrid[0:512, 0:512]
+    streak = np.where((rows > 20) & (rows < 490), 150.0 * np.exp(-0.5 * (cols - 256.0) ** 2), 0.0)
+    shape = frame.shape
+    dashes = sum(_gaussian(shape, u, v, 6.0, 0.8, 600.0) for u, v in ((100.0, 60.0), (160.0, 200.0), (420.0, 330.0)))
+    lumps = sum(_gaussian(shape, u, v, 12.0, 12.0, 300.0) for u, v in ((80.0, 420.0), (330.0, 120.0), (440.0, 460.0)))
+    frame = np.minimum(frame + streak + dashes + lumps, sensor.saturation_dn)
+    found = detect(frame, mesh_px=64, saturation_dn=sensor.saturation_dn)
+    is_star = np.array([np.min(np.hypot(*(uv - p).T)) < 1.5 and abs(p[0] - 256.0) > 6 for p in found.uv])
+    assert np.count_nonzero(is_star & found.saturated) >= 6
+    assert not found.extended[is_star].any()
+    objects = ~is_star & (found.npix >= 30)  # the streak, dashes and lumps; the rest: noise around the lumps
+    assert found.extended[objects].all() and np.count_nonzero(objects) == 7
+    kept = detect(frame, mesh_px=64, saturation_dn=sensor.saturation_dn, reject_extended=True)
+    assert len(kept) == np.count_nonzero(~found.extended)

@@ -31,7 +31,8 @@ REFERENCE = json.loads((DATA / "reference.json").read_text())
 JUDGED_BY_STARS = "2019-07-29T204726_Alt40_Azi45_Try1"
 #: Detection as ``startrack solve`` does it by default (mesh background, single pixels dropped, full scale).
 DETECTION = {"background": None, "sigma_n": None, "a": 5.0, "centroider": "threshold", "min_pixels": 1,
-             "mesh_px": 64, "reject_single_pixels": True, "saturation_dn": None}
+             "mesh_px": 64, "reject_single_pixels": True, "reject_extended": True,
+             "saturation_dn": None}
 #: Fixed single-pixel spots of this camera (seen in 3 or more of the 8 frames).
 HOT_PIXELS = {(25, 188), (286, 554), (339, 561), (371, 595), (449, 461), (452, 110), (508, 495), (540, 256),
               (636, 392), (639, 206), (675, 135), (715, 648), (753, 582), (878, 137)}
