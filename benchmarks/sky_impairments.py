@@ -30,6 +30,8 @@ WIDTH, HEIGHT = 1024, 768
 #: The night sky of every scene [e-/px/s]: faint, but trees are darker.
 SKY_E_PER_S = 200.0
 K1_MAX = 0.1
+#: Blur of the out-of-focus trees' silhouette [px] (sigma).
+TREE_BLUR_PX = 3.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -177,15 +179,17 @@ def defocus(exposure, level, rng):
 
 def trees(exposure, level, rng):
     """Tree silhouettes from the bottom over a fraction ``level`` of the frame: crowns of random height,
-    ragged edges and gaps of sky between branches; no starlight and no sky inside."""
+    ragged edges and gaps of sky between branches; no starlight and no sky inside.  The trees are out of
+    focus (a lens focused at infinity blurs a tree 20 m away over ~10 px): the silhouette's edges are
+    softened by a Gaussian of :data:`TREE_BLUR_PX`."""
     profile = level * HEIGHT * (1.0 + 0.35 * _smooth_field(rng, 6)[0] + 0.08 * rng.standard_normal(WIDTH))
     _, v = _grid()
     foreground = v > HEIGHT - profile[None, :]
     gaps = _smooth_field(rng, 60) > 1.6
     crown = v > HEIGHT - profile[None, :] + 0.25 * profile[None, :]
-    mask = foreground & ~(gaps & ~crown)
-    exposure.transmission = exposure.transmission * np.where(mask, 0.0, 1.0)
-    exposure.sky_e = np.where(mask, 0.0, exposure.sky_e)
+    clear = 1.0 - ndimage.gaussian_filter((foreground & ~(gaps & ~crown)).astype(float), TREE_BLUR_PX)
+    exposure.transmission = exposure.transmission * clear
+    exposure.sky_e = exposure.sky_e * clear
 
 
 def jpeg(exposure, level, rng):

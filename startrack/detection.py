@@ -15,14 +15,22 @@ Pipeline (one pass, vectorised):
    ``extended``;
 5. optionally, components flagged ``single_pixel`` or ``extended`` are dropped.
 
-Single-pixel events (hot pixels, cosmic-ray hits, JPEG block noise): the optics spread a star over
-several pixels, so the 8 pixels around a star's peak hold a large fraction of the peak's own excess --
-their sum R (the ring, background removed) is at least ~1.5 times it for a Gaussian PSF of sigma >=
-0.6 px centred on the pixel (more for other pixel phases) and 0.6 times it at sigma = 0.4 px.  The
-frame's own stars set the cut (:func:`_ring_cut`: half the median ratio of its bright detections,
-at least :data:`MIN_RING_RATIO`); a detection whose ring ratio R / (I_peak - b) lies below the cut by
-more than 3 times its noise (sqrt(8) sigma_n / (I_peak - b)) is flagged: at high SNR a hot pixel is
-told from a star with certainty, near the threshold the test keeps the detection.
+Single-pixel events (hot pixels and adjacent pairs of them, cosmic-ray hits, JPEG block noise): the
+optics spread a star over several pixels and in every direction, so the 8 pixels around a star's peak
+hold a large fraction of the peak's own excess even without the brightest of them -- the sum R of the
+other 7 (the ring, background removed) is at least 1.7 times it for a Gaussian PSF of sigma = 0.67 px,
+0.8 times at 0.5 px and 0.4 times at 0.4 px, whatever the pixel phase (pixel-integrated PSF), while a
+hot pixel has none and a pair of hot pixels (a few hundred of them among 10 000 hot pixels of a
+1024 x 768 sensor) only its twin, which is the pixel left out.  The frame's own stars set the cut
+(:func:`_ring_cut`: half the median ratio of its bright detections, at least :data:`MIN_RING_RATIO`);
+a detection whose ring ratio R / (I_peak - b) lies below the cut by more than 3 times its noise
+(sqrt(7) sigma_n / (I_peak - b)) is flagged: at high SNR a hot pixel is told from a star with
+certainty, near the threshold the test keeps the detection.  Clusters of three or more hot pixels pass
+that test but not another: a star whose peak reaches the saturation level S covers 2 pi sigma^2
+ln((S - b)/(V_th - b)) pixels above the threshold (a Gaussian image: ~14 px for sigma = 0.67 px on a
+12-bit frame); a saturated detection of fewer than half of them, with sigma the frame's star size
+(below, an underestimate: the margin grows), is flagged ``single_pixel`` too.  (A hot pixel that
+touches a star still takes the star with it: the component's peak is the hot pixel.)
 
 Extended detections (clouds lit from below, satellite and aircraft streaks, nebulae): a star is the
 image of a point, as large as the frame's other stars and round.  The second moments of the
@@ -54,7 +62,7 @@ from startrack.errors import InputError
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 #: Smallest ring ratio of a star image (module text).
-MIN_RING_RATIO = 0.4
+MIN_RING_RATIO = 0.3
 #: Largest axis ratio of a star image; fewest pixels that measure it (module text).
 MAX_ELONGATION, MIN_SHAPE_PIXELS = 3.0, 10
 #: Largest size of a star image over the median of the frame's bright stars (module text).
@@ -229,15 +237,18 @@ def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, mi
     saturated = peak >= saturation_dn if saturation_dn is not None else np.zeros(n, dtype=bool)
     with np.errstate(divide="ignore", invalid="ignore"):
         snr = np.where(s_peak > 0, (peak - b_peak) / s_peak, np.inf)
-        single = np.zeros(n, dtype=bool)
-        if ring is not None:
-            excess = peak - b_peak
-            ratio = (ring(peaks) - 8.0 * b_peak) / excess
-            single = ratio < _ring_cut(ratio, snr, npix, saturated) - 3.0 * np.sqrt(8.0) * s_peak / excess
     size, elongation = _shape(index, n, values - background, u_coord, v_coord)
+    star_size = _star_size(size, snr, saturated, npix)
+    single = np.zeros(n, dtype=bool)
+    if ring is not None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            excess = peak - b_peak
+            ratio = (ring(peaks) - 7.0 * b_peak) / excess
+            single = ratio < _ring_cut(ratio, snr, npix, saturated) - 3.0 * np.sqrt(7.0) * s_peak / excess
+        if saturation_dn is not None:
+            single |= saturated & (npix < _saturated_pixels(star_size, saturation_dn - b_peak, _at(threshold, peaks) - b_peak))
     with np.errstate(invalid="ignore"):
-        extended = ((elongation > MAX_ELONGATION) & (npix >= MIN_SHAPE_PIXELS)) | (
-            size > EXTENDED_SIZE * _star_size(size, snr, saturated, npix))
+        extended = ((elongation > MAX_ELONGATION) & (npix >= MIN_SHAPE_PIXELS)) | (size > EXTENDED_SIZE * star_size)
     keep = np.flatnonzero(npix >= min_pixels)
     keep = keep[np.argsort(-flux[keep], kind="stable")]
     summary = (float(np.median(level)) for level in levels)
@@ -262,6 +273,16 @@ def _shape(index, n, excess, u_coord, v_coord):
     return size, elongation
 
 
+def _saturated_pixels(star_size, saturation_excess, threshold_excess):
+    """Fewest pixels of a saturated star image (module text): half the 2 pi s^2 ln((S - b)/(V_th - b)) pixels
+    above the threshold of a Gaussian image of the frame's star size s [px] whose peak reaches S; 0 when the
+    frame has no star size."""
+    if not np.isfinite(star_size):
+        return 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 0.5 * 2.0 * np.pi * star_size**2 * np.log(np.maximum(saturation_excess / threshold_excess, 1.0))
+
+
 def _star_size(size, snr, saturated, npix):
     """Median size [px] of the frame's bright (SNR >= 20) unsaturated detections of 2 pixels or more when
     there are 5 of them, else infinite (no size cut)."""
@@ -271,8 +292,8 @@ def _star_size(size, snr, saturated, npix):
 
 def _ring_cut(ratio, snr, npix, saturated):
     """Smallest ring ratio of a star in this frame: half the median ratio of its bright (SNR >= 20),
-    unsaturated detections of 2 pixels or more when there are 5 of them -- a star centred on a pixel has
-    the smallest ratio, about 0.8 times the median over pixel phases -- within [MIN_RING_RATIO, 1.5]."""
+    unsaturated detections of 2 pixels or more when there are 5 of them -- the smallest ratio over pixel
+    phases is 0.7-0.95 times the median (sigma 0.4-0.67 px) -- within [MIN_RING_RATIO, 1.5]."""
     bright = (snr >= 20.0) & (npix >= 2) & ~saturated
     if np.count_nonzero(bright) < 5:
         return MIN_RING_RATIO
@@ -326,20 +347,23 @@ def _centroider(centroider):
 
 
 def _ring_sums(array):
-    """ring(peaks_rc) -> sum of the (up to) 8 pixels around each peak (row, col), scaled to 8 at the border."""
+    """ring(peaks_rc) -> sum of the (up to) 8 pixels around each peak (row, col) but the brightest of them,
+    scaled to 7 pixels at the border."""
     height, width = array.shape
 
     def ring(rows, cols):
-        total, count = np.zeros(rows.size), np.zeros(rows.size)
+        total, count, brightest = np.zeros(rows.size), np.zeros(rows.size), np.full(rows.size, -np.inf)
         for dr in (-1, 0, 1):
             for dc in (-1, 0, 1):
                 if dr == 0 and dc == 0:
                     continue
                 r, c = rows + dr, cols + dc
                 inside = (r >= 0) & (r < height) & (c >= 0) & (c < width)
-                total[inside] += array[r[inside], c[inside]].astype(float)
+                value = array[r[inside], c[inside]].astype(float)
+                total[inside] += value
+                brightest[inside] = np.maximum(brightest[inside], value)
                 count += inside
-        return total * 8.0 / np.maximum(count, 1.0)
+        return (total - brightest) * 7.0 / np.maximum(count - 1.0, 1.0)
 
     return ring
 

@@ -114,3 +114,23 @@ def test_streaks_and_cloud_lumps_are_extended_stars_even_saturated_are_not():
     assert found.extended[objects].all() and np.count_nonzero(objects) == 7
     kept = detect(frame, mesh_px=64, saturation_dn=sensor.saturation_dn, reject_extended=True)
     assert len(kept) == np.count_nonzero(~found.extended)
+
+
+@pytest.mark.parametrize("psf_sigma_px", [0.45, 0.671, 1.2])
+def test_pairs_of_hot_pixels_are_single_pixel_events_too(psf_sigma_px):
+    """40 pairs of adjacent hot pixels (side by side or diagonal, saturated or 20 % of it) among 80 stars of SNR
+    20-2000: each pair is flagged, no star is -- the ring without its brightest pixel (the twin) holds no light."""
+    sensor = SensorModel(psf_sigma_px=psf_sigma_px)
+    rng = np.random.default_rng(36)
+    uv = rng.uniform(20, 492, (80, 2))
+    frame = render(sensor, 512, 512, [Sources(uv, rng.uniform(2e3, 2e5, 80), psf_sigma_px)], rng).astype(float)
+    hot, steps = rng.integers(10, 500, (40, 2)), np.array([(1, 0), (0, 1), (1, 1), (-1, 1)])[rng.integers(0, 4, 40)]
+    far = np.array([np.min(np.hypot(*(uv - h).T)) > 6 for h in hot])
+    for (col, row), (dc, dr), level in zip(hot[far], steps[far], rng.choice([1.0, 0.2], 40)):
+        frame[[row, row + dr], [col, col + dc]] = sensor.bias_dn + level * (sensor.saturation_dn - sensor.bias_dn)
+    found = detect(frame, mesh_px=64, saturation_dn=sensor.saturation_dn)
+    pairs = hot[far] + 0.5 * steps[far]
+    is_hot = np.array([np.min(np.hypot(*(pairs - p).T)) < 1.0 for p in found.uv])  # two pairs may touch
+    is_star = np.array([np.min(np.hypot(*(uv - p).T)) < 1.0 for p in found.uv])
+    assert np.count_nonzero(is_hot) >= np.count_nonzero(far) - 2 and found.single_pixel[is_hot].all()
+    assert is_star.sum() >= 60 and not found.single_pixel[is_star].any()
