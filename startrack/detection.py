@@ -229,7 +229,8 @@ def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, mi
     v = np.bincount(index, weights=weights * v_coord, minlength=n) / wsum
     sigma_u = _centroid_sigma(index, n, u_coord, u, npix, wsum, sigma_n)
     sigma_v = _centroid_sigma(index, n, v_coord, v, npix, wsum, sigma_n)
-    flux = np.bincount(index, weights=values - background, minlength=n)
+    light = values - background
+    flux = np.bincount(index, weights=light, minlength=n)
     peaks = _peak_pixels(values, index, n)
     peak = values[peaks]
     b_peak, s_peak = _at(background, peaks), _at(sigma_n, peaks)
@@ -237,7 +238,7 @@ def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, mi
     saturated = peak >= saturation_dn if saturation_dn is not None else np.zeros(n, dtype=bool)
     with np.errstate(divide="ignore", invalid="ignore"):
         snr = np.where(s_peak > 0, (peak - b_peak) / s_peak, np.inf)
-    size, elongation = _shape(index, n, values - background, u_coord, v_coord)
+    size, elongation = _shape(index, n, light, u_coord, v_coord)
     star_size = _star_size(size, snr, saturated, npix)
     single = np.zeros(n, dtype=bool)
     if ring is not None:
@@ -280,21 +281,26 @@ def _saturated_pixels(star_size, saturation_excess, threshold_excess):
     if not np.isfinite(star_size):
         return 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        return 0.5 * 2.0 * np.pi * star_size**2 * np.log(np.maximum(saturation_excess / threshold_excess, 1.0))
+        return np.pi * star_size**2 * np.log(np.maximum(saturation_excess / threshold_excess, 1.0))  # half of 2 pi s^2 ln
 
 
 def _star_size(size, snr, saturated, npix):
     """Median size [px] of the frame's bright (SNR >= 20) unsaturated detections of 2 pixels or more when
     there are 5 of them, else infinite (no size cut)."""
-    bright = (snr >= 20.0) & (npix >= 2) & ~saturated & np.isfinite(size)
+    bright = _bright(snr, npix, saturated) & np.isfinite(size)
     return float(np.median(size[bright])) if np.count_nonzero(bright) >= 5 else np.inf
+
+
+def _bright(snr, npix, saturated):
+    """The detections that show the frame's star image: SNR >= 20, 2 pixels or more, unsaturated."""
+    return (snr >= 20.0) & (npix >= 2) & ~saturated
 
 
 def _ring_cut(ratio, snr, npix, saturated):
     """Smallest ring ratio of a star in this frame: half the median ratio of its bright (SNR >= 20),
     unsaturated detections of 2 pixels or more when there are 5 of them -- the smallest ratio over pixel
     phases is 0.7-0.95 times the median (sigma 0.4-0.67 px) -- within [MIN_RING_RATIO, 1.5]."""
-    bright = (snr >= 20.0) & (npix >= 2) & ~saturated
+    bright = _bright(snr, npix, saturated)
     if np.count_nonzero(bright) < 5:
         return MIN_RING_RATIO
     return float(np.clip(0.5 * np.median(ratio[bright]), MIN_RING_RATIO, 1.5))
