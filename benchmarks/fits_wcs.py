@@ -29,7 +29,7 @@ from startrack.camera import Camera
 from startrack.rotation import from_rotation_vector, to_matrix
 from startrack.sphere import vector_to_radec
 from startrack.units import DEG
-from startrack.wcs import tan_sip
+from startrack.wcs import frame_wcs
 
 HERE = Path(__file__).resolve().parent
 CAMERAS = {"pinhole 12 deg": (12.0, 0.0, 0.0), "pincushion 20 deg": (20.0, 0.05, 0.0),
@@ -47,7 +47,7 @@ def compare(work, fov_deg, k1, k2, rotation):
     """(SIP order, largest wcs-xy2rd miss of the camera model ["], largest wcs-rd2xy miss of the pixel [px])."""
     camera = Camera.from_fov(fov_deg * DEG, 1600, 1200, cx=810.3, cy=590.7, k1=k1, k2=k2)
     q = from_rotation_vector(np.array(rotation))
-    solution = tan_sip(camera, q)
+    solution = frame_wcs(camera, q)
     wcs = work / "frame.wcs"
     fits.PrimaryHDU(header=fits.Header(solution.cards())).writeto(wcs, overwrite=True)
     rng = np.random.default_rng(0)

@@ -21,6 +21,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.detection": ("Detections", "detect", "detect_windows"),
     "startrack.errors": ("InputError",),
     "startrack.fov_select": ("field_radius", "radec_prefilter"),
+    "startrack.gaia_catalog": ("load_gaia_catalog",),
     "startrack.identify": ("IdentificationResult", "PlateSolver", "Prior", "StarIdentifier"),
     "startrack.image_io": ("read_frame", "read_image", "write_image"),
     "startrack.kvector": ("KVector",),

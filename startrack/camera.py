@@ -1,4 +1,4 @@
-"""Pinhole camera of the star sensor with radial distortion (k1, k2).
+"""Camera of the star sensor: a pinhole or a fisheye projection with radial distortion (k1, k2).
 
 Frame convention (docs/design.md, binding):
 
@@ -8,9 +8,13 @@ Frame convention (docs/design.md, binding):
 * Image coordinates (u, v) in pixels, origin at the *centre* of the top-left
   pixel, so pixel (row r, column c) covers u in [c - 1/2, c + 1/2] and v in
   [r - 1/2, r + 1/2]; the principal point defaults to ((W-1)/2, (H-1)/2).
-* Ideal pinhole: x_n = x/z, y_n = y/z (normalised, tangent-plane coordinates),
-  u = cx + f x_n, v = cy + f y_n with f the focal length in pixels.
-* Radial distortion (Brown's polynomial, even terms; Brown 1971):
+* Projection: a direction at angle theta from the boresight and azimuth phi has the normalised ideal
+  coordinates (x_n, y_n) = R(theta) (cos phi, sin phi), and u = cx + f x_n, v = cy + f y_n with f the
+  focal length in pixels.  ``pinhole`` (gnomonic): R = tan theta, i.e. x_n = x/z, y_n = y/z (tangent-plane
+  coordinates); ``fisheye`` (equidistant): R = theta, the model of Kannala & Brandt (2006) whose radial
+  terms below also reach the equisolid (2 sin(theta/2) = theta (1 - theta^2/24 + ...)), stereographic
+  and orthographic lenses; it images fields up to and beyond 180 deg.
+* Radial distortion (Brown's polynomial, even terms; Brown 1971; Kannala & Brandt's for the fisheye):
   (x_d, y_d) = (x_n, y_n) (1 + k1 r^2 + k2 r^4), r^2 = x_n^2 + y_n^2, and
   u = cx + f x_d, v = cy + f y_d.  The inverse is solved for the radius by
   Newton's method to machine precision; the constructor refuses (k1, k2)
@@ -21,7 +25,7 @@ Frame convention (docs/design.md, binding):
   rotates S-frame vectors into the inertial frame I: v_I = R_IS v_S
   (boresight RA/Dec/roll conversions in :mod:`startrack.attitude_angles`).
 * Field of view: ``fov_x`` is the full angle across the image width,
-  f = (W/2) / tan(fov_x/2).  With ``circular_fov`` the field is the cone of
+  f = (W/2) / R(fov_x/2) (R = tan for the pinhole).  With ``circular_fov`` the field is the cone of
   half-angle fov_x/2 (the circle inscribed in the width, as in 000 and 004),
   intersected with the image; otherwise the image rectangle.
 """
@@ -38,6 +42,44 @@ from startrack.rotation import from_rotation_vector, to_matrix
 
 #: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
 _NEWTON_ITERATIONS = 12
+#: The projections, in the order of their code in the compiled kernels' camera arrays (index 8).
+PROJECTIONS = ("pinhole", "fisheye")
+
+
+def radius_of_angle(theta, projection="pinhole"):
+    """Ideal normalised radius R(theta) of directions ``theta`` [rad] off the axis (module text)."""
+    return np.tan(theta) if projection == "pinhole" else np.asarray(theta, dtype=float)
+
+
+def angle_of_radius(radius, projection="pinhole"):
+    """Angle off the axis [rad] of ideal normalised radii (the inverse of :func:`radius_of_angle`)."""
+    return np.arctan(radius) if projection == "pinhole" else np.asarray(radius, dtype=float)
+
+
+def ideal_coordinates(v_S, projection="pinhole"):
+    """(x_n, y_n) (..., 2) of directions ``v_S`` (..., 3) in S and the mask of those the projection images
+    (pinhole: z > 0; fisheye: all but the -z axis); NaN where it does not (module text)."""
+    v_S = np.asarray(v_S, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if projection == "pinhole":
+            front = v_S[..., 2] > 0.0
+            return v_S[..., :2] / np.where(front, v_S[..., 2], np.nan)[..., None], front
+        rho = np.hypot(v_S[..., 0], v_S[..., 1])
+        theta = np.arctan2(rho, v_S[..., 2])
+        front = theta < np.pi
+        scale = np.where(rho > 0.0, theta / np.where(rho > 0.0, rho, 1.0), 1.0 / np.abs(v_S[..., 2]))
+        return v_S[..., :2] * np.where(front, scale, np.nan)[..., None], front
+
+
+def ray(xy_n, projection="pinhole"):
+    """Unit vectors (..., 3) in S of normalised ideal coordinates (..., 2) (inverse of :func:`ideal_coordinates`)."""
+    xy_n = np.asarray(xy_n, dtype=float)
+    if projection == "pinhole":
+        v = np.concatenate([xy_n, np.ones(xy_n.shape[:-1] + (1,))], axis=-1)
+        return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    theta = np.hypot(xy_n[..., 0], xy_n[..., 1])
+    sinc = np.where(theta > 0.0, np.sin(theta) / np.where(theta > 0.0, theta, 1.0), 1.0)
+    return np.concatenate([xy_n * sinc[..., None], np.cos(theta)[..., None]], axis=-1)
 
 
 def fold_radius_squared(k1, k2):
@@ -76,22 +118,26 @@ def _ideal_scale(rd, k1, k2):
     return np.where(rd > 0.0, r / np.where(rd > 0.0, rd, 1.0), 1.0)
 
 
-def width_angle(focal_px, cx, cy, k1, k2, width, height):
+def width_angle(focal_px, cx, cy, k1, k2, width, height, projection="pinhole"):
     """Angle [rad] the image width subtends through its middle row, between the outer edges of its end
-    pixels, distortion removed (broadcasts over the camera parameters: one call for many cameras)."""
+    pixels, distortion removed: the angles from each end to the row's point below the principal point, summed
+    (the row is a great circle of a pinhole; a fisheye's field may pass 180 deg); broadcasts over the camera
+    parameters: one call for many cameras."""
     middle = (height - 1) / 2.0
-    ends = []
-    for u in (-0.5, width - 0.5):
+    points = []
+    for u in (-0.5, cx, width - 0.5):
         x_d, y_d = np.broadcast_arrays((u - np.asarray(cx, float)) / focal_px, (middle - np.asarray(cy, float)) / focal_px)
         scale = _ideal_scale(np.hypot(x_d, y_d), k1, k2)
-        ends.append(np.stack([x_d * scale, y_d * scale, np.ones_like(x_d)], axis=-1))
-    left, right = ends
-    return np.arctan2(np.linalg.norm(np.cross(left, right), axis=-1), np.sum(left * right, axis=-1))
+        points.append(ray(np.stack([x_d * scale, y_d * scale], axis=-1), projection))
+    left, centre, right = points
+    return sum(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+               for a, b in ((left, centre), (centre, right)))
 
 
 @dataclass(frozen=True)
 class Camera:
-    """Pinhole camera: W x H pixels, focal length in pixels, principal point, k1, k2."""
+    """Camera: W x H pixels, focal length in pixels, principal point, k1, k2, ``projection`` (one of
+    :data:`PROJECTIONS`)."""
 
     width: int
     height: int
@@ -101,6 +147,7 @@ class Camera:
     k1: float = 0.0
     k2: float = 0.0
     circular_fov: bool = False
+    projection: str = "pinhole"
 
     def __post_init__(self):
         for name in ("width", "height"):
@@ -118,15 +165,19 @@ class Camera:
                 raise InputError(f"camera {name} must be finite, got {getattr(self, name)!r}")
         object.__setattr__(self, "k1", float(self.k1))
         object.__setattr__(self, "k2", float(self.k2))
+        if self.projection not in PROJECTIONS:
+            raise InputError(f"camera projection {self.projection!r} is not one of {', '.join(PROJECTIONS)}")
         self._check_distortion_monotonic()
 
     # ----------------------------------------------------------------- constructors
     @classmethod
-    def from_fov(cls, fov_x_rad, width, height, **kw):
-        """Camera whose full field across the width is ``fov_x_rad``: f = (W/2)/tan(fov_x/2)."""
-        if not 0 < fov_x_rad < np.pi:
-            raise InputError(f"field of view must be in (0, 180) deg, got {np.degrees(fov_x_rad)!r} deg")
-        return cls(width, height, (width / 2.0) / np.tan(fov_x_rad / 2.0), **kw)
+    def from_fov(cls, fov_x_rad, width, height, projection="pinhole", **kw):
+        """Camera whose full field across the width is ``fov_x_rad``: f = (W/2)/R(fov_x/2)."""
+        top = np.pi if projection == "pinhole" else 2.0 * np.pi
+        if not 0 < fov_x_rad < top:
+            raise InputError(f"field of view must be in (0, {np.degrees(top):g}) deg for a {projection} camera, got "
+                             f"{np.degrees(fov_x_rad)!r} deg")
+        return cls(width, height, (width / 2.0) / radius_of_angle(fov_x_rad / 2.0, projection), projection=projection, **kw)
 
     @classmethod
     def from_file(cls, path):
@@ -148,25 +199,26 @@ class Camera:
     # ----------------------------------------------------------------- field
     @property
     def fov_x(self):
-        """Full field angle across the width [rad] (pinhole, undistorted)."""
-        return 2.0 * np.arctan(self.width / (2.0 * self.focal_px))
+        """Full field angle across the width [rad] (undistorted)."""
+        return 2.0 * float(angle_of_radius(self.width / (2.0 * self.focal_px), self.projection))
 
     @property
     def fov_y(self):
         """Full field angle across the height [rad]."""
-        return 2.0 * np.arctan(self.height / (2.0 * self.focal_px))
+        return 2.0 * float(angle_of_radius(self.height / (2.0 * self.focal_px), self.projection))
 
     @functools.cached_property
     def angular_width(self):
         """Angle [rad] the image width subtends through its middle row (outer pixel edges, distortion
         included): the field of view a plate solver measures; fov_x for an undistorted camera with its
         principal point at the centre (:func:`width_angle`)."""
-        return float(width_angle(self.focal_px, self.cx, self.cy, self.k1, self.k2, self.width, self.height))
+        return float(width_angle(self.focal_px, self.cx, self.cy, self.k1, self.k2, self.width, self.height,
+                                 self.projection))
 
     @property
     def fov_diagonal(self):
         """Full field angle across the diagonal [rad]."""
-        return 2.0 * np.arctan(np.hypot(self.width, self.height) / (2.0 * self.focal_px))
+        return 2.0 * float(angle_of_radius(np.hypot(self.width, self.height) / (2.0 * self.focal_px), self.projection))
 
     # ----------------------------------------------------------------- distortion
     def _radial_factor(self, r2):
@@ -208,10 +260,8 @@ class Camera:
 
     # ----------------------------------------------------------------- projection
     def _project(self, v_S):
-        """(uv, normalised ideal x_n y_n, in-front mask) of directions (N,3) in S; NaN behind the lens."""
-        front = v_S[:, 2] > 0.0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xy_n = v_S[:, :2] / np.where(front, v_S[:, 2], np.nan)[:, None]
+        """(uv, normalised ideal x_n y_n, imaged mask) of directions (N,3) in S; NaN where not imaged."""
+        xy_n, front = ideal_coordinates(v_S, self.projection)
         return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy]), xy_n, front
 
     def project_body(self, vectors_S):
@@ -219,7 +269,7 @@ class Camera:
 
         visible: in front of the lens (z > 0), inside the image (pixel edges
         included) and, for a circular field, within fov_x/2 of the boresight.
-        Points behind the lens get NaN coordinates.
+        Points the projection does not image (behind a pinhole) get NaN coordinates.
         """
         v = np.atleast_2d(np.asarray(vectors_S, dtype=float))
         if v.ndim != 2 or v.shape[1] != 3:
@@ -244,9 +294,7 @@ class Camera:
         uv = np.atleast_2d(np.asarray(uv, dtype=float))
         if uv.ndim != 2 or uv.shape[1] != 2:
             raise InputError(f"image points must have shape (N, 2), got {uv.shape}")
-        xy_n = self.undistort((uv - np.array([self.cx, self.cy])) / self.focal_px)
-        v = np.concatenate([xy_n, np.ones((len(uv), 1))], axis=1)
-        return v / np.linalg.norm(v, axis=1, keepdims=True)
+        return ray(self.undistort((uv - np.array([self.cx, self.cy])) / self.focal_px), self.projection)
 
     def unproject_covariance(self, uv, cov_uv):
         """Covariances (N, 3, 3) in S of the unit vectors of image points ``uv`` (N, 2) [px] whose positions have
@@ -305,7 +353,5 @@ class Camera:
         rotvecs = np.asarray(times_s, dtype=float)[:, None] * np.asarray(omega_S, dtype=float)[None, :]
         mats = to_matrix(from_rotation_vector(rotvecs))  # (K,3,3) S(t) -> S(0)
         v_S = np.einsum("nj,kji->nki", v_S0, mats)  # R^T v
-        z = v_S[..., 2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xy_n = v_S[..., :2] / np.where(z > 0, z, np.nan)[..., None]
+        xy_n, _ = ideal_coordinates(v_S, self.projection)
         return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy])

@@ -12,6 +12,7 @@ Layout (units in the key names, docs/design.md)::
     cy_px = 386.2
     k1 = 0.119               # radial distortion (default 0)
     k2 = 0.0
+    projection = "pinhole"   # or "fisheye" (equidistant; :mod:`startrack.camera`), default pinhole
     fov_deg = 11.4206        # angle the width subtends through the middle row (written, not read)
 
     [sigma]                  # optional: 1-sigma of the same keys
@@ -39,6 +40,8 @@ from startrack.errors import InputError
 _CAMERA_KEYS = (("width_px", "width", True), ("height_px", "height", True), ("focal_px", "focal_px", True),
                 ("cx_px", "cx", False), ("cy_px", "cy", False), ("k1", "k1", False), ("k2", "k2", False))
 _WRITTEN_ONLY = ("fov_deg",)
+#: The [camera] key that is text: the projection.
+_PROJECTION = "projection"
 
 
 @dataclass(frozen=True)
@@ -74,7 +77,7 @@ def read_camera_file(path) -> CameraFile:
                          + (f" (unknown: {', '.join(sorted(unknown))})" if unknown else ""))
     names = {key for key, _, _ in _CAMERA_KEYS}
     for table in ("camera", "sigma"):
-        extra = set(data.get(table, {})) - names - (set(_WRITTEN_ONLY) if table == "camera" else set())
+        extra = set(data.get(table, {})) - names - (set(_WRITTEN_ONLY) | {_PROJECTION} if table == "camera" else set())
         if extra:
             raise InputError(f"camera file {path}: unknown key(s) {', '.join(f'{table}.{k}' for k in sorted(extra))}")
     values = {}
@@ -83,6 +86,10 @@ def read_camera_file(path) -> CameraFile:
             values[name] = _number(path, f"camera.{key}", data["camera"][key])
         elif required:
             raise InputError(f"camera file {path}: camera.{key} is missing")
+    if _PROJECTION in data["camera"]:
+        values["projection"] = data["camera"][_PROJECTION]
+        if not isinstance(values["projection"], str):
+            raise InputError(f"camera file {path}: camera.projection = {values['projection']!r} is not text")
     sigma = {name: float(_number(path, f"sigma.{key}", data["sigma"][key])) for key, name, _ in _CAMERA_KEYS
              if key in data.get("sigma", {})}
     if any(value < 0.0 for value in sigma.values()):
@@ -102,6 +109,7 @@ def write_camera_file(path, calibration, source: str) -> Path:
               "k1": sigma["k1"], "k2": sigma["k2"]}
     lines = ["# startrack camera file: written by `startrack solve --write-camera` (docs/design.md)", "[camera]"]
     lines += [f"{key} = {getattr(cam, name)!r}" for key, name, _ in _CAMERA_KEYS]
+    lines += [f"{_PROJECTION} = {_toml_string(cam.projection)}"]
     lines += [f"fov_deg = {math.degrees(cam.angular_width)!r}  # angle the width subtends through the middle row",
               "", "[sigma]"]
     lines += [f"{key} = {spread[name]!r}" for key, name, _ in _CAMERA_KEYS if spread[name] is not None]

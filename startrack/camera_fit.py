@@ -1,13 +1,17 @@
 """Least-squares fit of the attitude and the camera's intrinsics to matched stars (compiled).
 
 Model (:mod:`startrack.camera`, docs/design.md): a catalog direction v_I is seen at
-v_S = R_IS^T v_I, x = v_x / v_z, y = v_y / v_z, r^2 = x^2 + y^2, d = 1 + k1 r^2 + k2 r^4 and
+v_S = R_IS^T v_I with the ideal coordinates (x, y) of the camera's projection -- pinhole x = v_x / v_z,
+y = v_y / v_z; fisheye (equidistant, Kannala & Brandt 2006) (x, y) = theta (v_x, v_y) / rho, rho =
+hypot(v_x, v_y), theta = atan2(rho, v_z) -- r^2 = x^2 + y^2, d = 1 + k1 r^2 + k2 r^4 and
 
     u = cx + f x d,   v = cy + f y d.
 
 Parameters: the attitude error dtheta (rotation vector in S, R_IS <- R_IS exp([dtheta x]), the
 convention of the filter's error state) and the intrinsics p = (f, cx, cy, k1, k2), each free or held.
-The Jacobian: dv_S/d dtheta = [v_S x]; dx/dv_S = (1/v_z, 0, -x/v_z), dy/dv_S = (0, 1/v_z, -y/v_z);
+The Jacobian: dv_S/d dtheta = [v_S x]; pinhole dx/dv_S = (1/v_z, 0, -x/v_z), dy/dv_S = (0, 1/v_z, -y/v_z);
+fisheye, with s = theta / rho, dtheta/dv_S = (v_x v_z / rho, v_y v_z / rho, -rho) / |v|^2,
+dx/dv_S = s e_x + v_x (dtheta/dv_S - s (v_x, v_y, 0) / rho) / rho (and y alike);
 du/dx = f (d + 2 x^2 (k1 + 2 k2 r^2)), du/dy = dv/dx = 2 f x y (k1 + 2 k2 r^2),
 dv/dy = f (d + 2 y^2 (k1 + 2 k2 r^2)); du/df = x d, du/dcx = 1, du/dk1 = f x r^2, du/dk2 = f x r^4
 (and likewise for v).
@@ -28,13 +32,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.camera import fold_radius_squared, width_angle
+from startrack.camera import PROJECTIONS, fold_radius_squared, width_angle
 from startrack.jit import njit
 from startrack.rotation_jit import quat_from_rotation_vector, quat_to_matrix
 
 #: Positions of the intrinsics (f, cx, cy, k1, k2) in a camera-parameter array (f, cx, cy, W, H, k1, k2,
-#: circular) -- the layout of :class:`startrack.identify.verify.FieldStars.camera_params`.
+#: circular, projection) -- the layout of :func:`camera_array`.
 INTRINSICS = np.array([0, 1, 2, 5, 6], np.int64)
+#: Code of the fisheye projection at index 8 of a camera-parameter array (0: pinhole;
+#: :data:`startrack.camera.PROJECTIONS`).
+FISHEYE = 1.0
+
+
+def camera_array(camera) -> np.ndarray:
+    """The compiled kernels' camera-parameter array (f, cx, cy, W, H, k1, k2, circular, projection) of a
+    :class:`startrack.camera.Camera`."""
+    return np.array([camera.focal_px, camera.cx, camera.cy, camera.width, camera.height, camera.k1, camera.k2,
+                     float(camera.circular_fov), float(PROJECTIONS.index(camera.projection))])
 #: Compiled twin of :func:`startrack.camera.fold_radius_squared` (the same function).
 fold_radius_squared_jit = njit(fold_radius_squared)
 #: Names of the fitted parameters, in the order of :func:`fit` 's covariance.
@@ -42,13 +56,70 @@ PARAMETERS = ("dtheta_x", "dtheta_y", "dtheta_z", "f", "cx", "cy", "k1", "k2")
 
 
 @njit(_nrt=False)
-def project_one(vx, vy, vz, camera_params):  # pragma: no cover  (compiled)
-    """(u, v) [px] of the direction (vx, vy, vz) in S (in front of the lens): the module's model."""
-    f, cx, cy, _, _, k1, k2, _ = camera_params
-    x, y = vx / vz, vy / vz
+def ideal_xy(vx, vy, vz, projection):  # pragma: no cover  (compiled)
+    """(imaged, x, y): the normalised ideal coordinates of the direction (vx, vy, vz) in S under the
+    projection code (module text); imaged is False behind a pinhole and on the fisheye's -z axis."""
+    if projection != FISHEYE:
+        if vz <= 0.0:
+            return False, 0.0, 0.0
+        return True, vx / vz, vy / vz
+    rho = math.sqrt(vx * vx + vy * vy)
+    if rho <= 1e-12 * abs(vz):
+        return vz > 0.0, vx / abs(vz), vy / abs(vz)
+    s = math.atan2(rho, vz) / rho
+    return True, s * vx, s * vy
+
+
+@njit(_nrt=False)
+def in_view(vx, vy, vz, camera_params, fold):  # pragma: no cover  (compiled)
+    """(imaged within the fold radius^2 ``fold`` of the distortion, x, y) of a direction in S."""
+    imaged, x, y = ideal_xy(vx, vy, vz, camera_params[8])
+    return imaged and x * x + y * y < fold, x, y
+
+
+@njit(_nrt=False)
+def folds_inside(camera_params):  # pragma: no cover  (compiled)
+    """Whether the distorted radius stops growing before the farthest image corner (with the 5 % margin of
+    :class:`startrack.camera.Camera`, which refuses such a camera)."""
+    f, cx, cy, width, height, k1, k2 = camera_params[:7]
+    fold = fold_radius_squared_jit(k1, k2)
+    if math.isinf(fold):
+        return False
+    corner = math.hypot(max(cx + 0.5, width - 0.5 - cx), max(cy + 0.5, height - 0.5 - cy)) / f
+    return math.sqrt(fold) * (1.0 + k1 * fold + k2 * fold * fold) <= 1.05 * corner
+
+
+@njit(_nrt=False)
+def image_point(x, y, camera_params):  # pragma: no cover  (compiled)
+    """(u, v) [px] of normalised ideal coordinates (x, y): the radial polynomial and the intrinsics."""
+    f, cx, cy, k1, k2 = camera_params[0], camera_params[1], camera_params[2], camera_params[5], camera_params[6]
     r2 = x * x + y * y
     d = 1.0 + k1 * r2 + k2 * r2 * r2
     return cx + f * x * d, cy + f * y * d
+
+
+@njit(_nrt=False)
+def project_one(vx, vy, vz, camera_params):  # pragma: no cover  (compiled)
+    """(u, v) [px] of the direction (vx, vy, vz) in S (one the projection images): the module's model."""
+    _, x, y = ideal_xy(vx, vy, vz, camera_params[8])
+    return image_point(x, y, camera_params)
+
+
+@njit(_nrt=False)
+def off_axis_angle(radius, projection):  # pragma: no cover  (compiled)
+    """Angle off the axis [rad] of the ideal normalised radius ``radius`` (pinhole atan, fisheye itself)."""
+    return radius if projection == FISHEYE else math.atan(radius)
+
+
+@njit(_nrt=False)
+def ray_one(x, y, projection):  # pragma: no cover  (compiled)
+    """Unit vector in S of the normalised ideal coordinates (x, y) (the inverse of :func:`ideal_xy`)."""
+    if projection != FISHEYE:
+        norm = math.sqrt(x * x + y * y + 1.0)
+        return x / norm, y / norm, 1.0 / norm
+    theta = math.sqrt(x * x + y * y)
+    sinc = math.sin(theta) / theta if theta > 0.0 else 1.0
+    return x * sinc, y * sinc, math.cos(theta)
 
 
 @njit
@@ -61,18 +132,43 @@ def project(v_S, camera_params):  # pragma: no cover  (compiled)
 
 
 @njit(_nrt=False)
-def _jacobian_rows(v, camera_params, rows):  # pragma: no cover  (compiled)
-    """rows (2, 8): d(u, v)/d(dtheta, f, cx, cy, k1, k2) at the direction v (3,) in S (module text); with
-    x = v_x / v_z, y = v_y / v_z, d(x, y)/d dtheta = ((x y, -(1 + x^2), y), (1 + y^2, -x y, -x))."""
+def _ideal_jacobian(v, projection, J):  # pragma: no cover  (compiled)
+    """(x, y) of the direction v (3,) in S, with J (2, 3) = d(x, y)/dv_S filled (module text)."""
+    vx, vy, vz = v[0], v[1], v[2]
+    rho = math.sqrt(vx * vx + vy * vy)
+    if projection != FISHEYE or rho <= 1e-9 * abs(vz):  # the fisheye is the pinhole to first order on its axis
+        x, y = vx / vz, vy / vz
+        J[0, 0], J[0, 1], J[0, 2] = 1.0 / vz, 0.0, -x / vz
+        J[1, 0], J[1, 1], J[1, 2] = 0.0, 1.0 / vz, -y / vz
+        return x, y
+    n2 = rho * rho + vz * vz
+    theta = math.atan2(rho, vz)
+    s = theta / rho
+    d_theta = (vx * vz / (rho * n2), vy * vz / (rho * n2), -rho / n2)
+    d_rho = (vx / rho, vy / rho, 0.0)
+    for c in range(3):
+        d_s = (d_theta[c] - s * d_rho[c]) / rho
+        J[0, c] = vx * d_s
+        J[1, c] = vy * d_s
+    J[0, 0] += s
+    J[1, 1] += s
+    return s * vx, s * vy
+
+
+@njit(_nrt=False)
+def _jacobian_rows(v, camera_params, rows, J):  # pragma: no cover  (compiled)
+    """rows (2, 8): d(u, v)/d(dtheta, f, cx, cy, k1, k2) at the direction v (3,) in S (module text), with
+    d(x, y)/d dtheta = J [v x] (J (2, 3) scratch for d(x, y)/dv_S)."""
     f, k1, k2 = camera_params[0], camera_params[5], camera_params[6]
-    x, y = v[0] / v[2], v[1] / v[2]
+    x, y = _ideal_jacobian(v, camera_params[8], J)
     r2 = x * x + y * y
     d = 1.0 + k1 * r2 + k2 * r2 * r2
     g = 2.0 * (k1 + 2.0 * k2 * r2)
     du_dx, du_dy = f * (d + x * x * g), f * x * y * g
     dv_dx, dv_dy = du_dy, f * (d + y * y * g)
-    dx0, dx1, dx2 = x * y, -(1.0 + x * x), y
-    dy0, dy1, dy2 = 1.0 + y * y, -x * y, -x
+    # [v x] = ((0, -v_z, v_y), (v_z, 0, -v_x), (-v_y, v_x, 0))
+    dx0, dx1, dx2 = J[0, 1] * v[2] - J[0, 2] * v[1], -J[0, 0] * v[2] + J[0, 2] * v[0], J[0, 0] * v[1] - J[0, 1] * v[0]
+    dy0, dy1, dy2 = J[1, 1] * v[2] - J[1, 2] * v[1], -J[1, 0] * v[2] + J[1, 2] * v[0], J[1, 0] * v[1] - J[1, 1] * v[0]
     rows[0, 0], rows[1, 0] = du_dx * dx0 + du_dy * dy0, dv_dx * dx0 + dv_dy * dy0
     rows[0, 1], rows[1, 1] = du_dx * dx1 + du_dy * dy1, dv_dx * dx1 + dv_dy * dy1
     rows[0, 2], rows[1, 2] = du_dx * dx2 + du_dy * dy2, dv_dx * dx2 + dv_dy * dy2
@@ -89,6 +185,7 @@ def _normal_equations(uv, weight, ref_I, R_IS, camera_params, free, prior_mean, 
     N = np.zeros((8, 8))
     b = np.zeros(8)
     rows = np.empty((2, 8))
+    J = np.empty((2, 3))
     chi2 = 0.0
     v = np.empty(3)
     for i in range(uv.shape[0]):
@@ -96,7 +193,7 @@ def _normal_equations(uv, weight, ref_I, R_IS, camera_params, free, prior_mean, 
             v[c] = R_IS[0, c] * ref_I[i, 0] + R_IS[1, c] * ref_I[i, 1] + R_IS[2, c] * ref_I[i, 2]
         u_model, v_model = project_one(v[0], v[1], v[2], camera_params)
         res = (uv[i, 0] - u_model, uv[i, 1] - v_model)
-        _jacobian_rows(v, camera_params, rows)
+        _jacobian_rows(v, camera_params, rows, J)
         for a in range(2):
             chi2 += weight[i] * res[a] * res[a]
             for p in range(8):
@@ -163,7 +260,7 @@ def fit(uv, sigma_px, ref_I, R_IS, camera_params, free, prior_mean, prior_sigma,
     """Gauss-Newton fit of the attitude and the free intrinsics (module text).
 
     uv (m, 2) [px] observed; sigma_px (m,) per-axis noise [px]; ref_I (m, 3) catalog directions; R_IS
-    and camera_params (f, cx, cy, W, H, k1, k2, circular) the start; free (5,) bool for (f, cx, cy,
+    and camera_params (:func:`camera_array`) the start; free (5,) bool for (f, cx, cy,
     k1, k2); prior_mean, prior_sigma (5,) (inf: no prior).  Returns (ok, R_IS, camera_params, covariance
     (8, 8) of (dtheta, f, cx, cy, k1, k2) [rad, px, -], chi^2 / dof) -- zero rows for held parameters;
     ok is False when the stars do not determine the parameters (singular normal matrix).
@@ -220,7 +317,7 @@ class CameraCalibration:
         base = np.array([camera.focal_px, camera.cx, camera.cy, camera.k1, camera.k2])
         step = 1e-3 * spread
         moved = base + np.diag(step)
-        widths = width_angle(*moved.T, camera.width, camera.height)
+        widths = width_angle(*moved.T, camera.width, camera.height, camera.projection)
         gradient = np.where(step > 0.0, (widths - camera.angular_width) / np.where(step > 0.0, step, 1.0), 0.0)
         out["fov_deg"] = math.degrees(math.sqrt(max(gradient @ covariance @ gradient, 0.0)))
         return out

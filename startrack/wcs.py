@@ -1,4 +1,5 @@
-"""The FITS world coordinate system of a solved frame: gnomonic (TAN) with SIP distortion polynomials.
+"""The FITS world coordinate system of a solved frame: gnomonic (TAN) with SIP distortion polynomials, or
+for a fisheye camera the zenithal polynomial projection (ZPN).
 
 A camera of :mod:`startrack.camera` at the attitude ``q_IS`` maps a pixel (u, v) (0-based, origin at the
 centre of the first pixel) to a direction; the FITS WCS of that map (Calabretta & Greisen 2002, eqs. 54-55
@@ -17,10 +18,16 @@ and the reference pixel CRPIX at the principal point (cx + 1, cy + 1):
 The order N is the smallest (0 for a pinhole, else 2..:data:`MAX_ORDER`) whose fit misses the camera model
 by at most ``tolerance_arcsec`` (0.02") everywhere on the grid, the inverse likewise; the header states what it
 reached (``max_error_px``).
+
+A fisheye camera (equidistant with radial terms, :mod:`startrack.camera`) has no tangent plane beyond 90 deg
+from the axis, but it is exactly the zenithal polynomial projection ZPN (Calabretta & Greisen 2002, eq. 68):
+R = (180 / pi) sum_m P_m theta^m with theta the angle from CRVAL [rad] and R = |CD (U, V)| [deg], so the same
+CRPIX, CRVAL and CD with P_1 = 1, P_3 = k1, P_5 = k2 (PV2_1, PV2_3, PV2_5) reproduce it with no polynomial fit.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -37,10 +44,11 @@ GRID = 41
 
 
 @dataclass(frozen=True)
-class TanSip:
-    """A TAN(-SIP) WCS: ``crpix`` (2,) FITS px, ``crval`` (2,) [deg], ``cd`` (2, 2) [deg/px], the forward
-    polynomial coefficients ``a``, ``b`` and the inverse ``ap``, ``bp`` as {(p, q): value} (empty for a
-    pinhole), ``order``, ``max_error_px`` of forward and inverse on the grid, image ``width`` x ``height``."""
+class FrameWcs:
+    """A TAN(-SIP) or ZPN WCS: ``crpix`` (2,) FITS px, ``crval`` (2,) [deg], ``cd`` (2, 2) [deg/px], the forward
+    SIP coefficients ``a``, ``b`` and the inverse ``ap``, ``bp`` as {(p, q): value} (empty for a pinhole or a
+    fisheye), ``order``, ``max_error_px`` of forward and inverse on the grid, image ``width`` x ``height``;
+    ``projection`` "TAN" or "ZPN" with its coefficients ``pv`` {m: P_m}."""
 
     crpix: np.ndarray
     crval: np.ndarray
@@ -53,14 +61,18 @@ class TanSip:
     max_error_px: float
     width: int
     height: int
+    projection: str = "TAN"
+    pv: dict = dataclasses.field(default_factory=dict)
 
     def cards(self):
-        """[(keyword, value, comment)] of the FITS header (module text); SIP keywords when ``order``."""
+        """[(keyword, value, comment)] of the FITS header (module text); SIP keywords when ``order``, PV2_m
+        of a ZPN."""
         sip = bool(self.order)
         suffix = "-SIP" if sip else ""
+        name = {"TAN": "gnomonic projection", "ZPN": "zenithal polynomial (fisheye)"}[self.projection]
         cards = [("WCSAXES", 2, "2-D image"),
-                 ("CTYPE1", "RA---TAN" + suffix, "gnomonic projection" + (", SIP distortion" if sip else "")),
-                 ("CTYPE2", "DEC--TAN" + suffix, "gnomonic projection" + (", SIP distortion" if sip else "")),
+                 ("CTYPE1", f"RA---{self.projection}" + suffix, name + (", SIP distortion" if sip else "")),
+                 ("CTYPE2", f"DEC--{self.projection}" + suffix, name + (", SIP distortion" if sip else "")),
                  ("CUNIT1", "deg", ""), ("CUNIT2", "deg", ""),
                  ("RADESYS", "ICRS", "astrometric directions of the catalog"),
                  ("CRPIX1", float(self.crpix[0]), "principal point, FITS pixels"),
@@ -71,6 +83,7 @@ class TanSip:
                  ("CD1_1", float(self.cd[0, 0]), ""), ("CD1_2", float(self.cd[0, 1]), ""),
                  ("CD2_1", float(self.cd[1, 0]), ""), ("CD2_2", float(self.cd[1, 1]), ""),
                  ("IMAGEW", self.width, "image width [px]"), ("IMAGEH", self.height, "image height [px]")]
+        cards += [(f"PV2_{m}", float(value), "ZPN coefficient of theta^m") for m, value in sorted(self.pv.items())]
         if sip:
             for name, terms in (("A", self.a), ("B", self.b), ("AP", self.ap), ("BP", self.bp)):
                 cards.append((f"{name}_ORDER", self.order, "SIP polynomial order"))
@@ -114,15 +127,19 @@ def _fit(U, V, target, order, scale):
     return ({t: c for t, c in zip(terms, coef[:, 0])}, {t: c for t, c in zip(terms, coef[:, 1])}, miss)
 
 
-def tan_sip(camera, q_IS, tolerance_arcsec=0.02):
-    """The :class:`TanSip` of ``camera`` (:class:`startrack.camera.Camera`) at attitude ``q_IS`` (S -> I,
-    scalar last): CD exact, the SIP polynomials of the lowest order that reproduces the camera model within
-    ``tolerance_arcsec`` (as pixels at the focal length) on a grid over the image (module text); raises
-    InputError if no order up to :data:`MAX_ORDER` does."""
+def frame_wcs(camera, q_IS, tolerance_arcsec=0.02):
+    """The :class:`FrameWcs` of ``camera`` (:class:`startrack.camera.Camera`) at attitude ``q_IS`` (S -> I,
+    scalar last): CD exact; a fisheye's ZPN exact, a pinhole's SIP polynomials of the lowest order that
+    reproduces the camera model within ``tolerance_arcsec`` (as pixels at the focal length) on a grid over
+    the image (module text); raises InputError if no order up to :data:`MAX_ORDER` does."""
     tolerance_px = tolerance_arcsec * ARCSEC * camera.focal_px
     R = to_matrix(np.asarray(q_IS, dtype=float))
     crval, axes = reference(R[:, 2])
     cd = np.degrees(axes @ R[:, :2]) / camera.focal_px  # the sensor's x and y axes on east and north, over f
+    crpix = np.array([camera.cx + 1.0, camera.cy + 1.0])
+    if camera.projection == "fisheye":
+        return FrameWcs(crpix, crval, cd, {}, {}, {}, {}, 0, 0.0, camera.width, camera.height, "ZPN",
+                        {1: 1.0, 3: camera.k1, 5: camera.k2})
     u, v = np.meshgrid(np.linspace(-0.5, camera.width - 0.5, GRID), np.linspace(-0.5, camera.height - 0.5, GRID))
     U, V = (u.ravel() - camera.cx), (v.ravel() - camera.cy)
     ideal = camera.focal_px * camera.undistort(np.stack([U, V], axis=1) / camera.focal_px)  # f x_n, f y_n
@@ -132,8 +149,7 @@ def tan_sip(camera, q_IS, tolerance_arcsec=0.02):
         a, b, forward = _fit(U, V, ideal - np.stack([U, V], axis=1), order, scale)
         ap, bp, inverse = _fit(ideal[:, 0], ideal[:, 1], np.stack([U, V], axis=1) - ideal, order, scale)
         if max(forward, inverse) <= tolerance_px:
-            return TanSip(np.array([camera.cx + 1.0, camera.cy + 1.0]), crval, cd, a, b, ap, bp,
-                          order, max(forward, inverse), camera.width, camera.height)
+            return FrameWcs(crpix, crval, cd, a, b, ap, bp, order, max(forward, inverse), camera.width, camera.height)
     raise InputError(f"the camera's distortion (k1 {camera.k1:+.4g}, k2 {camera.k2:+.4g}) is not reproduced by SIP "
                      f"polynomials up to order {MAX_ORDER} within {tolerance_arcsec:g} arcsec (largest miss "
                      f"{max(forward, inverse):.3g} px)")

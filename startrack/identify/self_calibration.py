@@ -9,13 +9,16 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fi
 1. the brightest ``first_stars`` detections against the brightest predicted stars, gate g_1 (the
    pattern's tolerance scaled to the image), attitude and focal length free;
 2. every detection against the ``n_predicted`` brightest stars predicted in the image, gate g_2,
-   every intrinsic of ``free`` with its prior;
+   every intrinsic of ``free`` with its prior; repeated (up to ``WIDE_PASSES`` times) while it matches
+   ``GROWTH`` times the stars of the pass before;
 3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars;
 4. the depth of the catalog the frame shows (:func:`detected_depth`: where the matched fraction of the
    predicted stars, brightest first, falls to the level of chance): matches of fainter stars are
    dropped (in a crowd of false detections they are chance neighbours); then matches the fit puts
    outside r, or beyond OUTLIER (4) times their sigma scaled by the fit's sqrt(chi^2 / dof) (a
-   compression artefact next to a star), are dropped and the fit repeated.
+   compression artefact next to a star), are dropped and the fit repeated (up to OUTLIER_ROUNDS times;
+   the answer is always the fit of the matches it reports: a wrong match at a wide field's corner bends
+   the distortion terms until it is dropped).
 
 Matches are mutual nearest neighbours in the image (one-to-one).  The false-match probability of the
 result is :func:`startrack.identify.chance.chance_match_probability` with the local density of the
@@ -32,7 +35,7 @@ import math
 
 import numpy as np
 
-from startrack.camera_fit import fit, fold_radius_squared_jit, project, project_one
+from startrack.camera_fit import fit, fold_radius_squared_jit, folds_inside, image_point, in_view, off_axis_angle, project
 from startrack.identify.chance import chance_match_probability
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
@@ -42,8 +45,13 @@ from startrack.sort_jit import argsort, median, unique
 SEEDS = 4
 #: Passes at the final gate beyond the first, made while they add stars.
 EXTRA_PASSES = 2
+#: Passes at the second gate beyond the first, made while each matches GROWTH times the stars of the last: the
+#: fit spreads from the pattern outwards over a strongly distorted field (a fisheye's corners).
+WIDE_PASSES, GROWTH = 3, 1.1
 #: A match whose residual exceeds this many of its sigma (scaled by the fit's sqrt(chi^2 / dof)) is dropped.
 OUTLIER = 4.0
+#: Rounds of dropping outliers, each followed by the fit of the matches left.
+OUTLIER_ROUNDS = 3
 
 
 @njit
@@ -96,15 +104,16 @@ def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
     f, cx, cy, width, height = params[0], params[1], params[2], params[3], params[4]
     half = math.hypot(max(cx + 0.5, width - 0.5 - cx), max(cy + 0.5, height - 0.5 - cy)) / f
     near = np.empty(vectors.shape[0], np.int64)
-    near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), 1.2 * math.atan(half) + 0.005, near, max_star)]
+    radius = 1.2 * off_axis_angle(half, params[8]) + 0.005
+    near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), radius, near, max_star)]
     return unique(near)
 
 
 @njit
 def predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  (compiled)
     """(star indices, uv (m, 2)) of the first ``limit`` stars of ``around`` (brightest first) imaged inside
-    the frame for R_IS and the camera ``params`` (f, cx, cy, W, H, k1, k2, circular): in front of the
-    lens, within the fold radius of the distortion (:func:`startrack.camera.fold_radius_squared`)."""
+    the frame for R_IS and the camera ``params`` (:func:`startrack.camera_fit.camera_array`): imaged by
+    its projection, within the fold radius of the distortion (:func:`startrack.camera.fold_radius_squared`)."""
     width, height = params[3], params[4]
     fold = fold_radius_squared_jit(params[5], params[6])
     keep = np.empty(min(limit, around.size), np.int64)
@@ -116,9 +125,10 @@ def predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  
         vx = R_IS[0, 0] * vectors[s, 0] + R_IS[1, 0] * vectors[s, 1] + R_IS[2, 0] * vectors[s, 2]
         vy = R_IS[0, 1] * vectors[s, 0] + R_IS[1, 1] * vectors[s, 1] + R_IS[2, 1] * vectors[s, 2]
         vz = R_IS[0, 2] * vectors[s, 0] + R_IS[1, 2] * vectors[s, 1] + R_IS[2, 2] * vectors[s, 2]
-        if vz <= 0.0 or vx * vx + vy * vy >= fold * vz * vz:
+        seen, x, y = in_view(vx, vy, vz, params, fold)
+        if not seen:
             continue
-        u, v = project_one(vx, vy, vz, params)
+        u, v = image_point(x, y, params)
         if -0.5 <= u <= width - 0.5 and -0.5 <= v <= height - 0.5:
             keep[count] = s
             uv[count, 0], uv[count, 1] = u, v
@@ -172,7 +182,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     """Verification of the hypothesis (R_IS, params) of a pattern (module text).
 
     uv (n, 2) detections brightest first [px], sigma (n,) their centroid sigma [px]; ``params`` the
-    camera (f, cx, cy, W, H, k1, k2, circular); ``field`` for :func:`stars_around`; ``settings`` =
+    camera (:func:`startrack.camera_fit.camera_array`); ``field`` for :func:`stars_around`; ``settings`` =
     (final gate r [px], first_stars, n_predicted, free (5,) bool, prior (mean (5,), sigma (5,)), density
     grid, threshold); ``gates`` (3,) [px] g_1, g_2, r.  Returns (ok, R_IS, params, covariance (8, 8), obs
     indices, star indices, P_false, stars predicted, radius reached [px], chi^2 / dof).
@@ -185,14 +195,14 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     reduced = 0.0
     first_free = np.zeros(5, np.bool_)
     first_free[0] = free[0]
-    previous = 0
-    for p in range(3 + EXTRA_PASSES):
-        gate = gates[min(p, 2)]
-        if p == 1:
-            around = stars_around(R_IS, params, field, field[3])
+    stage, runs, previous = 0, 0, 0  # the gate's index, the passes made at it, the stars the last pass matched
+    for p in range(3 + WIDE_PASSES + EXTRA_PASSES):
+        gate = gates[stage]
+        if p == 1:  # as deep as needed for about 4 n_predicted stars in the field, at most the magnitude cap
+            around = stars_around(R_IS, params, field, brightest_in_field(4.0 * n_predicted, params, field[3]))
         stars, pred_uv = predicted_stars(R_IS, params, vectors, around, first_stars if p == 0 else n_predicted)
         obs_index, pred_index = match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
-        if p >= 3 and obs_index.size <= previous:
+        if stage == 2 and runs > 0 and obs_index.size <= previous:
             break  # the final gate adds no more stars
         if obs_index.size < SEEDS + 1:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
@@ -200,7 +210,11 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
                                                              params, first_free if p == 0 else free, prior)
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
-        previous = obs_index.size
+        runs, grew, previous = runs + 1, obs_index.size > GROWTH * previous, obs_index.size
+        if stage == 0 or (stage == 1 and (runs > WIDE_PASSES or not grew)):
+            stage, runs = stage + 1, 0
+        elif stage == 2 and runs > EXTRA_PASSES:
+            break
     return _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypotheses, covariance, reduced)
 
 
@@ -216,18 +230,22 @@ def _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypot
     chance = -np.expm1(-local_density(pred_uv, grid) * math.pi * gates[2] ** 2)
     deep = pred_index < detected_depth(pred_index, stars.size, chance)
     obs_index, star_index = obs_index[deep], stars[pred_index[deep]]
-    for _ in range(2):
+    for rounds in range(OUTLIER_ROUNDS + 1):
         if obs_index.size < SEEDS + 1:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
         ok, R_IS, params, covariance, reduced = _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params,
                                                            free, prior)
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
+        if rounds == OUTLIER_ROUNDS:
+            break  # the answer is the fit of the matches it reports
         residual = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params))
         keep = (residual <= gates[2]) & (residual <= OUTLIER * math.sqrt(max(reduced, 1.0)) * sigma[obs_index])
         if keep.all():
             break
         obs_index, star_index = obs_index[keep], star_index[keep]
+    if folds_inside(params):  # not a lens: its image would fold back on itself
+        return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
     reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
     reached = min(max(reached, median(sigma)), gates[2])
     q = local_density(pred_uv, grid) * math.pi * reached * reached

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from startrack.camera_fit import fold_radius_squared_jit
+from startrack.camera_fit import camera_array, fold_radius_squared_jit, image_point, in_view
 from startrack.identify.zones import stars_near, zone_index
 from startrack.jit import njit
 from startrack.navigation_catalog import chord
@@ -165,12 +165,12 @@ def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
 def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (compiled)
     """(indices, directions in S (m, 3)) of the stars ``stars_I`` (N, 3) imaged inside the field for R_IS.
 
-    ``camera_params`` = (f, cx, cy, W, H, k1, k2, circular) [px]; the image (and, if circular, the
-    inscribed circle of the width) is grown by ``margin_px``.  Pinhole with Brown radial distortion as
+    ``camera_params`` (:func:`startrack.camera_fit.camera_array`) [px]; the image (and, if circular, the
+    inscribed circle of the width) is grown by ``margin_px``; the projection and radial distortion of
     :class:`startrack.camera.Camera`.
     """
-    focal, cx, cy, width, height, k1, k2, circular = camera_params
-    fold = fold_radius_squared_jit(k1, k2)
+    cx, cy, width, height, circular = camera_params[1], camera_params[2], camera_params[3], camera_params[4], camera_params[7]
+    fold = fold_radius_squared_jit(camera_params[5], camera_params[6])
     v_S = np.empty_like(stars_I)
     for s in range(stars_I.shape[0]):
         for c in range(3):
@@ -179,15 +179,10 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     count = 0
     radius = width / 2.0 + margin_px
     for s in range(v_S.shape[0]):
-        z = v_S[s, 2]
-        if z <= 0.0:
-            continue
-        x, y = v_S[s, 0] / z, v_S[s, 1] / z
-        if x * x + y * y >= fold:
-            continue  # beyond the fold of the distortion polynomial: not imaged
-        factor = 1.0 + k1 * (x * x + y * y) + k2 * (x * x + y * y) ** 2
-        u = cx + focal * x * factor
-        v = cy + focal * y * factor
+        seen, x, y = in_view(v_S[s, 0], v_S[s, 1], v_S[s, 2], camera_params, fold)
+        if not seen:
+            continue  # not imaged, or beyond the fold of the distortion polynomial
+        u, v = image_point(x, y, camera_params)
         if u < -0.5 - margin_px or u > width - 0.5 + margin_px or v < -0.5 - margin_px or v > height - 0.5 + margin_px:
             continue
         if circular > 0.0 and (u - cx) ** 2 + (v - cy) ** 2 > radius * radius:
@@ -258,16 +253,20 @@ def _field_radius(camera) -> float:
 
 
 def field_solid_angle(camera, blocks: int = 128) -> float:
-    """Solid angle [sr] of the sensor's field: sum of f^-2 z^3 dA over a grid of image blocks."""
+    """Solid angle [sr] of the sensor's field: the sum over a grid of image blocks of |dv/du x dv/dv| dA
+    (the directions' derivatives by central differences of 0.01 block; any projection)."""
     u = (np.arange(blocks) + 0.5) * camera.width / blocks - 0.5
     v = (np.arange(blocks) + 0.5) * camera.height / blocks - 0.5
-    uu, vv = np.meshgrid(u, v)
-    directions = camera.unproject(np.column_stack([uu.ravel(), vv.ravel()]))
-    inside = np.ones(len(directions), bool)
+    uv = np.stack(np.meshgrid(u, v), axis=-1).reshape(-1, 2)
+    du, dv = 0.01 * camera.width / blocks, 0.01 * camera.height / blocks
+    d_u = camera.unproject(uv + [du, 0.0]) - camera.unproject(uv - [du, 0.0])
+    d_v = camera.unproject(uv + [0.0, dv]) - camera.unproject(uv - [0.0, dv])
+    density = np.linalg.norm(np.cross(d_u, d_v), axis=1) / (4.0 * du * dv)  # sr / px^2
+    inside = np.ones(len(uv), bool)
     if camera.circular_fov:
-        inside = directions[:, 2] >= math.cos(camera.fov_x / 2.0)
+        inside = camera.unproject(uv)[:, 2] >= math.cos(camera.fov_x / 2.0)
     area = camera.width * camera.height / blocks**2
-    return float(np.sum(directions[inside, 2] ** 3) * area / camera.focal_px**2)
+    return float(np.sum(density[inside]) * area)
 
 
 class FieldStars:
@@ -296,8 +295,7 @@ class FieldStars:
         self._cell_star = pairs["j"][order].astype(np.int64)
         self._cell_offsets = np.concatenate(
             [[0], np.cumsum(np.bincount(pairs["i"], minlength=catalog.n_base))]).astype(np.int64)
-        self.camera_params = np.array([camera.focal_px, camera.cx, camera.cy, camera.width, camera.height,
-                                       camera.k1, camera.k2, float(camera.circular_fov)])
+        self.camera_params = camera_array(camera)
 
     @classmethod
     def from_star_catalog(cls, catalog, camera, stars, mag_limit: float, resolution_px: float = 3.0):

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import least_squares
 
 from startrack.camera import Camera
-from startrack.camera_fit import CameraCalibration, fit
+from startrack.camera_fit import CameraCalibration, camera_array, fit
 from startrack.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
 from startrack.synthetic import random_attitude
 
@@ -24,7 +24,7 @@ def _stars(rng, n=150):
 
 
 def _params(camera):
-    return np.array([camera.focal_px, camera.cx, camera.cy, camera.width, camera.height, camera.k1, camera.k2, 0.0])
+    return camera_array(camera)
 
 
 def _start(q_IS):

@@ -22,9 +22,11 @@ import pytest
 from startrack.attitude_angles import matrix_from_radec_roll
 from startrack.camera import Camera
 from startrack.detection import detect
+from startrack.errors import InputError
 from startrack.identify import plate_solver
+from startrack.identify.pattern_catalog import PatternCatalogParams
 from startrack.identify.plate_solver import PlateSolver
-from startrack.star_catalog import load_star_catalog
+from startrack.star_catalog import HIP_MAX, load_star_catalog
 from startrack.synthetic import as_jpeg, centroid_frame, noise_crowd, random_attitude, rendered_sky
 from startrack.units import ARCSEC, DEG
 from tests.support import SteppedClock
@@ -102,6 +104,59 @@ def _check_rendered(solver, stars, fov_deg, k1, seed):
                                          (30.0, 0.2)])
 def test_rendered_frames_with_distortion(solver, stars, fov_deg, k1):
     _check_rendered(solver, stars, fov_deg, k1, seed=int(fov_deg * 1000 + 7))
+
+
+#: The fisheye lenses in the equidistant model with radial terms: (k1, k2) of the equidistant, equisolid and
+#: stereographic projections (their Taylor series, :mod:`startrack.camera`).
+FISHEYES = {"equidistant": (0.0, 0.0), "equisolid": (-1.0 / 24.0, 1.0 / 1920.0), "stereographic": (1.0 / 12.0, 1.0 / 120.0)}
+
+
+@pytest.mark.parametrize("fov_deg, lens", [(60.0, "equidistant"), (90.0, "stereographic"), (120.0, "equisolid")])
+def test_rendered_fisheye_frames(solver, stars, fov_deg, lens):
+    """Fisheye frames of 60-120 deg, no field of view given: solved right as fisheye cameras, the field within
+    0.05 %, k1 within 4 sigma of the lens's."""
+    k1, k2 = FISHEYES[lens]
+    focal = Camera.from_fov(fov_deg * DEG, WIDTH, HEIGHT, projection="fisheye").focal_px
+    camera = Camera(WIDTH, HEIGHT, focal, k1=k1, k2=k2, projection="fisheye")
+    sky = rendered_sky(camera, stars, np.random.default_rng(int(fov_deg)))
+    found, result = _solve(solver, sky.image, sky.full_scale)
+    assert result.ok, f"{fov_deg:.0f} deg {lens}: {result.reason}"
+    assert _is_right(result, found, sky) and result.camera.projection == "fisheye"
+    assert abs(result.camera.angular_width / camera.angular_width - 1.0) < 5e-4
+    assert abs(result.camera.k1 - k1) < 4.0 * result.calibration.sigma["k1"] + 1e-4
+
+
+def test_pattern_levels_deepen_below_five_degrees():
+    """The Gaia levels take stars to V 8 + 4.5 log10(5 deg / F) (at most 10): about as many per lattice
+    circle as a 5 deg one to V 8; the Hipparcos levels all to their magnitude limit."""
+    gaia = PatternCatalogParams(fov_min=2.0 * DEG, mag_limit=10.0, source="gaia")
+    limits = [gaia.level_mag_limit(f * DEG) for f in (40.0, 5.0, 5.0 / math.sqrt(2.0), 2.5, 1.0)]
+    np.testing.assert_allclose(limits, [8.0, 8.0, 8.0 + 2.25 * math.log10(2.0), 8.0 + 4.5 * math.log10(2.0), 10.0])
+    assert PatternCatalogParams().level_mag_limit(2.0 * DEG) == 8.0
+    with pytest.raises(InputError, match="source 'tycho'"):
+        PatternCatalogParams(source="tycho")
+
+
+@pytest.mark.slow
+def test_rendered_narrow_frames():
+    """Frames of 2-5 deg rendered from the Gaia DR3 sky (2 s exposure: V ~ 10.5), solved with the Gaia stars
+    (a field range reaching below 5 deg): right, and named by HIP or Gaia source_id."""
+    from startrack.gaia_catalog import load_gaia_catalog
+    from startrack.render import SensorModel
+
+    sky_stars = load_gaia_catalog(2000.0)
+    narrow = PlateSolver(fov_range=(2.0 * DEG, 160.0 * DEG))
+    for fov_deg, seed in ((2.2, 1), (3.3, 2), (4.7, 3)):
+        camera = Camera.from_fov(fov_deg * DEG, WIDTH, HEIGHT, k1=0.05)
+        sky = rendered_sky(camera, sky_stars, np.random.default_rng(seed), SensorModel(exposure_s=2.0))
+        found, result = _solve(narrow, sky.image, sky.full_scale)
+        assert result.ok, f"{fov_deg} deg: {result.reason}"
+        assert _centre_error(result, camera, sky.q_IS) < WRONG_ANGLE
+        order = np.argsort(sky_stars.ids)
+        star = order[np.searchsorted(sky_stars.ids[order], result.matched_hip)]  # each matched id's star
+        truth_uv, _ = camera.project(sky.q_IS, sky_stars.vectors[star])
+        assert np.all(np.hypot(*(truth_uv - found.uv[result.matches[:, 0]]).T) < BLEND_PX)
+        assert (result.matched_hip > HIP_MAX).any()  # stars Hipparcos-2 lacks, by their Gaia source_id
 
 
 @pytest.mark.slow
