@@ -123,15 +123,19 @@ def width_angle(focal_px, cx, cy, k1, k2, width, height, projection="pinhole"):
     pixels, distortion removed: the angles from each end to the row's point below the principal point, summed
     (the row is a great circle of a pinhole; a fisheye's field may pass 180 deg); broadcasts over the camera
     parameters: one call for many cameras."""
-    middle = (height - 1) / 2.0
-    points = []
-    for u in (-0.5, cx, width - 0.5):
-        x_d, y_d = np.broadcast_arrays((u - np.asarray(cx, float)) / focal_px, (middle - np.asarray(cy, float)) / focal_px)
-        scale = _ideal_scale(np.hypot(x_d, y_d), k1, k2)
-        points.append(ray(np.stack([x_d * scale, y_d * scale], axis=-1), projection))
-    left, centre, right = points
-    return sum(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
-               for a, b in ((left, centre), (centre, right)))
+    cx, cy, focal_px = (np.asarray(value, float) for value in (cx, cy, focal_px))
+    u = np.stack(np.broadcast_arrays(-0.5 + 0.0 * cx, cx, width - 0.5 + 0.0 * cx))  # the ends and the middle
+    x_d, y_d = np.broadcast_arrays((u - cx) / focal_px, ((height - 1) / 2.0 - cy) / focal_px)
+    scale = _ideal_scale(np.hypot(x_d, y_d), k1, k2)
+    left, centre, right = ray(np.stack([x_d * scale, y_d * scale], axis=-1), projection)
+    return _angle(left, centre) + _angle(centre, right)
+
+
+def _angle(a, b):
+    """Angle [rad] between the vectors a and b (..., 3): atan2(|a x b|, a . b)."""
+    cross = np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    return np.arctan2(np.sqrt(np.sum(cross * cross, axis=-1)), np.sum(a * b, axis=-1))
 
 
 @dataclass(frozen=True)

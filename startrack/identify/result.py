@@ -136,9 +136,9 @@ class IdentificationResult:
                 ra_deg=math.degrees(self.ra),
                 dec_deg=math.degrees(self.dec),
                 roll_deg=math.degrees(self.roll),
-                matches=[[int(i), int(h)] for i, h in self.matches],
-                residuals_arcsec=[round(float(r) / ARCSEC, 4) for r in self.residuals],
-                sigma_arcsec=[float(s) for s in sigma],
+                matches=self.matches.tolist(),
+                residuals_arcsec=np.round(self.residuals / ARCSEC, 4).tolist(),
+                sigma_arcsec=sigma.tolist(),
                 false_match_probability=float(self.false_match_probability),
             )
             if self.camera is not None:
@@ -157,4 +157,5 @@ class IdentificationResult:
 def _camera_dict(camera) -> dict:
     """The geometry of ``camera`` as the ``camera`` entry of ``startrack solve --json`` gives it."""
     return {"width": camera.width, "height": camera.height, "fov_deg": math.degrees(camera.angular_width),
-            "focal_px": camera.focal_px, "cx": camera.cx, "cy": camera.cy, "k1": camera.k1, "k2": camera.k2}
+            "focal_px": camera.focal_px, "cx": camera.cx, "cy": camera.cy, "k1": camera.k1, "k2": camera.k2,
+            "projection": camera.projection}

@@ -127,3 +127,34 @@ def test_time_budget_ends_a_frame_of_noise_with_its_reason(tmp_path, capsys, mon
                header="u,v,flux", comments="")
     status, out, _ = _run(capsys, ["solve", str(path), "--width", "1024", "--height", "768", "--time-budget-s", "0.05"])
     assert status == 1 and "no_match" in out and "time budget of 0.05 s" in out
+
+
+def test_a_fisheye_image_is_solved_as_one_and_its_wcs_is_zpn(tmp_path, capsys):
+    """An equisolid fisheye frame of ~100 deg (16-bit PNG): fitted as a fisheye camera, written as a ZPN WCS
+    that astropy maps back to the solved image centre, and as a camera file that keeps the projection."""
+    from astropy.io import fits
+    from astropy.wcs import WCS
+
+    from startrack.camera import Camera
+    from startrack.camera_file import read_camera_file
+    from startrack.image_io import write_image
+    from startrack.star_catalog import load_star_catalog
+    from startrack.synthetic import rendered_sky
+    from startrack.units import DEG
+
+    focal = Camera.from_fov(100.0 * DEG, 1024, 768, projection="fisheye").focal_px
+    camera = Camera(1024, 768, focal, k1=-1.0 / 24.0, k2=1.0 / 1920.0, projection="fisheye")
+    sky = rendered_sky(camera, load_star_catalog(2000.0).brighter_than(8.5), np.random.default_rng(100))
+    image = tmp_path / "allsky.png"
+    write_image(image, np.round(sky.image / sky.full_scale * 65535.0))
+    status, out, err = _run(capsys, ["solve", str(image), "--json", "--wcs", str(tmp_path / "allsky.wcs"),
+                                     "--write-camera", str(tmp_path / "allsky.toml")])
+    record = json.loads(out)
+    assert status == 0 and err == "" and record["camera"]["projection"] == "fisheye"
+    assert abs(record["camera"]["fov_deg"] / np.degrees(camera.angular_width) - 1.0) < 1e-3  # 103.5 deg: k1 < 0
+    header = fits.getheader(tmp_path / "allsky.wcs")
+    assert header["CTYPE1"] == "RA---ZPN" and header["PV2_3"] == pytest.approx(-1.0 / 24.0, abs=1e-3)
+    ra, dec = WCS(header).all_pix2world([512.5], [384.5], 1)  # the image centre, FITS pixels
+    centre = record["center"]
+    assert abs(dec[0] - centre["dec_deg"]) < 1e-6 and abs((ra[0] - centre["ra_deg"] + 180.0) % 360.0 - 180.0) < 1e-6
+    assert read_camera_file(tmp_path / "allsky.toml").camera.projection == "fisheye"
