@@ -190,7 +190,9 @@ def _stop(signum, frame):
 
 def run(args):
     from startrack.cli import build_parser
+    from startrack.memory import reuse_freed_memory
 
+    reuse_freed_memory()  # one request after another
     path = Path(args.socket) if args.socket else socket_path()
     solvers = SolverCache()
     solvers(build_parser().parse_args(["solve"])).prepare()  # the unknown camera's solver, kernels loaded

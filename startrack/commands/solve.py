@@ -266,6 +266,10 @@ def run(args, frame_solver=_frame_solver):
     options = detection_options(args)
     solver = frame_solver(args)
     check_output_options(args, None if args.batch is not None else len(args.input))
+    if args.batch is not None:
+        from startrack.memory import reuse_freed_memory
+
+        reuse_freed_memory()  # one frame after another
     if args.batch == "-":
         solver.prepare()
     boresight = None if args.boresight_deg is None else _parse_boresight(args.boresight_deg, args.boresight_error_deg)
