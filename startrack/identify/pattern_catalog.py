@@ -314,13 +314,9 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
             groups.append(brightest[_COMBINATIONS[brightest.size]])
     if not groups:  # no field holds four stars
         return np.zeros((0, 4), np.int32)
-    ranked = np.sort(np.concatenate(groups), axis=1).astype(np.uint64)
-    if stars.size < 1 << 16:  # four 16-bit ranks in one integer: a 1-D unique, far faster than unique(axis=0)
-        packed = np.sort(((ranked[:, 0] << 48) | (ranked[:, 1] << 32)) | ((ranked[:, 2] << 16) | ranked[:, 3]))
-        packed = packed[np.concatenate([[True], packed[1:] != packed[:-1]])]
-        ranked = np.column_stack([(packed >> np.uint64(s)) & np.uint64(0xFFFF) for s in (48, 32, 16, 0)])
-    else:
-        ranked = np.unique(ranked, axis=0)
+    ranked = np.sort(np.concatenate(groups), axis=1)
+    ranked = ranked[np.lexsort(ranked.T[::-1])]  # rows in lexical order, then the distinct ones (np.unique(axis=0)
+    ranked = ranked[np.r_[True, np.any(ranked[1:] != ranked[:-1], axis=1)]]  # sorts rows as objects: 10x slower)
     return stars[ranked.astype(np.int64)].astype(np.int32)
 
 
