@@ -72,7 +72,8 @@ def register(subparsers):
     parser.add_argument("--refit", metavar="LIST",
                         help="refit these intrinsics of the given camera per frame: focal,centre,k1,k2 or all")
     parser.add_argument("--fov-hint-deg", type=float,
-                        help="unknown camera: field of view across the width [deg] searched first (a hint)")
+                        help="unknown camera: field of view across the width [deg] searched first (a hint; below "
+                             "5 deg it extends the search down to it)")
     parser.add_argument("--fov-range-deg", metavar="LO,HI",
                         help="unknown camera: search only fields of view in [LO, HI] deg (default 5,160; "
                              "pinhole and, from 28 deg, fisheye lenses)")
@@ -126,8 +127,14 @@ def _parse_boresight(text, error_deg):
 
 
 def _fov_range(args):
-    """(low, high) [rad] of the field of view searched, or None for the default range."""
+    """(low, high) [rad] of the field of view searched, or None for the default range; a hint narrower than
+    the default range's low end extends it down to the hint over :data:`GIVEN_FOV_SPREAD`."""
     if args.fov_range_deg is None:
+        from startrack.identify.pattern_catalog import PatternCatalogParams
+
+        low = PatternCatalogParams().fov_min / DEG
+        if args.fov_hint_deg is not None and args.fov_hint_deg < low:
+            return args.fov_hint_deg / GIVEN_FOV_SPREAD * DEG, _widest_deg() * DEG
         return None
     low, high = _pair("--fov-range-deg", args.fov_range_deg)
     widest = _widest_deg()

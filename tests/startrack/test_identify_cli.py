@@ -190,3 +190,16 @@ def test_malformed_csv(tmp_path, capsys, text, message):
     path.write_text(text)
     status, _, err = _run(capsys, ["solve", str(path), *GEOMETRY])
     assert status == 2 and message in err
+
+
+@pytest.mark.parametrize("argv, expected_deg", [
+    (["--fov-hint-deg", "3"], (3.0 / 1.3, 160.0)),       # below the default range: searched down to it
+    (["--fov-hint-deg", "11"], None),                    # inside it: the default range
+    (["--fov-range-deg", "2,20", "--fov-hint-deg", "3"], (2.0, 20.0))])
+def test_a_narrow_hint_extends_the_search(argv, expected_deg):
+    from startrack.cli import build_parser
+    from startrack.commands.solve import _fov_range
+    from startrack.units import DEG
+
+    found = _fov_range(build_parser().parse_args(["solve", "frame.png", *argv]))
+    assert found == expected_deg if expected_deg is None else np.allclose(np.array(found) / DEG, expected_deg)
