@@ -30,8 +30,9 @@ A fisheye frame's ratios are computed with the equidistant projection (:mod:`sta
 focal-length spread and the lenses it must reach (equidistant, equisolid, stereographic, each with
 |k1| <= 0.08 more) move a ratio by at most about ``FISHEYE_SPREAD`` theta^2, theta = 1.25 F_l / 2
 (the 99th percentile of random patterns over whole 3:2 and 4:3 frames of 40-160 deg is 0.021-0.029
-theta^2).  Level l's bin width is twice the smaller model tolerance plus :data:`NOISE_TOLERANCE`; a
-look-up adds the centroid noise of its pattern (4 sqrt 2 sigma / e_6).
+theta^2).  Level l's bin width is twice the model tolerance of the frames it serves -- rectilinear up to
+:data:`RECTILINEAR_TO`, fisheye above -- plus :data:`NOISE_TOLERANCE`; a look-up adds the centroid noise
+of its pattern (4 sqrt 2 sigma / e_6).
 
 Keys map to their runs in the key-sorted pattern table through an open-addressing hash table
 (multiplicative hashing, linear probing, load <= 0.5: Knuth §6.4); each level is stored as ``.npy`` files in the cache directory and
@@ -60,6 +61,9 @@ from startrack.units import DEG
 RATIO_SPREAD = 0.15
 #: Ratio spread per unit theta^2 [rad^-2] of a fisheye frame's tolerance model (module text).
 FISHEYE_SPREAD = 0.03
+#: Widest level [rad] searched as rectilinear (pinhole) frames: a rectilinear lens's tolerance grows as
+#: tan^2 of the half field (0.07 at 57 deg, 0.17 at 80 deg), the wider levels serve fisheye frames only.
+RECTILINEAR_TO = 40.0 * DEG * (1.0 + 1e-9)
 #: Part of each level's bin width that is left for centroid noise (ratio units).
 NOISE_TOLERANCE = 0.004
 #: Layout of the cached files; bump when the arrays change.
@@ -343,7 +347,7 @@ class PatternLevel:
 def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> PatternLevel:
     """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag)."""
     tolerance = model_tolerance(fov)
-    width = 2.0 * min(tolerance, fisheye_tolerance(fov)) + NOISE_TOLERANCE
+    width = 2.0 * (tolerance if fov <= RECTILINEAR_TO else fisheye_tolerance(fov)) + NOISE_TOLERANCE
     base = int(math.ceil(1.0 / width)) + 1
     patterns = level_patterns(vectors, v_mag, fov, params)
     keys = _pattern_keys(vectors, patterns, width, base)

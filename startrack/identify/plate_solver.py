@@ -33,7 +33,13 @@ import numpy as np
 from startrack.camera import PROJECTIONS, Camera, radius_of_angle
 from startrack.camera_fit import CameraCalibration
 from startrack.errors import InputError
-from startrack.identify.pattern_catalog import PatternCatalogParams, fisheye_tolerance, load_pattern_catalog, load_source
+from startrack.identify.pattern_catalog import (
+    RECTILINEAR_TO,
+    PatternCatalogParams,
+    fisheye_tolerance,
+    load_pattern_catalog,
+    load_source,
+)
 from startrack.identify.result import IdentificationResult
 from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
 from startrack.identify.zones import SKY, cap, zone_index
@@ -59,9 +65,9 @@ REFIT = ("focal", "centre", "k1", "k2")
 DEFAULT_REFIT = ("focal", "centre", "k1")
 #: Prior sigma of a held focal length, as a fraction of it: the fit's first step puts it at the camera's.
 HELD_FOCAL = 1e-9
-#: Levels [rad] whose frames are also searched as fisheye images (from this level's field up) and as pinhole
-#: images (up to this one): a rectilinear lens's pattern tolerance grows as tan^2 of the half field.
-FISHEYE_FROM, PINHOLE_TO = 40.0 * DEG * (1 - 1e-9), 40.0 * DEG * (1 + 1e-9)
+#: Level [rad] from which up frames are also searched as fisheye images (the pinhole ones up to
+#: :data:`startrack.identify.pattern_catalog.RECTILINEAR_TO`).
+FISHEYE_FROM = 40.0 * DEG * (1 - 1e-9)
 #: Prior sigma of k2 of a fisheye hypothesis when the solver holds k2 (the equisolid, stereographic and
 #: orthographic lenses have k2 = 1/1920, 1/120 and 1/120 in the equidistant model).
 FISHEYE_K2_SIGMA = 0.02
@@ -135,7 +141,7 @@ class PlateSolver:
         self._arrays = tuple(level.arrays for level in self.levels)
         # the look-ups: (level, projection code) of every level and the projections its frames may have
         self._entries = np.array([(n, code) for n, level in enumerate(self.levels) for code, limit in
-                                  ((0, level.fov <= PINHOLE_TO), (1, level.fov >= FISHEYE_FROM)) if limit], np.int64)
+                                  ((0, level.fov <= RECTILINEAR_TO), (1, level.fov >= FISHEYE_FROM)) if limit], np.int64)
         self._mid_fov = np.array([self.levels[n].fov / math.sqrt(ratio) for n, _ in self._entries])
         self._tolerance = np.array([self.levels[n].tolerance if code == 0 else fisheye_tolerance(self.levels[n].fov)
                                     for n, code in self._entries])

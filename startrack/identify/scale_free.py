@@ -182,6 +182,10 @@ def _gates(eps, width, final):  # pragma: no cover  (compiled)
     return np.array([first, max(first / 4.0, 2.0 * final), final])
 
 
+#: Most ratio bins one look-up visits (a clean pattern visits 2^5): a pattern whose centroid sigma makes its
+#: tolerance wider is skipped at that level, so that no look-up runs past the time budget (a defocused
+#: star's 7 px sigma took one 7 deg look-up to ~10^9 bins, 16 s).
+MAX_BINS = 4096
 #: Catalog candidates gathered per observed pattern (over every level) before they are verified.
 CANDIDATE_BUFFER = 256
 
@@ -206,6 +210,8 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, entries, vectors, cx, cy
         ratios, _, _ = edge_ratios(seen, np.arange(4))
         eps = entry_tolerance[n] + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
         bin_ranges(ratios, 1.0, eps, width, base, low, high)
+        if np.prod(high - low + 1) > MAX_BINS:
+            continue  # ratios this uncertain (a blurred star's sigma) would match most of the level
         bins[:] = low
         while True:
             key = pack_key(bins, base)
