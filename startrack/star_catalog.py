@@ -360,10 +360,15 @@ def load_star_catalog(epoch: float = 2000.0) -> StarCatalog:
     hip2.dat is parsed once and cached (:func:`load_hip2_table`); magnitude,
     multiple-star and variable-star filtering belong to the navigation catalog.
     """
+    return _star_catalog_at(checked_epoch(epoch))
+
+
+def checked_epoch(epoch) -> float:
+    """``epoch`` as a float Julian year, or an InputError unless it lies in [1000, 3000]."""
     epoch = float(epoch)
     if not np.isfinite(epoch) or not 1000.0 <= epoch <= 3000.0:
         raise InputError(f"catalog epoch {epoch} is not a Julian year between 1000 and 3000.")
-    return _star_catalog_at(epoch)
+    return epoch
 
 
 @functools.lru_cache(maxsize=4)
