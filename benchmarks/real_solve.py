@@ -21,7 +21,7 @@ the width subtends); solve ms = wall time of the solver call alone (centroids in
 median / p95 / max.  cedar-solve runs in its own venv (``sh benchmarks/peers/setup_venvs.sh``) with its
 database for 8-30 deg, V <= 8 built once from the same Hipparcos-2 stars (``generate_database`` at its
 defaults), its 5 s timeout, once without and once with its distortion search (-0.2, 0.1).  startrack
-runs with its defaults (5-40 deg, 1 s budget).
+runs with its defaults (2-160 deg, 1 s budget).
 
 One-shot wall time: ``startrack solve IMAGE`` in a new process on a warm cache (median of 20), the same
 command handed to a running ``startrack serve`` (median of 20), and, with

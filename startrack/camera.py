@@ -39,6 +39,7 @@ import numpy as np
 from startrack.attitude_angles import radec_roll_from_matrix
 from startrack.errors import InputError
 from startrack.rotation import from_rotation_vector, to_matrix
+from startrack.sphere import angular_distance
 
 #: Newton iterations of the distortion inverse (quadratic convergence; 8 are ample).
 _NEWTON_ITERATIONS = 12
@@ -128,14 +129,7 @@ def width_angle(focal_px, cx, cy, k1, k2, width, height, projection="pinhole"):
     x_d, y_d = np.broadcast_arrays((u - cx) / focal_px, ((height - 1) / 2.0 - cy) / focal_px)
     scale = _ideal_scale(np.hypot(x_d, y_d), k1, k2)
     left, centre, right = ray(np.stack([x_d * scale, y_d * scale], axis=-1), projection)
-    return _angle(left, centre) + _angle(centre, right)
-
-
-def _angle(a, b):
-    """Angle [rad] between the vectors a and b (..., 3): atan2(|a x b|, a . b)."""
-    cross = np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-    return np.arctan2(np.sqrt(np.sum(cross * cross, axis=-1)), np.sum(a * b, axis=-1))
+    return angular_distance(left, centre) + angular_distance(centre, right)
 
 
 @dataclass(frozen=True)

@@ -25,12 +25,13 @@ def vector_to_radec(v):
 
 
 def angular_distance(a, b):
-    """Angle [rad] between direction arrays (..., 3), accurate at 0 and pi (atan2 form)."""
+    """Angle [rad] between direction arrays (..., 3), accurate at 0 and pi: atan2(|a x b|, a . b), the cross
+    product written out (np.cross costs ~20 us a call, most of a small array's time)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
-    cross = np.linalg.norm(np.cross(a, b), axis=-1)
-    dot = np.sum(a * b, axis=-1)
-    return np.arctan2(cross, dot)
+    cross = np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    return np.arctan2(np.sqrt(np.sum(cross * cross, axis=-1)), np.sum(a * b, axis=-1))
 
 
 def local_frame(ra, dec):

@@ -1,27 +1,39 @@
-"""Shared test set-up: caches go to a per-session temporary directory unless set."""
+"""Shared test set-up: caches go to one temporary directory per session unless set, shared by the
+session's xdist workers."""
 
+import fcntl
 import os
+import shutil
+import tempfile
+from pathlib import Path
 
 import pytest
 
 
-@pytest.fixture(autouse=True, scope="session")
-def _isolated_cache(tmp_path_factory):
-    if "STARTRACK_CACHE_DIR" not in os.environ:
-        os.environ["STARTRACK_CACHE_DIR"] = str(tmp_path_factory.mktemp("startrack-cache"))
-    yield
+def pytest_configure(config):
+    """In the session's first process (xdist's controller, or the only one): one cache folder, which the
+    workers inherit with the environment, so the kernels, the star tables and the pattern catalogs are made
+    once per session rather than once per worker."""
+    if hasattr(config, "workerinput") or "STARTRACK_CACHE_DIR" in os.environ:
+        return
+    folder = tempfile.mkdtemp(prefix="startrack-test-cache-")
+    os.environ["STARTRACK_CACHE_DIR"] = folder
+    config.add_cleanup(lambda: shutil.rmtree(folder, ignore_errors=True))
 
 
 @pytest.fixture(autouse=True, scope="session")
-def _kernels_compiled_ahead(_isolated_cache):
+def _kernels_compiled_ahead():
     """The kernels of the image chain, the plate solver and the INS compiled first, on both cores
-    (``startrack.precompile``): no test's output depends on whether it is the first to need them, and the
-    suite compiles them in about half the time."""
+    (``startrack.precompile``), by the first worker to get here while the others wait (then find them
+    compiled): no test's output depends on whether it is the first to need them, and the suite compiles
+    them once, in about half the time of one core."""
     from navsim.attitude.run import IMAGE_LANES
     from navsim.navigation.run import VECTOR_LANES
     from startrack.precompile import compile_ahead
 
-    compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES))
+    with open(Path(os.environ["STARTRACK_CACHE_DIR"]) / "compile-ahead.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES))
     yield
 
 

@@ -197,10 +197,12 @@ def run(args):
     solvers = SolverCache()
     solvers(build_parser().parse_args(["solve"])).prepare()  # the unknown camera's solver, kernels loaded
     server = _listen(path)
-    signal.signal(signal.SIGTERM, _stop)
-    version, home = code_version(), os.getcwd()
-    print(f"startrack serve: listening on {path} (code {version}); Ctrl-C stops", file=sys.stderr, flush=True)
-    try:
+    try:  # a SIGTERM from here on (right after the line that says it listens too) stops the server cleanly
+        signal.signal(signal.SIGTERM, _stop)
+        version, home = code_version(), os.getcwd()
+        # one write of the whole line: a SIGTERM cannot fall between the text and its newline
+        sys.stderr.write(f"startrack serve: listening on {path} (code {version}); Ctrl-C stops\n")
+        sys.stderr.flush()
         while True:
             connection, _ = server.accept()
             with connection:

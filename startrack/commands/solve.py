@@ -73,10 +73,10 @@ def register(subparsers):
                         help="refit these intrinsics of the given camera per frame: focal,centre,k1,k2 or all")
     parser.add_argument("--fov-hint-deg", type=float,
                         help="unknown camera: field of view across the width [deg] searched first (a hint; below "
-                             "5 deg it extends the search down to it)")
+                             "2 deg it extends the search down to it)")
     parser.add_argument("--fov-range-deg", metavar="LO,HI",
-                        help="unknown camera: search only fields of view in [LO, HI] deg (default 5,160; "
-                             "pinhole and, from 28 deg, fisheye lenses)")
+                        help="unknown camera: search only fields of view in [LO, HI] deg (default 2,160; "
+                             "pinhole and, from 28 deg, fisheye lenses; below 5 deg with Gaia DR3 stars to V 10)")
     parser.add_argument("--write-camera", metavar="FILE", help="write the fitted camera (TOML) to FILE")
     parser.add_argument("--width", type=int,
                         help="image width [px] (centroid input, default the camera file's; checked for images)")
@@ -87,7 +87,8 @@ def register(subparsers):
                         help="largest error of the prior boresight [deg] for the plate solver (10)")
     parser.add_argument("--mag", type=float, default=None,
                         help="faintest catalog star [V mag]: of a given camera's catalog (default from the field's "
-                             "size: V 6 at 16 deg) or of the plate solver's verification (8)")
+                             "size: V 6 at 16 deg) or of the plate solver's verification (10 with the Gaia stars "
+                             "of a search below 5 deg, as the default's, else 8)")
     parser.add_argument("--epoch", type=float, default=None,
                         help="epoch of the star positions [Julian year] (a FITS image's observation, else 2000)")
     parser.add_argument("--hdu", type=int, default=None, help="the HDU of FITS images to solve (the first image HDU)")
@@ -130,9 +131,9 @@ def _fov_range(args):
     """(low, high) [rad] of the field of view searched, or None for the default range; a hint narrower than
     the default range's low end extends it down to the hint over :data:`GIVEN_FOV_SPREAD`."""
     if args.fov_range_deg is None:
-        from startrack.identify.pattern_catalog import PatternCatalogParams
+        from startrack.identify.plate_solver import DEFAULT_FOV_RANGE
 
-        low = PatternCatalogParams().fov_min / DEG
+        low = DEFAULT_FOV_RANGE[0] / DEG
         if args.fov_hint_deg is not None and args.fov_hint_deg < low:
             return args.fov_hint_deg / GIVEN_FOV_SPREAD * DEG, _widest_deg() * DEG
         return None
@@ -183,7 +184,7 @@ def _frame_solver(args):
     check_range("--boresight-error-deg", args.boresight_error_deg, 0.0, 180.0)
     check_range("--max-false-match", args.max_false_match, 1e-300, 1.0)
     if args.mag is not None:
-        check_range("--mag", args.mag, -2.0, 8.0)
+        check_range("--mag", args.mag, -2.0, 10.0)
     refit = None if args.refit is None else parse_refit(args.refit)
     camera_file = None if args.camera is None else read_camera_file(args.camera)
     if camera_file is not None or args.fov_deg is not None:  # a refit or a diagnosis searches near the given field

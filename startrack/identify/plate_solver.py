@@ -5,8 +5,9 @@ from the stars (a plate solver).
 verification stars (the same stars, V <= its magnitude limit, at the frames' epoch, in a
 declination-zone index): the Hipparcos-2 stars to V 8, or when the fields searched reach below 5 deg
 the Gaia DR3 stars to V 10 (:mod:`startrack.gaia_catalog`; a 2 deg field holds a median 28 of them, 6
-Hipparcos-2 stars to V 9).  The answer names each star by its id
-(:attr:`startrack.star_catalog.StarCatalog.ids`: the HIP number, else the Gaia DR3 source_id).
+Hipparcos-2 stars to V 9), as the default range, 2-160 deg (:data:`DEFAULT_FOV_RANGE`), does.  The answer
+names each star by its id (:attr:`startrack.star_catalog.StarCatalog.ids`: the HIP number, else the Gaia
+DR3 source_id).
 ``solve`` orders the detections brightest first, thins them into pattern candidates, measures the local
 density of the detections (a grid of the frame, the false-match model of
 :mod:`startrack.identify.self_calibration`), and runs the compiled search
@@ -75,6 +76,9 @@ FISHEYE_K2_SIGMA = 0.02
 PINHOLE_WIDEST = 170.0 * DEG
 #: Faintest star [V mag] of the Gaia DR3 stars a search below the Hipparcos levels (5 deg) takes.
 GAIA_MAG_LIMIT = 10.0
+#: Fields of view [rad] searched unless told otherwise: 2 deg (a 2 deg 4:3 field holds a median 28 Gaia
+#: stars to V 10, never fewer than 4; benchmarks/narrow_field_stars.py) to the widest level, 160 deg.
+DEFAULT_FOV_RANGE = (2.0 * DEG, PatternCatalogParams().fov_max)
 
 
 def _density_grid(uv, width, height):
@@ -93,7 +97,7 @@ def _density_grid(uv, width, height):
 class PlateSolver:
     """Star identification and camera calibration of frames whose field of view is unknown.
 
-    fov_range: (min, max) field of view across the image width [rad] (default: the pattern catalog's);
+    fov_range: (min, max) field of view across the image width [rad] (default :data:`DEFAULT_FOV_RANGE`);
     epoch: of the star positions [Julian year]; threshold: largest accepted false-match probability;
     time_budget_s: search time per frame before ``no_match``; final_gate_px: match radius of the last
     verification passes [px]; principal_point_sigma: prior sigma of the principal point about the
@@ -106,7 +110,7 @@ class PlateSolver:
     def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
                  principal_point_sigma=0.005, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
         defaults = PatternCatalogParams()
-        low, high = (defaults.fov_min, defaults.fov_max) if fov_range is None else (float(fov_range[0]), float(fov_range[1]))
+        low, high = DEFAULT_FOV_RANGE if fov_range is None else (float(fov_range[0]), float(fov_range[1]))
         if not (0.5 * DEG <= low <= high <= defaults.fov_max):
             raise InputError(f"field of view range [{low / DEG:g}, {high / DEG:g}] deg must lie within "
                              f"[0.5, {defaults.fov_max / DEG:g}] deg.")

@@ -52,13 +52,17 @@ WIDE_PASSES, GROWTH = 3, 1.1
 OUTLIER = 4.0
 #: Rounds of dropping outliers, each followed by the fit of the matches left.
 OUTLIER_ROUNDS = 3
+#: Predicted stars this close to a detection [px] are one blend to it: the brightest of them is its match
+#: (a double that Hipparcos-2 lists as one star and Gaia DR3 resolves, e.g. HIP 8544, G 5.9 and 7.2 at 2.9").
+BLEND_PX = 1.0
 
 
 @njit
 def match_pixels(obs_uv, n_obs, pred_uv, gate):  # pragma: no cover  (compiled)
     """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [px] among
-    the first ``n_obs`` observed points; predictions sorted by u, each point compares those within
-    +-gate in u (a nearest neighbour outside that window lies outside the gate)."""
+    the first ``n_obs`` observed points, the predictions brightest first: a point's neighbour is the
+    brightest prediction within :data:`BLEND_PX` of it, else the nearest.  Predictions sorted by u, each
+    point compares those within +-gate in u (a nearest neighbour outside that window lies outside the gate)."""
     m = pred_uv.shape[0]
     order = argsort(np.ascontiguousarray(pred_uv[:, 0]))
     u_sorted = pred_uv[order, 0]
@@ -66,12 +70,14 @@ def match_pixels(obs_uv, n_obs, pred_uv, gate):  # pragma: no cover  (compiled)
     best_pred_d = np.full(n_obs, np.inf)
     best_obs = np.full(m, -1, np.int64)
     best_obs_d = np.full(m, np.inf)
+    blend = BLEND_PX * BLEND_PX
     for i in range(n_obs):
         for e in range(np.searchsorted(u_sorted, obs_uv[i, 0] - gate), np.searchsorted(u_sorted, obs_uv[i, 0] + gate,
                                                                                         side="right")):
             j = order[e]
             d2 = (obs_uv[i, 0] - pred_uv[j, 0]) ** 2 + (obs_uv[i, 1] - pred_uv[j, 1]) ** 2
-            if d2 < best_pred_d[i]:
+            blended = d2 <= blend and best_pred_d[i] <= blend
+            if (j < best_pred[i]) if blended else d2 < best_pred_d[i]:
                 best_pred_d[i], best_pred[i] = d2, j
             if d2 < best_obs_d[j]:
                 best_obs_d[j], best_obs[j] = d2, i

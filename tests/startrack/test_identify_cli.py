@@ -193,8 +193,8 @@ def test_malformed_csv(tmp_path, capsys, text, message):
 
 
 @pytest.mark.parametrize("argv, expected_deg", [
-    (["--fov-hint-deg", "3"], (3.0 / 1.3, 160.0)),       # below the default range: searched down to it
-    (["--fov-hint-deg", "11"], None),                    # inside it: the default range
+    (["--fov-hint-deg", "1.5"], (1.5 / 1.3, 160.0)),     # below the default range: searched down to it
+    (["--fov-hint-deg", "3"], None),                     # inside it (2-160 deg): the default range
     (["--fov-range-deg", "2,20", "--fov-hint-deg", "3"], (2.0, 20.0))])
 def test_a_narrow_hint_extends_the_search(argv, expected_deg):
     from startrack.cli import build_parser

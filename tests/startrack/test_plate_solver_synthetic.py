@@ -70,19 +70,20 @@ def _centre_error(result, camera, q_IS):
     return math.acos(min(1.0, (np.trace(R) - 1.0) / 2.0))
 
 
-def _right_fraction(result, found, sky, radius_px):
-    """Fraction of the matched stars rendered within ``radius_px`` of their detection."""
-    right = 0
-    for index, hip in result.matches:
-        near = np.hypot(*(sky.uv - found.uv[index]).T) < radius_px
-        right += hip in set(sky.hip[near].tolist())
-    return right / len(result.matches)
+def _right_fraction(solver, result, found, sky, radius_px):
+    """Fraction of the matches whose catalog star the true attitude and camera image within ``radius_px`` of its
+    detection (by position: the solver's stars may be Gaia DR3's, which name a double that Hipparcos-2 lists as one
+    star by the Gaia source_id of its brighter component)."""
+    order = np.argsort(solver.ids, kind="stable")
+    star = order[np.searchsorted(solver.ids[order], result.matched_hip)]
+    truth_uv, _ = sky.camera.project(sky.q_IS, solver.vectors[star])
+    return float(np.mean(np.hypot(*(truth_uv - found.uv[result.matches[:, 0]]).T) < radius_px))
 
 
-def _is_right(result, found, sky):
-    """The answer is right: centre pointing within 1 arcmin and every matched star rendered at its detection."""
+def _is_right(solver, result, found, sky):
+    """The answer is right: centre pointing within 1 arcmin and every matched star imaged at its detection."""
     return (_centre_error(result, sky.camera, sky.q_IS) <= WRONG_ANGLE
-            and _right_fraction(result, found, sky, BLEND_PX) == 1.0)
+            and _right_fraction(solver, result, found, sky, BLEND_PX) == 1.0)
 
 
 def _check_rendered(solver, stars, fov_deg, k1, seed):
@@ -90,7 +91,7 @@ def _check_rendered(solver, stars, fov_deg, k1, seed):
     sky = rendered_sky(camera, stars, np.random.default_rng(seed))
     found, result = _solve(solver, sky.image, sky.full_scale)
     assert result.ok, f"{fov_deg:.2f} deg, k1 {k1:+.3f}: {result.reason}"
-    assert _is_right(result, found, sky)
+    assert _is_right(solver, result, found, sky)
     calibration = result.calibration
     assert abs(calibration.camera.angular_width / camera.angular_width - 1.0) < 5e-4
     k1_error, k1_sigma = abs(calibration.camera.k1 - k1), calibration.sigma["k1"]
@@ -121,7 +122,7 @@ def test_rendered_fisheye_frames(solver, stars, fov_deg, lens):
     sky = rendered_sky(camera, stars, np.random.default_rng(int(fov_deg)))
     found, result = _solve(solver, sky.image, sky.full_scale)
     assert result.ok, f"{fov_deg:.0f} deg {lens}: {result.reason}"
-    assert _is_right(result, found, sky) and result.camera.projection == "fisheye"
+    assert _is_right(solver, result, found, sky) and result.camera.projection == "fisheye"
     assert abs(result.camera.angular_width / camera.angular_width - 1.0) < 5e-4
     assert abs(result.camera.k1 - k1) < 4.0 * result.calibration.sigma["k1"] + 1e-4
 
@@ -137,25 +138,19 @@ def test_pattern_levels_deepen_below_five_degrees():
         PatternCatalogParams(source="tycho")
 
 
-@pytest.mark.slow
-def test_rendered_narrow_frames():
-    """Frames of 2-5 deg rendered from the Gaia DR3 sky (2 s exposure: V ~ 10.5), solved with the Gaia stars
-    (a field range reaching below 5 deg): right, and named by HIP or Gaia source_id."""
+def test_rendered_narrow_frames(solver):
+    """Frames of 2-5 deg rendered from the Gaia DR3 sky (2 s exposure: V ~ 10.5), solved by the default search
+    (down to 2 deg, with the Gaia stars): right, and named by HIP or Gaia source_id."""
     from startrack.gaia_catalog import load_gaia_catalog
     from startrack.render import SensorModel
 
     sky_stars = load_gaia_catalog(2000.0)
-    narrow = PlateSolver(fov_range=(2.0 * DEG, 160.0 * DEG))
     for fov_deg, seed in ((2.2, 1), (3.3, 2), (4.7, 3)):
         camera = Camera.from_fov(fov_deg * DEG, WIDTH, HEIGHT, k1=0.05)
         sky = rendered_sky(camera, sky_stars, np.random.default_rng(seed), SensorModel(exposure_s=2.0))
-        found, result = _solve(narrow, sky.image, sky.full_scale)
+        found, result = _solve(solver, sky.image, sky.full_scale)
         assert result.ok, f"{fov_deg} deg: {result.reason}"
-        assert _centre_error(result, camera, sky.q_IS) < WRONG_ANGLE
-        order = np.argsort(sky_stars.ids)
-        star = order[np.searchsorted(sky_stars.ids[order], result.matched_hip)]  # each matched id's star
-        truth_uv, _ = camera.project(sky.q_IS, sky_stars.vectors[star])
-        assert np.all(np.hypot(*(truth_uv - found.uv[result.matches[:, 0]]).T) < BLEND_PX)
+        assert _is_right(solver, result, found, sky)
         assert (result.matched_hip > HIP_MAX).any()  # stars Hipparcos-2 lacks, by their Gaia source_id
 
 
@@ -176,7 +171,7 @@ def _jpeg_case(solver, stars, seed):
     assert result.status in ("ok", "no_match")
     if result.ok:
         assert _centre_error(result, sky.camera, sky.q_IS) < 0.1 * DEG
-        assert _right_fraction(result, found, sky, JPEG_BLEND_PX) >= 0.9
+        assert _right_fraction(solver, result, found, sky, JPEG_BLEND_PX) >= 0.9
     return result.ok
 
 
@@ -222,12 +217,14 @@ def test_stars_in_a_crowd_are_found_right(solver, stars):
 def test_a_search_cut_after_every_hypothesis_resumes_to_the_same_answer(stars, monkeypatch):
     """The compiled search returns after each verified hypothesis and resumes at the next candidate of the
     same combination: the same hypotheses in the same order, so the same answer as in long calls (a 30 deg
-    frame with 100 false stars, found after ~940 hypotheses, ~900 of them cut inside a combination)."""
-    rng = np.random.default_rng(2)
+    frame with 70 false stars, found by the Hipparcos levels after 493 hypotheses, most of them cut inside a
+    combination)."""
+    rng = np.random.default_rng(5)
     camera = Camera.from_fov(30.0 * DEG, WIDTH, HEIGHT)
     frame = centroid_frame(camera, stars.vectors, stars.hip, stars.v_mag, random_attitude(rng), rng, sigma_px=0.3,
-                           n_false=100)
-    solver = PlateSolver(time_budget_s=100.0)  # 100 000 looks at the stepped clock: no budget ends either search
+                           n_false=70)
+    # 100 000 looks at the stepped clock: no budget ends either search
+    solver = PlateSolver(fov_range=(5.0 * DEG, 160.0 * DEG), time_budget_s=100.0)
     calls = []
 
     def counted(*args):
@@ -241,13 +238,18 @@ def test_a_search_cut_after_every_hypothesis_resumes_to_the_same_answer(stars, m
     monkeypatch.setattr(plate_solver, "MAX_TRIED", 1)
     calls.clear()
     cut = solver.solve(frame.uv, WIDTH, HEIGHT, frame.flux, np.full(len(frame.uv), 0.3))
-    assert sum(skip > 0 for skip in calls) > 500
+    assert sum(skip > 0 for skip in calls) > 300
     assert whole.ok and cut.ok and _centre_error(cut, camera, frame.q_IS) < WRONG_ANGLE
     np.testing.assert_array_equal(cut.matches, whole.matches)
     np.testing.assert_array_equal(cut.q_IS, whole.q_IS)
 
 
 @pytest.mark.slow
-def test_thirty_crowds(solver, stars):
+def test_thirty_crowds(solver, stars, monkeypatch):
+    """Thirty crowds, half with their stars: never a wrong answer.  A look at the stepped clock stands for 10 ms
+    and at most 20 hypotheses are verified between two: the budget's work is bounded as the real clock bounds it
+    (at 1 ms per look the pace estimate let each call verify up to 1000 hypotheses: 42 000 for one crowd, 260 s)."""
+    monkeypatch.setattr(plate_solver, "time", SimpleNamespace(perf_counter=SteppedClock(0.01)))
+    monkeypatch.setattr(plate_solver, "MAX_TRIED", 20)
     for seed in range(200, 230):
         _crowd_case(solver, stars, seed, with_stars=bool(seed % 2))

@@ -93,7 +93,8 @@ def test_other_code_a_stream_or_use_server_0_solve_in_the_clients_process(server
     monkeypatch.setenv(serve_client.SOCKET_ENV, str(server.socket))
     monkeypatch.setattr(serve_client, "code_version", lambda: "other code")
     assert serve_client.forward(["solve", str(IMAGE)]) is None
-    assert server.lines()[-1].endswith("refused a client of other code")
+    # the server logs the refusal after sending it
+    wait_for(lambda: server.lines()[-1].endswith("refused a client of other code"), "the refusal's log line")
     assert not serve_client.forwardable(["solve", "--batch", "-"])
     assert not serve_client.forwardable(["render", "-o", "x.png"])
     monkeypatch.setenv(serve_client.USE_ENV, "0")
@@ -116,7 +117,7 @@ def test_bad_requests_are_refused_or_dropped_and_the_server_goes_on(server):
     other = json.dumps({"version": serve_client.code_version(), "argv": ["render", "-o", "/tmp/x.png"], "cwd": "/"})
     assert json.loads(_raw(server, other.encode() + b"\n")) == {"refused": "the server answers startrack solve only"}
     assert _raw(server, b"not json\n") == b""
-    assert server.lines()[-1].endswith("dropped a request: the request is not JSON")
+    wait_for(lambda: server.lines()[-1].endswith("dropped a request: the request is not JSON"), "the drop's log line")
     assert _raw(server, b'{"argv": "solve"}\n') == b""
     assert server.solve(IMAGE).returncode == 0
 

@@ -100,7 +100,7 @@ def test_all_dark_and_empty_frames_say_why(tmp_path, capsys):
     ("corrupt", [], "could not be read"),
     ("missing", [], "does not exist"),
     ("good", ["--fov-range-deg", "5"], "--fov-range-deg"),
-    ("good", ["--mag", "9.5"], "--mag"),
+    ("good", ["--mag", "10.5"], "--mag"),
     ("good", ["--width", "1000"], "not the 1000 x"),
     ("good", ["--batch", "x"], "not both"),
 ])
