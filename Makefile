@@ -14,8 +14,8 @@ RUN_STAMP := $(VENV)/.installed-run
 TEST_STAMP := $(VENV)/.installed-test
 PYTEST_ARGS ?=
 # The suite runs on this many processes (pytest-xdist; a module's tests stay together, so its fixtures are built
-# once) sharing one cache folder, the kernels compiled ahead once by the first of them (tests/conftest.py): 12.5-14.3 min
-# on a fresh 2-core machine, 159 s of it compiling. TEST_WORKERS=0 runs it in this process.
+# once) sharing one cache folder, the kernels compiled ahead once by the first of them (tests/conftest.py): 5.6 min
+# on a fresh 2-core machine (12.5-14.3 min on a slower one). TEST_WORKERS=0 runs it in this process.
 TEST_WORKERS ?= 2
 LOCK := $(UV) pip compile --quiet --generate-hashes --python-version 3.11 --python-platform x86_64-unknown-linux-gnu
 INSTALL := $(UV) pip install --quiet --python $(PY) --require-hashes
