@@ -366,6 +366,10 @@ def stream_latency(image, frames=200):
 
 
 # ----------------------------------------------------------------------------------- main
+def _fmt(value, spec):
+    return "-" if value is None else format(value, spec)
+
+
 def _print(scores, one):
     sets = list(next(iter(scores.values())).keys())
     print(f"{'solver':<34} {'set':<10} {'frames':>6} {'success':>8} {'wrong':>6} {'ms med':>8} {'p95':>8} {'max':>9} "
@@ -375,10 +379,10 @@ def _print(scores, one):
             m = per_set[set_name]
             c, f, ms = m["centre_error_arcsec"], m["fov_error_percent"], m["solve_ms"] or {"median": None, "p95": None,
                                                                                              "max": None}
-            fmt = (lambda v, s: "-" if v is None else format(v, s))
             print(f"{name:<34} {set_name:<10} {m['answerable']:>3}/{m['frames']:<3} {m['success']:>8} {m['wrong']:>6} "
-                  f"{fmt(ms['median'], '.2f'):>8} {fmt(ms['p95'], '.2f'):>8} {fmt(ms['max'], '.1f'):>9} "
-                  f"{fmt(c['median'], '.1f'):>9}/{fmt(c['max'], '<9.1f')} {fmt(f['median'], '.4f'):>9}/{fmt(f['max'], '<9.4f')}")
+                  f"{_fmt(ms['median'], '.2f'):>8} {_fmt(ms['p95'], '.2f'):>8} {_fmt(ms['max'], '.1f'):>9} "
+                  f"{_fmt(c['median'], '.1f'):>9}/{_fmt(c['max'], '<9.1f')} "
+                  f"{_fmt(f['median'], '.4f'):>9}/{_fmt(f['max'], '<9.4f')}")
     print(f"\none-shot `startrack solve {one['image']}` (new process, warm cache, median of 20): after {one['after_ms']:.0f} ms "
           f"(one cached numba kernel in a new process: {one['floor_ms']:.0f} ms), handed to a running `startrack serve` "
           f"{one['served_ms']:.0f} ms"
