@@ -91,7 +91,7 @@ MATCH_RADIUS = 3.0 * ARCSEC
 MATCH_MAGNITUDE = 0.75
 MATCH_CLOSE = 0.5 * ARCSEC
 
-_PARSE_FORMAT = 1  # bump when the cached table's layout or the cross-match changes
+_PARSE_FORMAT = 2  # bump when the cached table's layout or the cross-match changes
 
 
 def g_minus_v(bp_rp):
@@ -204,7 +204,8 @@ def match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
 
 def build_gaia_table(gaia: dict, hip2: dict) -> dict:
     """A :func:`parse_gaia_binary` table with ``hip_row`` (:func:`match_hipparcos`) and the Hipparcos
-    rows' J2016.0 positions recomputed from Hipparcos-2 (rigorous propagation)."""
+    rows' J2016.0 positions recomputed from Hipparcos-2 (rigorous propagation), its rows brightest (V)
+    first as the catalogs of it are."""
     table = dict(gaia)
     hip_rows = match_hipparcos(gaia, hip2)
     table["hip_row"] = hip_rows
@@ -218,7 +219,23 @@ def build_gaia_table(gaia: dict, hip2: dict) -> dict:
     table["ra"] = table["ra"].copy()
     table["dec"] = table["dec"].copy()
     table["ra"][from_hip], table["dec"][from_hip] = ra, dec
-    return table
+    order = np.argsort(_magnitudes(table, hip2)[0], kind="stable")  # brightest first, as the catalogs are
+    return {name: column[order] for name, column in table.items()}
+
+
+def _magnitudes(table: dict, hip2: dict):
+    """(V, V - I_C) [mag] of the rows of a :func:`build_gaia_table` table (module text)."""
+    rows = table["hip_row"]
+    matched = rows >= 0
+    take = np.where(matched, rows, 0)
+    g, bp_rp = table["g_mag"], table["bp_mag"] - table["rp_mag"]
+    has_colour = np.isfinite(bp_rp)
+    hip_v = visual_magnitude(hip2["hp_mag"], hip2["b_v"])[take]
+    v_mag = np.where(has_colour, g - g_minus_v(np.where(has_colour, bp_rp, SOLAR_BP_RP)),
+                     np.where(matched, hip_v, g - g_minus_v(SOLAR_BP_RP)))
+    v_i = np.where(has_colour, v_minus_i(np.where(has_colour, bp_rp, SOLAR_BP_RP)),
+                   np.where(matched, hip2["v_i"][take], np.nan))
+    return v_mag, v_i
 
 
 def catalog_version() -> str:
@@ -244,7 +261,8 @@ def load_gaia_table() -> dict:
 
 def gaia_catalog_from_table(table: dict, hip2: dict, epoch: float) -> StarCatalog:
     """A :class:`StarCatalog` at ``epoch`` [Julian year] from :func:`load_gaia_table` and
-    :func:`load_hip2_table` tables, brightest first."""
+    :func:`load_hip2_table` tables, brightest first (the table's rows are: only the moving stars' columns
+    are computed anew)."""
     rows = table["hip_row"]
     matched = rows >= 0
     take = np.where(matched, rows, 0)
@@ -252,43 +270,41 @@ def gaia_catalog_from_table(table: dict, hip2: dict, epoch: float) -> StarCatalo
     def from_hip(name, missing):
         return np.where(matched, hip2[name][take], missing)
 
-    g, bp_rp = table["g_mag"], table["bp_mag"] - table["rp_mag"]
-    has_colour = np.isfinite(bp_rp)
-    hip_v = visual_magnitude(hip2["hp_mag"], hip2["b_v"])[take]
-    v_mag = np.where(has_colour, g - g_minus_v(np.where(has_colour, bp_rp, SOLAR_BP_RP)),
-                     np.where(matched, hip_v, g - g_minus_v(SOLAR_BP_RP)))
-    v_i = np.where(has_colour, v_minus_i(np.where(has_colour, bp_rp, SOLAR_BP_RP)), from_hip("v_i", np.nan))
+    v_mag, v_i = _magnitudes(table, hip2)
     pm_ra, pm_dec = from_hip("pm_ra_cosdec", 0.0), from_hip("pm_dec", 0.0)
-    vectors = propagate_proper_motion(table["ra"], table["dec"], pm_ra, pm_dec, epoch - GAIA_EPOCH)
-    ra, dec = vector_to_radec(vectors)
+    ra, dec = table["ra"].copy(), table["dec"].copy()
+    vectors = radec_to_vector(ra, dec)
+    # only the matched stars move (a quarter of them): the others keep their J2016.0 position
+    vectors[matched] = propagate_proper_motion(ra[matched], dec[matched], pm_ra[matched], pm_dec[matched],
+                                               epoch - GAIA_EPOCH)
+    ra[matched], dec[matched] = vector_to_radec(vectors[matched])
     sn = from_hip("solution_type", 0).astype(np.int16)
     so = from_hip("old_solution_type", 0)
     n_components = from_hip("n_components", 1).astype(np.int8)
     variability_annex = from_hip("variability_annex", 0).astype(np.int8)
     multiple = matched & ((n_components > 1) | (((sn // 10) & 1) == 1) | (sn % 10 == 3) | ((so >= 3) & (so <= 5)))
-    order = np.argsort(v_mag, kind="stable")
     return StarCatalog(
-        hip=from_hip("hip", -1).astype(np.int32)[order],
-        ra=ra[order],
-        dec=dec[order],
-        vectors=vectors[order],
-        mag=v_mag[order],
-        v_mag=v_mag[order],
-        hp_mag=from_hip("hp_mag", np.nan)[order],
-        b_v=from_hip("b_v", np.nan)[order],
-        v_i=v_i[order],
-        parallax=from_hip("parallax", np.nan)[order],
-        parallax_error=from_hip("parallax_error", np.nan)[order],
-        pm_ra_cosdec=pm_ra[order],
-        pm_dec=pm_dec[order],
-        n_components=n_components[order],
-        solution_type=sn[order],
-        variability_annex=variability_annex[order],
-        multiple=multiple[order],
-        variable=(variability_annex != 0)[order],
+        hip=from_hip("hip", -1).astype(np.int32),
+        ra=ra,
+        dec=dec,
+        vectors=vectors,
+        mag=v_mag,
+        v_mag=v_mag,
+        hp_mag=from_hip("hp_mag", np.nan),
+        b_v=from_hip("b_v", np.nan),
+        v_i=v_i,
+        parallax=from_hip("parallax", np.nan),
+        parallax_error=from_hip("parallax_error", np.nan),
+        pm_ra_cosdec=pm_ra,
+        pm_dec=pm_dec,
+        n_components=n_components,
+        solution_type=sn,
+        variability_annex=variability_annex,
+        multiple=multiple,
+        variable=(variability_annex != 0),
         epoch=float(epoch),
-        source_id=table["source_id"][order],
-        g_mag=g[order],
+        source_id=table["source_id"],
+        g_mag=table["g_mag"],
     )
 
 

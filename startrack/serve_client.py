@@ -1,6 +1,6 @@
 """The client side of ``startrack serve``: a one-shot ``startrack solve`` handed to a running solver.
 
-A new process pays ~3 s before its first solve on a 2-core machine (numpy, scipy and numba imports, the
+A new process pays ~1 s before its first solve on a 2-core machine (numpy, scipy and numba imports, the
 compiled kernels loaded), the solve itself a few ms.  When a ``startrack serve`` listens on the socket
 (:func:`socket_path`) and runs the same code (:func:`code_version`), ``startrack solve`` sends it its
 arguments and working directory and prints what the server's ``solve`` prints, as it prints it; else it

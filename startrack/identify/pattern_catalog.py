@@ -67,7 +67,7 @@ RECTILINEAR_TO = 40.0 * DEG * (1.0 + 1e-9)
 #: Part of each level's bin width that is left for centroid noise (ratio units).
 NOISE_TOLERANCE = 0.004
 #: Layout of the cached files; bump when the arrays change.
-_LAYOUT = 3
+_LAYOUT = 4
 #: The star sources: Hipparcos-2 (:mod:`startrack.star_catalog`) and Gaia DR3 (:mod:`startrack.gaia_catalog`).
 SOURCES = ("hipparcos", "gaia")
 #: Level [rad] from which down the Gaia levels take fainter stars, the magnitude there [V] and the slope.
@@ -328,7 +328,8 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
 class PatternLevel:
     """One scale level: ``fov`` F_l [rad], ratio bin ``width`` and ``base`` (bins per ratio), the model
     ``tolerance``; ``stars`` (N, 4) int32 pattern stars (indices into the catalog's stars) sorted by
-    ``keys`` (N,) int64; ``slots`` the hash table (key -> first index of its run)."""
+    ``keys`` (N,) int64; ``slots`` the hash table (key -> first index of its run); ``per_lookup`` the
+    expected catalog patterns per look-up (:func:`candidates_per_lookup`)."""
 
     fov: float
     width: float
@@ -337,6 +338,7 @@ class PatternLevel:
     stars: np.ndarray
     keys: np.ndarray
     slots: np.ndarray
+    per_lookup: float
 
     @property
     def arrays(self):
@@ -355,7 +357,18 @@ def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> Pat
     keys, patterns = keys[order], np.ascontiguousarray(patterns[order])
     n_distinct = int(np.count_nonzero(np.diff(keys)) + 1) if keys.size else 0
     n_slots = 1 << max(4, int(math.ceil(math.log2(2 * max(n_distinct, 1)))))
-    return PatternLevel(fov, width, base, tolerance, patterns, keys, _fill_slots(keys, n_slots))
+    return PatternLevel(fov, width, base, tolerance, patterns, keys, _fill_slots(keys, n_slots),
+                        candidates_per_lookup(keys))
+
+
+def candidates_per_lookup(keys) -> float:
+    """Expected catalog patterns per look-up of a level whose sorted keys are ``keys``: the 2^5 keys a
+    clean pattern's look-up visits times the mean number of patterns that share a key with a pattern (the
+    sum of the squared run lengths over the patterns)."""
+    if keys.size == 0:
+        return 0.0
+    runs = np.diff(np.flatnonzero(np.r_[True, np.diff(keys) != 0, True]))
+    return 32.0 * float(np.sum(runs.astype(float) ** 2) / keys.size)
 
 
 class PatternCatalog:
@@ -401,7 +414,7 @@ class PatternCatalog:
             for name in ("stars", "keys", "slots"):
                 np.save(folder / f"level{l}-{name}.npy", getattr(level, name), allow_pickle=False)
             meta["levels"].append({"fov": level.fov, "width": level.width, "base": level.base,
-                                   "tolerance": level.tolerance})
+                                   "tolerance": level.tolerance, "per_lookup": level.per_lookup})
         (folder / "meta.json").write_text(json.dumps(meta))
 
     @classmethod
@@ -416,7 +429,7 @@ class PatternCatalog:
                 arrays = {name: np.asarray(np.load(folder / f"level{l}-{name}.npy", mmap_mode="r", allow_pickle=False))
                           for name in ("stars", "keys", "slots")}
                 levels.append(PatternLevel(float(info["fov"]), float(info["width"]), int(info["base"]),
-                                           float(info["tolerance"]), **arrays))
+                                           float(info["tolerance"]), **arrays, per_lookup=float(info["per_lookup"])))
             ids = np.load(folder / "ids.npy", allow_pickle=False)
             return cls(PatternCatalogParams(**meta["params"]), ids, levels)
         except (OSError, ValueError, KeyError, TypeError) as error:

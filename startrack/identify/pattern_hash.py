@@ -21,7 +21,7 @@ the first few are taken breadth first (:data:`startrack.identify.scale_free.COMB
    the SVD attitude of the four (Markley 1988), kept when each of them lies within the first
    verification gate (a mirror image does not);
 4. :func:`startrack.identify.verify.verify_near` with 4 seed stars and N_h = the combinations searched
-   x the expected catalog patterns per look-up (:func:`startrack.identify.scale_free.expected_candidates`).
+   x the expected catalog patterns per look-up (:attr:`startrack.identify.pattern_catalog.PatternLevel.per_lookup`).
 
 The first accepted hypothesis ends the search; otherwise the pyramid search follows, its N_h increased
 by this one's (:func:`startrack.identify.lost_in_space.search_tables`).
@@ -52,7 +52,6 @@ from startrack.identify.scale_free import (
     MAX_CANDIDATES,
     angle_matrix,
     correspondence,
-    expected_candidates,
 )
 from startrack.identify.verify import PATTERN_SEEDS, verify_near
 from startrack.jit import njit
@@ -85,7 +84,7 @@ def pattern_arrays(field, hash_stars: int = HASH_STARS):
         return NO_PATTERNS
     level = build_level(field.vectors, field.v_mag, fov, params)
     n_combinations = int(COMBINATIONS_BELOW[min(hash_stars, MAX_CANDIDATES)])
-    n_h = n_combinations * expected_candidates(level)
+    n_h = n_combinations * level.per_lookup
     return (np.ascontiguousarray(level.stars, np.int32), np.ascontiguousarray(level.keys, np.int64),
             np.ascontiguousarray(level.slots, np.int32), float(level.width), int(level.base), n_combinations,
             math.cos(SEPARATION_PER_FOV * fov), float(n_h))

@@ -42,7 +42,7 @@ from startrack.identify.pattern_catalog import (
     load_source,
 )
 from startrack.identify.result import IdentificationResult
-from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates, pattern_candidates, search
+from startrack.identify.scale_free import COMBINATIONS_BELOW, pattern_candidates, search
 from startrack.identify.zones import SKY, cap, zone_index
 from startrack.units import DEG
 
@@ -79,6 +79,16 @@ GAIA_MAG_LIMIT = 10.0
 #: Fields of view [rad] searched unless told otherwise: 2 deg (a 2 deg 4:3 field holds a median 28 Gaia
 #: stars to V 10, never fewer than 4; benchmarks/narrow_field_stars.py) to the widest level, 160 deg.
 DEFAULT_FOV_RANGE = (2.0 * DEG, PatternCatalogParams().fov_max)
+
+
+def _positions(ids, wanted):
+    """Indices into ``ids`` of the ids ``wanted`` (both brightest first: mostly the same order), or None
+    when ``ids`` does not hold each of them once."""
+    if np.array_equal(ids, wanted):
+        return np.arange(ids.size)
+    order = np.argsort(ids, kind="stable")
+    position = order[np.clip(np.searchsorted(ids[order], wanted), 0, max(ids.size - 1, 0))]
+    return position if ids.size == wanted.size and np.array_equal(ids[position], wanted) else None
 
 
 def _density_grid(uv, width, height):
@@ -128,9 +138,8 @@ class PlateSolver:
         self.fisheye_k2_sigma = max(k2_sigma, FISHEYE_K2_SIGMA)
         self.catalog = load_pattern_catalog(params, progress=progress)
         stars = load_source(params.source, epoch).brighter_than(params.mag_limit)
-        ids, order = stars.ids, np.argsort(stars.ids, kind="stable")
-        position = order[np.clip(np.searchsorted(ids[order], self.catalog.ids), 0, max(ids.size - 1, 0))]
-        if ids.size != self.catalog.ids.size or not np.array_equal(ids[position], self.catalog.ids):
+        position = _positions(stars.ids, self.catalog.ids)
+        if position is None:
             raise InputError("pattern catalog and star catalog disagree (stale cache): remove the patterns-* cache folder.")
         self.source = params.source
         self.ids = np.asarray(self.catalog.ids, np.int64)  # brightest first
@@ -149,7 +158,7 @@ class PlateSolver:
         self._mid_fov = np.array([self.levels[n].fov / math.sqrt(ratio) for n, _ in self._entries])
         self._tolerance = np.array([self.levels[n].tolerance if code == 0 else fisheye_tolerance(self.levels[n].fov)
                                     for n, code in self._entries])
-        self._per_lookup = sum(expected_candidates(self.levels[n]) for n, _ in self._entries)
+        self._per_lookup = sum(self.levels[n].per_lookup for n, _ in self._entries)
         start = time.perf_counter()
         self._warm_up()
         self.load_ms = 1e3 * (time.perf_counter() - start)

@@ -24,7 +24,8 @@ One compiled call searches the combinations [start, stop), from candidate ``skip
 returns after at most ``max_tried`` verified hypotheses with the place to resume (the same order of
 hypotheses whatever the calls' sizes); the caller checks the time budget between calls.  N_h, the
 hypotheses the search can make, counts every combination of the candidates times
-the expected catalog candidates per look-up of each level (:func:`expected_candidates`).
+the expected catalog candidates per look-up of each level
+(:attr:`~startrack.identify.pattern_catalog.PatternLevel.per_lookup`).
 """
 
 from __future__ import annotations
@@ -62,15 +63,6 @@ def pattern_candidates(uv, separation_px: float, limit: int = MAX_CANDIDATES) ->
             if len(kept) == limit:
                 break
     return np.array(kept, np.int64)
-
-
-def expected_candidates(level) -> float:
-    """Expected catalog patterns per look-up of ``level``: the 2^5 keys visited times the mean number of
-    patterns that share a key with a pattern (sum of squared run lengths over the patterns)."""
-    if level.keys.size == 0:
-        return 0.0
-    runs = np.diff(np.flatnonzero(np.r_[True, np.diff(level.keys) != 0, True]))
-    return 32.0 * float(np.sum(runs.astype(float) ** 2) / level.keys.size)
 
 
 @njit

@@ -14,9 +14,9 @@ from scipy.spatial.transform import Rotation
 
 from startrack.camera import Camera
 from startrack.identify import StarIdentifier
-from startrack.identify.pattern_catalog import PatternCatalogParams, build_level
+from startrack.identify.pattern_catalog import PatternCatalog, PatternCatalogParams, build_level, candidates_per_lookup
 from startrack.identify.pattern_hash import HASH_STARS, NO_PATTERNS, hash_search, pattern_arrays
-from startrack.identify.scale_free import COMBINATIONS_BELOW, expected_candidates
+from startrack.identify.scale_free import COMBINATIONS_BELOW
 from startrack.identify.zones import SKY, cap
 from startrack.navigation_catalog import load_navigation_catalog
 from startrack.star_catalog import load_star_catalog
@@ -61,7 +61,26 @@ def test_the_level_is_the_camera_field_and_n_h_counts_every_look_up(setup):
     assert pattern_arrays(few)[0].shape == (0, 4)  # no field of four stars: nothing to look up, no error
     field = identifier.field
     level = build_level(field.vectors, field.v_mag, camera.fov_x, PatternCatalogParams(camera.fov_x, camera.fov_x))
-    assert level.width == width and n_h == pytest.approx(35 * expected_candidates(level))
+    assert level.width == width and n_h == pytest.approx(35 * level.per_lookup)
+
+
+def test_candidates_per_lookup_counts_the_patterns_sharing_a_key():
+    """Runs of 2, 1 and 3 equal keys: a pattern shares its key with (2*2 + 1*1 + 3*3) / 6 patterns on
+    average, over the 32 keys a look-up visits."""
+    assert candidates_per_lookup(np.array([4, 4, 7, 9, 9, 9])) == pytest.approx(32.0 * 14.0 / 6.0)
+    assert candidates_per_lookup(np.zeros(0, np.int64)) == 0.0
+
+
+def test_a_saved_pattern_catalog_reads_back_the_same(tmp_path):
+    """The two levels of a 12-22 deg catalog over the stars to V 5: every field and array as built."""
+    params = PatternCatalogParams(fov_min=12.0 * math.pi / 180.0, fov_max=22.0 * math.pi / 180.0, mag_limit=5.0)
+    built = PatternCatalog.build(params, load_star_catalog())
+    read = PatternCatalog.read(built.save(tmp_path / "patterns"))
+    assert read.params == params and np.array_equal(read.ids, built.ids) and len(read.levels) == len(built.levels) == 2
+    for a, b in zip(read.levels, built.levels):
+        assert (a.fov, a.width, a.base, a.tolerance, a.per_lookup) == (b.fov, b.width, b.base, b.tolerance, b.per_lookup)
+        assert a.per_lookup == candidates_per_lookup(b.keys) > 0.0
+        assert all(np.array_equal(getattr(a, name), getattr(b, name)) for name in ("stars", "keys", "slots"))
 
 
 def test_look_ups_identify_clean_frames_at_the_pyramids_attitude(setup):
