@@ -21,7 +21,10 @@ number of detections within [30, 1000]; the faintest of them is the frame's cata
 (reported as ``mag_limit``), so a rich frame is checked against a deep catalog and a sparse one
 against its brightest stars; the stars near the boresight are gathered down to the depth that puts about
 4 n_predicted of them in the field (all of Hipparcos-2's to V 8 but for the widest fields; the
-brightest ~50 000 of Gaia's 480 000 for a 60 deg one).
+brightest ~50 000 of Gaia's 480 000 for a 60 deg one).  In a frame of more than 75 detections a
+hypothesis is first screened against its :data:`SCREEN_STARS` brightest predicted stars
+(:mod:`startrack.identify.scale_free`, step 6), so that a crowded frame's budget holds about three times
+the hypotheses.
 """
 
 from __future__ import annotations
@@ -56,6 +59,14 @@ MAX_TRIED = 1000
 DENSITY_CELLS = 8
 #: Detections and predicted stars of the first verification pass.
 FIRST_STARS = 40
+#: Most predicted stars of a hypothesis's first verification, before the full depth (the screen of
+#: :func:`startrack.identify.scale_free.search`): 150 verify about three times the hypotheses per second of
+#: a crowded frame's 1000 (1150-2440 detections: 270-450 -> 600-1370 in the 1 s budget).
+SCREEN_STARS = 150
+#: The screen passes a hypothesis on to the full verification when the chance of its matches (the Poisson
+#: tail alone, without the look-elsewhere factor of the full verification) is below this: a noisy frame's
+#: right hypothesis matches few of 150 stars (4 px centroid noise: screened out at 0.01, kept at 0.1).
+SCREEN_THRESHOLD = 0.1
 #: Centroid error [px] added in quadrature to every detection's sigma: the pixel noise a detection
 #: reports leaves out the PSF's asymmetries, the pixel response and compression, so without a floor the
 #: brightest stars would take nearly all the weight of the fit.
@@ -187,13 +198,15 @@ class PlateSolver:
             return _failed("too_few", f"{candidates.size} separated detections; at least 4 are needed", start)
         params, priors, f_range = self._start(width, height, camera, refit)
         grid = _density_grid(uv, width, height)
-        settings = tuple((self.final_gate_px, FIRST_STARS, int(np.clip(2 * len(uv), 30, 1000)), prior[1] > 0.0, prior, grid,
-                          self.threshold) for prior in priors)
+        n_predicted = int(np.clip(2 * len(uv), 30, 1000))
+        settings, screen = (tuple((self.final_gate_px, FIRST_STARS, n, prior[1] > 0.0, prior, grid, threshold)
+                                  for prior in priors) for n, threshold in ((n_predicted, self.threshold),
+                                                                            (min(n_predicted, SCREEN_STARS), SCREEN_THRESHOLD)))
         regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
         known = None if camera is None else camera.camera
         frame = (uv, sigma, candidates, self._entry_arrays(width, fov_hint if known is None else known.fov_x, known),
-                 f_range, params, settings, float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
+                 f_range, params, (settings, screen), float(len(regions) * max(n_combinations, 1) * max(self._per_lookup, 1.0)))
         tried = 0
         for region in regions:
             result, count, done = self._search(frame, region, start)
@@ -213,13 +226,14 @@ class PlateSolver:
         of the budget left: its combinations (one at first, at most :data:`CHUNK`) and the hypotheses it may
         verify (one at first; a crowded frame verifies many per combination, ~10 ms each), so that the
         budget is overrun by at most about one hypothesis's verification or one combination's look-ups."""
-        uv, sigma, candidates, entries, f_range, params, settings, n_hypotheses = frame
+        uv, sigma, candidates, entries, f_range, params, (settings, screen), n_hypotheses = frame
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
         done, skip, tried, chunk, cap = 0, 0, 0, 1, 1
         while done < n_combinations:
             begin, first = time.perf_counter(), done
             result, count, done, skip = search(uv, sigma, candidates, done, done + chunk, skip, cap, self._arrays, entries,
-                                               self.vectors, f_range, params, region, self.field, settings, n_hypotheses)
+                                               self.vectors, f_range, params, region, self.field, settings, screen,
+                                               n_hypotheses)
             tried += count
             now = time.perf_counter()
             if result[0] or now - start > self.time_budget_s:

@@ -17,8 +17,12 @@ with star n + 1 (:data:`COMBINATIONS`) -- and each is looked up in every level o
    when the field of view lies in the allowed range;
 5. the attitude by SVD (Wahba's problem, Markley 1988) of the four stars; a mirror image of the
    pattern (same edges, other handedness) leaves residuals of the pattern's own size and is dropped;
-6. :func:`startrack.identify.self_calibration.verify_calibrate`; the first accepted hypothesis ends
-   the search.
+6. in a rich frame, a screen: :func:`startrack.identify.self_calibration.verify_calibrate` against the
+   brightest ``screen`` predicted stars (150 of up to 1000: a third of the cost, so that a crowded frame
+   tries three times the hypotheses in its budget) with a loose test (the chance of its matches alone,
+   without the look-elsewhere factor, below the screen's threshold); then the hypotheses it passes, and every
+   hypothesis of a frame no richer than the screen, are verified at the full depth of ``settings`` (the
+   answer is that verification's, as without the screen); the first accepted hypothesis ends the search.
 
 One compiled call searches the combinations [start, stop), from candidate ``skip`` of the first, and
 returns after at most ``max_tried`` verified hypotheses with the place to resume (the same order of
@@ -227,7 +231,7 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, entries, vectors, cx, cy
 
 @njit
 def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries, vectors, f_range, camera, region, field,
-           settings, n_hypotheses):  # pragma: no cover  (compiled)
+           settings, screen, n_hypotheses):  # pragma: no cover  (compiled)
     """Search the combinations [start, stop) of :data:`COMBINATIONS` over ``candidates`` (module text),
     the first from its ``skip``-th catalog candidate; the catalog candidates of a combination are verified
     in order of their ratio mismatch, at most ``max_tried`` of them in this call.
@@ -238,8 +242,8 @@ def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries,
     order; ``vectors`` the pattern stars' unit vectors; f_range (2, 2) [px] the focal lengths allowed
     per projection code; ``camera`` (:func:`startrack.camera_fit.camera_array`) the start of the
     calibration (f and the projection replaced); ``region`` for :func:`_gather`; ``settings`` per
-    projection code (:func:`verify_calibrate`'s).  Returns (verify_calibrate's tuple, hypotheses
-    verified, the combination and candidate to resume at)."""
+    projection code (:func:`verify_calibrate`'s), ``screen`` the same with fewer predicted stars (step 6).
+    Returns (verify_calibrate's tuple, hypotheses verified, the combination and candidate to resume at)."""
     cx, cy = camera[1], camera[2]
     near = np.empty(field[0].shape[0], np.int64)
     stars = np.empty(4, np.int64)
@@ -273,9 +277,12 @@ def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries,
             tried += 1
             params = camera.copy()
             params[0], params[8] = focal, projection
-            result = verify_calibrate(uv, sigma, R_IS, params, field, settings[p], gates, n_hypotheses)
-            if result[0]:
-                return result, tried, c + 1, 0
+            screened_out = screen[p][2] < settings[p][2] and not verify_calibrate(uv, sigma, R_IS, params.copy(), field,
+                                                                                  screen[p], gates, 0.0)[0]
+            if not screened_out:
+                result = verify_calibrate(uv, sigma, R_IS, params, field, settings[p], gates, n_hypotheses)
+                if result[0]:
+                    return result, tried, c + 1, 0
             if tried >= max_tried:
                 return _nothing(camera), tried, c, n + 1
     return _nothing(camera), tried, stop, 0

@@ -127,6 +127,19 @@ def test_rendered_fisheye_frames(solver, stars, fov_deg, lens):
     assert abs(result.camera.k1 - k1) < 4.0 * result.calibration.sigma["k1"] + 1e-4
 
 
+def test_the_screen_leaves_the_answer_of_a_rich_frame_as_it_was(solver, stars, monkeypatch):
+    """A 40 deg frame of ~1000 detections: hypotheses are screened against 150 predicted stars before the full
+    verification, whose answer is the one the search without the screen gives (the same stars, attitude and camera)."""
+    camera = Camera.from_fov(40.0 * DEG, WIDTH, HEIGHT, k1=0.1)
+    sky = rendered_sky(camera, stars, np.random.default_rng(40))
+    found, screened = _solve(solver, sky.image, sky.full_scale)
+    assert 2 * len(found.uv) > plate_solver.SCREEN_STARS and screened.ok and _is_right(solver, screened, found, sky)
+    monkeypatch.setattr(plate_solver, "SCREEN_STARS", 10**6)
+    _, unscreened = _solve(solver, sky.image, sky.full_scale)
+    assert np.array_equal(screened.matches, unscreened.matches) and np.allclose(screened.q_IS, unscreened.q_IS, atol=0.0)
+    assert screened.camera == unscreened.camera
+
+
 def test_pattern_levels_deepen_below_five_degrees():
     """The Gaia levels take stars to V 8 + 4.5 log10(5 deg / F) (at most 10): about as many per lattice
     circle as a 5 deg one to V 8; the Hipparcos levels all to their magnitude limit."""
