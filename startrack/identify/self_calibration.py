@@ -11,7 +11,9 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fi
 2. every detection against the ``n_predicted`` brightest stars predicted in the image, gate g_2,
    every intrinsic of ``free`` with its prior; repeated (up to ``WIDE_PASSES`` times) while it matches
    ``GROWTH`` times the stars of the pass before;
-3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars;
+3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars; a
+   hypothesis whose first pass there matches no more stars than chance would (:data:`HOPELESS`) is
+   dropped at once (a wrong one: its last passes cost a crowded frame a third of its verification);
 4. the depth of the catalog the frame shows (:func:`detected_depth`: where the matched fraction of the
    predicted stars, brightest first, falls to the level of chance): matches of fainter stars are
    dropped (in a crowd of false detections they are chance neighbours); then matches the fit puts
@@ -36,7 +38,7 @@ import math
 import numpy as np
 
 from startrack.camera_fit import fit, fold_radius_squared_jit, folds_inside, image_point, in_view, off_axis_angle, project
-from startrack.identify.chance import chance_match_probability
+from startrack.identify.chance import chance_match_probability, poisson_tail
 from startrack.identify.zones import stars_near
 from startrack.jit import njit
 from startrack.sort_jit import argsort, median, unique
@@ -48,6 +50,9 @@ EXTRA_PASSES = 2
 #: Passes at the second gate beyond the first, made while each matches GROWTH times the stars of the last: the
 #: fit spreads from the pattern outwards over a strongly distorted field (a fisheye's corners).
 WIDE_PASSES, GROWTH = 3, 1.1
+#: Chance (the Poisson tail of the matches of the first pass at the final gate) above which a hypothesis
+#: is dropped before its last passes: it matched about as many stars as a wrong one does.
+HOPELESS = 0.5
 #: A match whose residual exceeds this many of its sigma (scaled by the fit's sqrt(chi^2 / dof)) is dropped.
 OUTLIER = 4.0
 #: Rounds of dropping outliers, each followed by the fit of the matches left.
@@ -210,7 +215,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
         obs_index, pred_index = match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
         if stage == 2 and runs > 0 and obs_index.size <= previous:
             break  # the final gate adds no more stars
-        if obs_index.size < SEEDS + 1:
+        if obs_index.size < SEEDS + 1 or (stage == 2 and runs == 0 and _hopeless(pred_uv, settings[5], gate, obs_index.size)):
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gate, reduced
         ok, R_IS, params, covariance, reduced = _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS,
                                                              params, first_free if p == 0 else free, prior)
@@ -222,6 +227,14 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
         elif stage == 2 and runs > EXTRA_PASSES:
             break
     return _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypotheses, covariance, reduced)
+
+
+@njit
+def _hopeless(pred_uv, grid, gate, n_matches):  # pragma: no cover  (compiled)
+    """Whether the first pass at the final gate matched no more stars than chance would (the Poisson tail of
+    its matches beyond the seeds above HOPELESS): a wrong hypothesis, not worth the passes left."""
+    expected = -np.expm1(-local_density(pred_uv, grid) * math.pi * gate * gate)
+    return poisson_tail(np.sum(expected), n_matches - SEEDS) > HOPELESS
 
 
 @njit
