@@ -199,9 +199,12 @@ class PlateSolver:
         params, priors, f_range = self._start(width, height, camera, refit)
         grid = _density_grid(uv, width, height)
         n_predicted = int(np.clip(2 * len(uv), 30, 1000))
-        settings, screen = (tuple((self.final_gate_px, FIRST_STARS, n, prior[1] > 0.0, prior, grid, threshold)
-                                  for prior in priors) for n, threshold in ((n_predicted, self.threshold),
-                                                                            (min(n_predicted, SCREEN_STARS), SCREEN_THRESHOLD)))
+
+        def verification(n, threshold):  # verify_calibrate's settings per projection code
+            return tuple((self.final_gate_px, FIRST_STARS, n, prior[1] > 0.0, prior, grid, threshold) for prior in priors)
+
+        settings = verification(n_predicted, self.threshold)
+        screen = verification(min(n_predicted, SCREEN_STARS), SCREEN_THRESHOLD)
         regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
         known = None if camera is None else camera.camera
