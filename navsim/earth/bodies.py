@@ -42,12 +42,13 @@ class SunMoon:
     def compute(cls, epoch_utc, orientation, lat, lon, h):
         """The Sun and the Moon at the frames of an :class:`~navsim.earth.orientation.EarthOrientation`
         (its ``t`` and C_ie) for the observer at geodetic (L, λ, h) (F,) [rad, rad, m]."""
-        t = orientation.t
-        tt = tt_epoch(epoch_utc, t)
-        sun = -erfa.epv00(*tt)[0]["p"] * AU
-        moon = erfa.moon98(*tt)["p"] * AU
         r_I = np.einsum("fij,fj->fi", orientation.c_ie, np.stack(geodetic_to_ecef(lat, lon, h), axis=-1))
-        up_I = local_up(orientation.c_ie, lat, lon)
+        return cls.seen_from(orientation.t, *geocentric(epoch_utc, orientation.t), r_I, local_up(orientation.c_ie, lat, lon))
+
+    @classmethod
+    def seen_from(cls, t, sun, moon, r_I, up_I):
+        """The Sun and the Moon at the geocentric positions ``sun``, ``moon`` (F, 3) [m] (:func:`geocentric`) seen by
+        the observer at the geocentric ``r_I`` (F, 3) [m] whose vertical is ``up_I`` (F, 3), at times ``t`` (F,) [s]."""
         to_sun, to_moon = sun - r_I, moon - r_I
         distance = np.linalg.norm(to_moon, axis=-1)
         phase = angular_distance(sun - moon, r_I - moon)
@@ -57,6 +58,13 @@ class SunMoon:
     def elevation(self, u_I):
         """Elevation [rad] above the observer's horizontal plane of unit directions ``u_I`` (F, 3)."""
         return np.arcsin(np.clip(np.sum(u_I * self.up_I, axis=-1), -1.0, 1.0))
+
+
+def geocentric(epoch_utc, t):
+    """(sun (F, 3), moon (F, 3)) [m]: the geocentric positions of the Sun (``erfa.epv00``) and the Moon
+    (``erfa.moon98``) in GCRS axes at ``t`` (F,) [s after the UTC epoch] (module docstring)."""
+    tt = tt_epoch(epoch_utc, t)
+    return -erfa.epv00(*tt)[0]["p"] * AU, erfa.moon98(*tt)["p"] * AU
 
 
 def _unit(v):

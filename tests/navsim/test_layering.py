@@ -13,6 +13,7 @@ NAVSIM = Path(__file__).resolve().parents[2] / "navsim"
 #: API, is above them all).
 FLOORS = (
     {"kinematics", "kinematics_jit", "earth", "scenario"},   # geometry, numerics, the scenario files' machinery
+    {"orbit"},                                               # a spacecraft's orbit and what it sees of the Earth
     {"truth", "sensors", "ins"},                             # the truth, the sensor models, the strapdown INS
     {"estimation"},                                          # the filters
     {"closed_loop", "records", "output", "places", "pooling", "analysis"},
