@@ -2,13 +2,13 @@
 its kind: the one place that knows them all.
 
 A scenario's kind is named by the table that marks it: ``[study]`` a static study
-(:mod:`navsim.studies`), a run kind's own table (``[trajectory]``: navigation), and none the kind without
+(:mod:`navsim.studies`), a run kind's own table (``[trajectory]``: navigation, ``[orbit]``: spacecraft), and none the kind without
 one (attitude). Generic code — the front door :mod:`navsim.simulation`, campaigns, tuning, the error
 budget, reports and the command line — asks :func:`run_kind` for the scenario's kind once and calls it,
 never testing which kind it is.
 
-A **run kind** is a package providing (each name loaded on first use; :mod:`navsim.attitude` and
-:mod:`navsim.navigation` are the two):
+A **run kind** is a package providing (each name loaded on first use; :mod:`navsim.attitude`,
+:mod:`navsim.navigation` and :mod:`navsim.spacecraft` are the three):
 
     NAME, TABLE                                   its name, the table that marks its scenarios (None: none)
     validate(data, source) -> dict                its schema and cross-key rules, derived defaults filled
@@ -35,7 +35,7 @@ kind is a new package providing these (:data:`INTERFACE`), and one more entry in
 
 from pathlib import Path
 
-from navsim import attitude, navigation, studies
+from navsim import attitude, navigation, spacecraft, studies
 from navsim.scenario import Scenario, apply_overrides, read_scenario_file
 from startrack.errors import InputError
 
@@ -45,7 +45,7 @@ INTERFACE = ("NAME", "TABLE", "validate", "prepare", "simulate", "lanes", "TRUTH
              "run_report", "campaign_report", "REQUIRED_SERIES", "CAMPAIGN_SERIES", "covariance_analysis", "COVARIANCE_QUANTITIES",
              "COVARIANCE_SOURCES", "covariance_run_errors", "star_availability")
 #: The run kinds by name; the one without a table takes every scenario no other kind claims.
-KINDS = {kind.NAME: kind for kind in (attitude, navigation)}
+KINDS = {kind.NAME: kind for kind in (attitude, navigation, spacecraft)}
 #: The name of the static studies' kind, and the table that marks them.
 STUDY = "study"
 

@@ -58,8 +58,11 @@ def truth_profile(scenario):
     )
 
 
-def initial_covariance(scenario, gyro):
-    """P0 (n x n) from the filter's initial σ; defaults follow the gyro's own errors."""
+def initial_covariance(scenario, gyro, mountings=None, mounting_sigmas=None):
+    """P0 (n x n) from the filter's initial σ; defaults follow the gyro's own errors. ``mountings``: the mounting
+    treatment of each head of a spacecraft (default: ``filter.mounting`` for the one sensor); when any head carries
+    its mounting, each head has three states, an ignored head's with σ 0; ``mounting_sigmas`` [arcsec] each head's
+    initial σ (default ``filter.initial_mounting_sigma_arcsec``)."""
     f = scenario["filter"]
     sigma_att = float(units.deg_to_rad(f["initial_attitude_sigma_deg"]))
     if f["initial_bias_sigma_deg_per_h"] is not None:
@@ -79,8 +82,11 @@ def initial_covariance(scenario, gyro):
     if treatment["gyro_misalignment"] != "ignore":
         arcsec = f["initial_gyro_misalignment_sigma_arcsec"] or max(gyro.misalignment_sigma / units.ARCSEC, 1.0)
         diag += [(arcsec * units.ARCSEC) ** 2] * 6
-    if treatment["mounting"] != "ignore":
-        diag += [(f["initial_mounting_sigma_arcsec"] * units.ARCSEC) ** 2] * 3
+    mountings = (treatment["mounting"],) if mountings is None else tuple(mountings)
+    if any(t != "ignore" for t in mountings):
+        sigmas = mounting_sigmas or [f["initial_mounting_sigma_arcsec"]] * len(mountings)
+        for t, sigma in zip(mountings, sigmas):
+            diag += [(sigma * units.ARCSEC) ** 2 if t != "ignore" else 0.0] * 3
     return scipy.linalg.block_diag(*blocks, np.diag(diag)) if diag else scipy.linalg.block_diag(*blocks)
 
 
@@ -94,19 +100,23 @@ def filter_states(scenario, gyro):
             "mounting": f["mounting"]}
 
 
-def filter_config(scenario, gyro):
+def filter_config(scenario, gyro, q_BS=None, mountings=None, mounting_sigmas=None):
     """The :class:`~navsim.estimation.attitude_filter.AttitudeFilterConfig` of ``scenario['filter']``: its
     initial covariance (:func:`initial_covariance`), the noise and state treatments of the gyro's datasheet
-    unless the scenario names its own, the nominal mounting, tuning and gate."""
+    unless the scenario names its own, the nominal mounting (``q_BS``: one per head (H, 4) with their
+    ``mountings`` treatments and initial σ ``mounting_sigmas`` [arcsec]; default the one ``star_sensor`` table's),
+    tuning and gate."""
     f = scenario["filter"]
-    q_BS, _ = mounting(scenario["star_sensor"])
+    q_BS = mounting(scenario["star_sensor"])[0] if q_BS is None else np.asarray(q_BS, dtype=float)
     states = filter_states(scenario, gyro)
+    if mountings is not None:
+        states["mounting"] = tuple(mountings)
     arw = gyro.arw if f["arw_deg_per_sqrt_h"] is None else float(units.arw_to_si(f["arw_deg_per_sqrt_h"]))
     rrw = gyro.rrw if states["bias_instability"] != "ignore" else gyro.filter_rrw
     if f["rrw_deg_per_h_per_sqrt_h"] is not None:
         rrw = float(units.rrw_to_si(f["rrw_deg_per_h_per_sqrt_h"]))
     return AttitudeFilterConfig(
-        P0=initial_covariance(scenario, gyro),
+        P0=initial_covariance(scenario, gyro, mountings, mounting_sigmas),
         arw=arw,
         rrw=rrw,
         q_BS=q_BS,

@@ -34,8 +34,9 @@ REQUIRED_SERIES = ("t", "attitude_error")
 CAMPAIGN_SERIES = ("t", "attitude_error", "P_diag", "nees", "mode", "n_identified", "n_stacked", "n_accepted")
 
 
-def run_report(run) -> bytes:
-    """The PDF (bytes) of one run directory's report."""
+def run_report(run, kind_sections=None) -> bytes:
+    """The PDF (bytes) of one run directory's report; ``kind_sections(doc, run)`` adds a kind's own sections after the
+    key results (the spacecraft's orbit and heads)."""
     summary, s = run.summary, run.series
     name = scenario_name(summary, run.scenario, run.directory)
     with tempfile.TemporaryDirectory(prefix="navsim-report-") as tmp, matplotlib.rc_context(figures.STYLE):
@@ -47,6 +48,8 @@ def run_report(run) -> bytes:
             f"{run.frames} star-sensor frames over {number(float(s['t'][-1]), 1)} s; fidelity "
             f"{summary.get('fidelity', 'n/a')}, measurement {summary.get('measurement', 'n/a')}."))
         _key_results(doc, run)
+        if kind_sections is not None:
+            kind_sections(doc, run)
         scenario_section(doc, run.scenario)
         _attitude_section(doc, run)
         _bias_section(doc, run)
@@ -189,8 +192,9 @@ def _absent_section(doc, run):
                              + " (vector-fidelity runs log no image-chain quantities), so those figures are omitted."))
 
 
-def campaign_report(campaign) -> bytes:
-    """The PDF (bytes) of a Monte Carlo campaign directory's report."""
+def campaign_report(campaign, kind_sections=None) -> bytes:
+    """The PDF (bytes) of a Monte Carlo campaign directory's report; ``kind_sections(doc, campaign)`` adds a kind's
+    own sections after the tables."""
     name = campaign.campaign.get("scenario")
     if not isinstance(name, str) or not name:
         name = scenario_name(campaign.runs[0].summary, campaign.scenario, campaign.directory)
@@ -205,6 +209,8 @@ def campaign_report(campaign) -> bytes:
         doc.heading("Key results")
         doc.paragraph(*(markup(x) for x in _campaign_sentences(env, avg, metrics, success, criterion)))
         campaign_tables(doc, campaign, metrics)
+        if kind_sections is not None:
+            kind_sections(doc, campaign)
         _campaign_figures(doc, env, avg, len(campaign.runs))
         if success:
             doc.heading("Identification success per mode")

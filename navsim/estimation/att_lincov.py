@@ -36,7 +36,7 @@ def _update_frame(P, mean, P_f, q_IB, q_BS, f, meas, n_t, W, estimated):
     """The frame's stars (one measurement) or its attitude fix."""
     lo, hi = meas.star_offsets[f], meas.star_offsets[f + 1]
     if hi > lo:
-        z, H, R = star_residuals(q_IB, q_BS, meas.star_ref[lo:hi], meas.star_obs[lo:hi], meas.star_cov[lo:hi], n_t, True)
+        z, H, R = star_residuals(q_IB, q_BS, meas.star_ref[lo:hi], meas.star_obs[lo:hi], meas.star_cov[lo:hi], n_t, n_t - 3)
         m = z.shape[0]
         H_t, R_t, d = np.zeros((2 * m, n_t)), np.zeros((2 * m, 2 * m)), np.empty(2 * m)
         for k in range(m):

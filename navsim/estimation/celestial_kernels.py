@@ -102,7 +102,7 @@ def star_terms(nav, q_BS, q_ie, ref_I, obs_S, cov_S, layout, shift_I):
     ``shift_I`` (N, 3) the refraction the processing's model air gave each star, of which the real air
     leaves ε_r more in the measured direction (eq. 3 of :mod:`navsim.earth.refraction`)."""
     q_IB = inertial_attitude(nav, q_ie)
-    z, H_att, R = star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, 6, True)
+    z, H_att, R = star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, 6, 3)
     A = attitude_jacobian(nav, layout.n)
     H = np.empty((z.shape[0], 2, layout.n))
     R_SI = quat_to_matrix(q_BS).T @ quat_to_matrix(q_IB).T

@@ -6,15 +6,16 @@ filter step runs tens of thousands of times per simulated minute; each is tested
 numpy / filterpy counterpart. Conventions are those of docs/design.md (scalar-last Hamilton
 quaternions, error state δθ in body axes).
 
-Nominal state ``x`` (23,): q_IB [0:4], total gyro bias b [4:7] (rad/s), the gyro error matrix K
+Nominal state ``x`` (19 + 4 H,): q_IB [0:4], total gyro bias b [4:7] (rad/s), the gyro error matrix K
 [7:16] (row-major 3x3, ω̃ = (I + K) ω + b + noise: scale factors on the diagonal, misalignment and
-non-orthogonality off it), star-sensor mounting q_BS [16:20], the Gauss-Markov part g of the bias
-[20:23] (rad/s). Error state (n,): δθ [0:3], δb [3:6] (the total bias), then optional groups in this
-order: δg [6:9] (``model.n_bi`` = 3: the bias instability as a first-order Gauss-Markov process of
-σ_g and τ, inside the total bias), the calibration states δk — the 3 scale factors (``model.n_sf`` = 3)
-followed by the 6 off-diagonal terms k_xy, k_xz, k_yx, k_yz, k_zx, k_zy (``model.n_gm`` = 6) — and,
-with ``model.mounting``, δm [n-3:n]. ``estimated`` (n,) marks the states the updates correct;
-the others are consider states (Schmidt): they stay in P and in Φ, their gain is zero.
+non-orthogonality off it), the Gauss-Markov part g of the bias [16:19] (rad/s), then the mounting q_BS of each
+of the ``model.heads`` = H star-sensor heads [19 + 4h : 23 + 4h]. Error state (n,): δθ [0:3], δb [3:6] (the total
+bias), then optional groups in this order: δg [6:9] (``model.n_bi`` = 3: the bias instability as a first-order
+Gauss-Markov process of σ_g and τ, inside the total bias), the calibration states δk — the 3 scale factors
+(``model.n_sf`` = 3) followed by the 6 off-diagonal terms k_xy, k_xz, k_yx, k_yz, k_zx, k_zy (``model.n_gm`` = 6) —
+and, with ``model.mounting``, δm of each head [n − 3H + 3h : n − 3H + 3h + 3]. ``estimated`` (n,) marks the states
+the updates correct; the others are consider states (Schmidt): they stay in P and in Φ, their gain is zero. A
+measurement of head h (a fix, a star) sees the body through that head's mounting and mounting error.
 """
 
 from collections import namedtuple
@@ -29,8 +30,10 @@ from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, qua
 #: What the filter assumes of the gyro and which states it carries: ARW σ_v [rad/√s], RRW σ_u
 #: [rad/s^(3/2)], the bias instability's σ_g [rad/s] and correlation time τ [s], random walk of the
 #: calibration terms σ_k [1/√s], the factor on Q, the number of Gauss-Markov states (0 or 3), of
-#: scale-factor states (0 or 3) and of misalignment states (0 or 6), whether δm is a state.
-FilterModel = namedtuple("FilterModel", "arw rrw gm_sigma gm_tau cal_rw q_scale n_bi n_sf n_gm mounting")
+#: scale-factor states (0 or 3) and of misalignment states (0 or 6), whether δm is a state, the star-sensor heads.
+FilterModel = namedtuple("FilterModel", "arw rrw gm_sigma gm_tau cal_rw q_scale n_bi n_sf n_gm mounting heads", defaults=(1,))
+#: Where the Gauss-Markov bias and the first head's mounting start in the nominal state.
+X_G, X_BS = 16, 19
 #: Flat index in K of each calibration state: the scale factors, then the off-diagonal terms.
 K_FLAT = np.array([0, 4, 8, 1, 2, 3, 5, 6, 7])
 
@@ -173,8 +176,8 @@ def predict(x, P, omega_measured, dt, model):
                 P[j, i] = value
         x[0:4] = rk4_hold(x[0:4], omega, dt)
         if model.n_bi:
-            x[4:7] -= (1.0 - decay) * x[20:23]
-            x[20:23] *= decay
+            x[4:7] -= (1.0 - decay) * x[X_G : X_G + 3]
+            x[X_G : X_G + 3] *= decay
     return x, P
 
 
@@ -240,42 +243,76 @@ def tangent_basis(s):
 
 
 @njit
-def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mounting):
+def mounting_column(model, n, head):
+    """The first error-state column of head ``head``'s mounting error δm, or −1 when the filter carries none."""
+    return n - 3 * model.heads + 3 * head if model.mounting else -1
+
+
+@njit
+def q_BS_of(x, head):
+    """The mounting estimate q_BS (4,) of head ``head`` in the nominal state x."""
+    return x[X_BS + 4 * head : X_BS + 4 * head + 4]
+
+
+@njit
+def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mount_col):
     """Tangent-plane residuals of identified stars against the estimates q_IB, q_BS, their Jacobians and
     their measurement covariances.
 
     ŝ = R_SB R_IBᵀ r; T (2x3) spans the plane ⟂ ŝ; z = T (s − ŝ); R = T C Tᵀ of the measured direction's
     covariance C (3x3, sensor axes: ``cov_S``, correlated along a smear trail);
-    H = T [R_SB [b̂×], 0, …, ([ŝ×] in the last three columns when ``mounting``)] for the body-axes
-    attitude error δθ (first three columns) and the mounting error δm (last three).
+    H = T [R_SB [b̂×], 0, …, ([ŝ×] in the three columns from ``mount_col``, when it is ≥ 0)] for the body-axes
+    attitude error δθ (first three columns) and the mounting error δm.
     Returns (z (N, 2), H (N, 2, n), R (N, 2, 2)).
     """
     m = ref_I.shape[0]
-    R_IB = quat_to_matrix(q_IB)
-    R_SB = quat_to_matrix(q_BS).T
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     R = np.empty((m, 2, 2))
+    R_IB = quat_to_matrix(q_IB)
+    R_SB = quat_to_matrix(q_BS).T
     for k in range(m):
-        b_hat = R_IB.T @ ref_I[k]
-        s_hat = R_SB @ b_hat
-        e1, e2 = tangent_basis(s_hat)
-        d = obs_S[k] - s_hat
-        z[k, 0] = np.sum(e1 * d)
-        z[k, 1] = np.sum(e2 * d)
-        c1, c2 = cov_S[k] @ e1, cov_S[k] @ e2
-        R[k, 0, 0] = np.sum(e1 * c1)
-        R[k, 0, 1] = R[k, 1, 0] = 0.5 * (np.sum(e1 * c2) + np.sum(e2 * c1))
-        R[k, 1, 1] = np.sum(e2 * c2)
-        A = R_SB @ skew(b_hat)
+        _star_row(R_IB, R_SB, ref_I[k], obs_S[k], cov_S[k], z[k], H[k], R[k], mount_col)
+    return z, H, R
+
+
+@njit
+def _star_row(R_IB, R_SB, ref_I, obs_S, cov_S, z, H, R, mount_col):
+    """One star's z (2,), H (2, n) and R (2, 2) of :func:`star_residuals`, written in place."""
+    b_hat = R_IB.T @ ref_I
+    s_hat = R_SB @ b_hat
+    e1, e2 = tangent_basis(s_hat)
+    d = obs_S - s_hat
+    z[0] = np.sum(e1 * d)
+    z[1] = np.sum(e2 * d)
+    c1, c2 = cov_S @ e1, cov_S @ e2
+    R[0, 0] = np.sum(e1 * c1)
+    R[0, 1] = R[1, 0] = 0.5 * (np.sum(e1 * c2) + np.sum(e2 * c1))
+    R[1, 1] = np.sum(e2 * c2)
+    A = R_SB @ skew(b_hat)
+    for j in range(3):
+        H[0, j] = e1[0] * A[0, j] + e1[1] * A[1, j] + e1[2] * A[2, j]
+        H[1, j] = e2[0] * A[0, j] + e2[1] * A[1, j] + e2[2] * A[2, j]
+    if mount_col >= 0:
+        B = skew(s_hat)
         for j in range(3):
-            H[k, 0, j] = e1[0] * A[0, j] + e1[1] * A[1, j] + e1[2] * A[2, j]
-            H[k, 1, j] = e2[0] * A[0, j] + e2[1] * A[1, j] + e2[2] * A[2, j]
-        if mounting:
-            B = skew(s_hat)
-            for j in range(3):
-                H[k, 0, n - 3 + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
-                H[k, 1, n - 3 + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
+            H[0, mount_col + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
+            H[1, mount_col + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
+
+
+@njit
+def head_residuals(x, heads, ref_I, obs_S, cov_S, n, model):
+    """:func:`star_residuals` of stars seen by several heads: star k through head ``heads[k]``'s mounting estimate
+    and mounting columns."""
+    m = ref_I.shape[0]
+    z = np.empty((m, 2))
+    H = np.zeros((m, 2, n))
+    R = np.empty((m, 2, 2))
+    R_IB = quat_to_matrix(x[0:4])
+    for k in range(m):
+        h = heads[k]
+        _star_row(R_IB, quat_to_matrix(q_BS_of(x, h)).T, ref_I[k], obs_S[k], cov_S[k], z[k], H[k], R[k],
+                  mounting_column(model, n, h))
     return z, H, R
 
 
@@ -304,20 +341,21 @@ def fix_residual(q_IB, q_BS, q_IS, R_S):
 
 
 @njit
-def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
-    """Gated update with an attitude fix q_IS (covariance R_S in sensor axes), then the reset.
+def attitude_update(x, P, q_IS, R_S, head, gate, model, estimated):
+    """Gated update with head ``head``'s attitude fix q_IS (covariance R_S in sensor axes), then the reset.
 
-    z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes, H = [I, 0, (0), (R_BS)], R = R_BS R_S R_BSᵀ.
-    Returns (x, P, z, nis, accepted); the state is unchanged when rejected.
+    z = δθ(q, q_IS ⊗ q_BS⁻¹) in body axes, H = [I, 0, (0), (R_BS in the head's mounting columns)],
+    R = R_BS R_S R_BSᵀ. Returns (x, P, z, nis, accepted); the state is unchanged when rejected.
     """
     n = P.shape[0]
-    z, R_BS, R = fix_residual(x[0:4], x[16:20], q_IS, R_S)
+    z, R_BS, R = fix_residual(x[0:4], q_BS_of(x, head), q_IS, R_S)
     H = np.zeros((3, n))
+    col = mounting_column(model, n, head)
     for i in range(3):
         H[i, i] = 1.0
-        if model.mounting:
+        if col >= 0:
             for j in range(3):
-                H[i, n - 3 + j] = R_BS[i, j]
+                H[i, col + j] = R_BS[i, j]
     S = mm_t(mm(H, P), H) + R
     S_inv = inverse_small(S)
     nis = 0.0
@@ -326,7 +364,7 @@ def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
             nis += z[i] * S_inv[i, j] * z[j]
     if nis > gate:
         return x, P, z, nis, False
-    if model.mounting:
+    if col >= 0:
         dx, P_next = joseph_update(P, H, R, z, estimated)
     else:
         dx, P_next = joseph_update_attitude(P, R, z, estimated)
@@ -334,11 +372,11 @@ def attitude_update(x, P, q_IS, R_S, gate, model, estimated):
 
 
 @njit
-def stars_update(x, P, ref_I, obs_S, cov_S, gate, model, estimated):
-    """Gated update with identified stars and their covariances in S (see :func:`star_residuals`): each
-    star's 2-dof NIS against the prior is compared with ``gate``; the accepted stars update together, then
-    the reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
-    z, H, R = star_residuals(x[0:4], x[16:20], ref_I, obs_S, cov_S, P.shape[0], model.mounting)
+def stars_update(x, P, heads, ref_I, obs_S, cov_S, gate, model, estimated):
+    """Gated update with identified stars, star k seen by head ``heads[k]``, and their covariances in S (see
+    :func:`star_residuals`): each star's 2-dof NIS against the prior is compared with ``gate``; the accepted stars
+    update together, then the reset. Returns (x, P, z (N, 2), nis (N,), accepted (N,))."""
+    z, H, R = head_residuals(x, heads, ref_I, obs_S, cov_S, P.shape[0], model)
     nis, accepted, Ha, za, Ra = gate_stars(H, P, z, R, gate)
     if za.shape[0] == 0:
         return x, P, z, nis, accepted
@@ -373,20 +411,22 @@ def gate_stars(H, P, z, R, gate):
 @njit
 def reset(x, dx, model):
     """Move the error estimate dx into the nominal state (first-order reset):
-    q ← q ⊗ δq(δθ), b ← b + δb, g ← g + δg, K ← K + δK, q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
+    q ← q ⊗ δq(δθ), b ← b + δb, g ← g + δg, K ← K + δK, each head's q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
     n = dx.shape[0]
     out = x.copy()
     q_next = quat_multiply(x[0:4], quat_from_rotation_vector(dx[0:3]))
     out[0:4] = q_next / np.sqrt(np.sum(q_next * q_next))
     out[4:7] = x[4:7] + dx[3:6]
     if model.n_bi:
-        out[20:23] = x[20:23] + dx[6:9]
+        out[X_G : X_G + 3] = x[X_G : X_G + 3] + dx[6:9]
     flat = calibration_flat(model)
     for c in range(flat.shape[0]):
         out[7 + flat[c]] = x[7 + flat[c]] + dx[6 + model.n_bi + c]
     if model.mounting:
-        q_BS_next = quat_multiply(x[16:20], quat_from_rotation_vector(dx[n - 3 : n]))
-        out[16:20] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
+        for h in range(model.heads):
+            col = mounting_column(model, n, h)
+            q_BS_next = quat_multiply(q_BS_of(x, h), quat_from_rotation_vector(dx[col : col + 3]))
+            out[X_BS + 4 * h : X_BS + 4 * h + 4] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
     return out
 
 
@@ -407,8 +447,8 @@ def star_statistics(z, nis, accepted):
 
 
 @njit
-def _allocate_logs(n_frames, n):
-    return (np.empty((n_frames, 23)), np.empty((n_frames, n, n)), np.zeros(n_frames, dtype=np.int32),
+def _allocate_logs(n_frames, x_size, n):
+    return (np.empty((n_frames, x_size)), np.empty((n_frames, n, n)), np.zeros(n_frames, dtype=np.int32),
             np.zeros(n_frames, dtype=np.int32), np.full(n_frames, np.nan), np.zeros(n_frames, dtype=np.int32),
             np.full(n_frames, np.nan))
 
@@ -416,43 +456,46 @@ def _allocate_logs(n_frames, n):
 @njit
 def run_fixes(x, P, omega, ratio, dt, model, estimated, q_meas, R_S, gate, available):
     """The whole-record loop of the fast path with attitude fixes: for each frame f, ``ratio`` gyro
-    samples of ``omega`` (F*ratio, 3) propagate the filter (:func:`predict`), then the fix
-    ``q_meas[f]`` (covariance R_S) updates it (:func:`attitude_update`); frames not ``available``
-    only propagate. Returns per frame: x (F, 23), P (F, n, n), measurements, accepted, NIS of the
-    accepted, its dof and the RMS of the accepted innovations [rad]."""
-    n_frames = available.shape[0]
-    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
+    samples of ``omega`` (F*ratio, 3) propagate the filter (:func:`predict`), then the fix of each head h
+    ``q_meas[f, h]`` (covariance R_S[h]) that is ``available[f, h]`` updates it, head after head
+    (:func:`attitude_update`). Returns per frame: x (F, 19 + 4H), P (F, n, n), measurements, accepted, NIS of the
+    accepted (summed over the heads), its dof and the RMS of the accepted innovations [rad]."""
+    n_frames, n_heads = available.shape
+    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, x.shape[0], P.shape[0])
     for f in range(n_frames):
         x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
-        if available[f]:
-            x, P, z, nis, ok = attitude_update(x, P, q_meas[f], R_S, gate, model, estimated)
-            n_meas[f] = 1
-            if ok:
-                n_acc[f] = 1
-                nis_log[f] = nis
-                dof_log[f] = 3
-                innov_log[f] = np.sqrt(np.sum(z * z) / 3.0)
+        nis_sum, squares = 0.0, 0.0
+        for h in range(n_heads):
+            if available[f, h]:
+                x, P, z, nis, ok = attitude_update(x, P, q_meas[f, h], R_S[h], h, gate, model, estimated)
+                n_meas[f] += 1
+                if ok:
+                    n_acc[f] += 1
+                    nis_sum += nis
+                    squares += np.sum(z * z)
+        if n_acc[f]:
+            nis_log[f] = nis_sum
+            dof_log[f] = 3 * n_acc[f]
+            innov_log[f] = np.sqrt(squares / (3.0 * n_acc[f]))
         x_log[f] = x
         P_log[f] = P
     return x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
 
 
 @njit
-def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, ref_I, obs_S, cov_S, gate, available):
+def run_stars(x, P, omega, ratio, dt, model, estimated, offsets, heads, ref_I, obs_S, cov_S, gate, available):
     """:func:`run_fixes` with star vectors: frame f updates with the stars offsets[f]:offsets[f+1]
-    of ``ref_I``/``obs_S``/``cov_S`` (:func:`stars_update`)."""
+    of ``heads``/``ref_I``/``obs_S``/``cov_S`` (:func:`stars_update`)."""
     n_frames = available.shape[0]
-    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, P.shape[0])
+    x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log = _allocate_logs(n_frames, x.shape[0], P.shape[0])
     for f in range(n_frames):
         x, P = predict(x, P, omega[f * ratio : (f + 1) * ratio], dt, model)
         lo, hi = offsets[f], offsets[f + 1]
         if available[f] and hi > lo:
-            x, P, z, nis, accepted = stars_update(x, P, ref_I[lo:hi], obs_S[lo:hi], cov_S[lo:hi], gate, model,
-                                                  estimated)
+            x, P, z, nis, accepted = stars_update(x, P, heads[lo:hi], ref_I[lo:hi], obs_S[lo:hi], cov_S[lo:hi], gate,
+                                                  model, estimated)
             n_meas[f] = hi - lo
             n_acc[f], nis_log[f], dof_log[f], innov_log[f] = star_statistics(z, nis, accepted)
         x_log[f] = x
         P_log[f] = P
     return x_log, P_log, n_meas, n_acc, nis_log, dof_log, innov_log
-
-

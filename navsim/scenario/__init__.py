@@ -53,21 +53,40 @@ def parse_override(text):
 
 def apply_overrides(data, overrides, source):
     """Return a copy of ``data`` with overrides applied; ``overrides`` is a dict {dotted: value}
-    (a value of None removes the key) or a list of 'key=value' strings."""
+    (a value of None removes the key) or a list of 'key=value' strings; a number in the key indexes an array of
+    tables (``star_sensor.1.fov_deg``)."""
     data = copy.deepcopy(data)
     items = overrides.items() if isinstance(overrides, dict) else (parse_override(o) for o in overrides)
     for key, value in items:
         path = key.split(".") if isinstance(key, str) else list(key)
         node = data
         for part in path[:-1]:
-            node = node.setdefault(part, {})
-            if not isinstance(node, dict):
-                raise InputError(f"{source}: {'.'.join(path)}: {part} is not a table")
-        if value is None:  # the Python API's way to remove an optional key or table
+            node = _element(node, part, path, source) if isinstance(node, list) else node.setdefault(part, {})
+            if not isinstance(node, (dict, list)):
+                raise InputError(f"{source}: {'.'.join(map(str, path))}: {part} is not a table")
+        if isinstance(node, list):  # an element of an array of tables replaced whole
+            node[_index(node, path[-1], path, source)] = value
+        elif value is None:  # the Python API's way to remove an optional key or table
             node.pop(path[-1], None)
         else:
             node[path[-1]] = value
     return data
+
+
+def _index(array, part, path, source):
+    """The index ``part`` (a number: 0 the first) into an array of tables, or an InputError naming the key."""
+    try:
+        index = int(part)
+    except (TypeError, ValueError):
+        raise InputError(f"{source}: {'.'.join(map(str, path))}: {part!r} is not an index of the array (0, 1, ...)") from None
+    if not 0 <= index < len(array):
+        raise InputError(f"{source}: {'.'.join(map(str, path))}: index {index} outside the array of {len(array)}")
+    return index
+
+
+def _element(array, part, path, source):
+    """The table at index ``part`` of an array of tables (``star_sensor.1.fov_deg`` names the second head's field)."""
+    return array[_index(array, part, path, source)]
 
 
 def read_scenario_file(path, overrides=()):
@@ -87,9 +106,11 @@ def read_scenario_file(path, overrides=()):
     except RecursionError:
         raise InputError(f"{path}: invalid TOML: arrays or tables nested too deeply") from None
     data = apply_overrides(data, overrides, str(path))
-    image = data.get("star_sensor", {}).get("image", {}) if isinstance(data.get("star_sensor"), dict) else {}
-    if isinstance(image, dict) and isinstance(image.get("camera_file"), str):  # relative to the scenario file
-        image["camera_file"] = str(path.parent / image["camera_file"])
+    sensors = data.get("star_sensor")
+    for sensor in sensors if isinstance(sensors, list) else [sensors]:  # a spacecraft's heads, or the one sensor
+        image = sensor.get("image") if isinstance(sensor, dict) else None
+        if isinstance(image, dict) and isinstance(image.get("camera_file"), str):  # relative to the scenario file
+            image["camera_file"] = str(path.parent / image["camera_file"])
     return data
 
 

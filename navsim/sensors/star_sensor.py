@@ -74,7 +74,9 @@ class StarFrame:
     from which the filter may be re-initialised when it rejects the stars (a lost track).
     ``info``: the per-frame log quantities (``log_fields``); ``diagnostics``: what observers read
     (detections, the stacked star, the true sensor attitude); ``aiding``: the measurements of the other
-    sensors of the same frame (an INS's baro and position fixes), fused after the star sensor's."""
+    sensors of the same frame (an INS's baro and position fixes), fused after the star sensor's. A spacecraft's
+    several heads (:mod:`navsim.sensors.star_heads`) give ``heads``: the head of each star, or with fixes ``q_IS``
+    (K, 4) and ``R_S`` (K, 3, 3) of the heads ``heads`` (K,), each fused through its head's mounting."""
 
     mode: str
     reason: str = ""
@@ -88,14 +90,19 @@ class StarFrame:
     info: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
     aiding: tuple = ()
+    heads: np.ndarray | None = None
 
     @property
     def star_measurements(self):
-        """((kind, arguments of the filter's update),) of the star sensor: an attitude fix, stars or nothing."""
+        """((kind, arguments of the filter's update), ...) of the star sensor: an attitude fix (one per head), stars
+        or nothing."""
+        if self.q_IS is not None and self.heads is not None:
+            return tuple(("attitude", (q, R, int(h))) for q, R, h in zip(self.q_IS, self.R_S, self.heads))
         if self.q_IS is not None:
             return (("attitude", (self.q_IS, self.R_S)),)
         if len(self.ref_I):
-            return (("stars", (self.ref_I, self.obs_S, self.cov_S)),)
+            heads = () if self.heads is None else (self.heads,)
+            return (("stars", (self.ref_I, self.obs_S, self.cov_S, *heads)),)
         return ()
 
     @property

@@ -32,7 +32,8 @@ from startrack.sphere import tangent_basis
 class StarFrames:
     """Star measurements of many frames, concatenated: frame f owns rows offsets[f]:offsets[f+1]; each star's
     direction σ [rad] per tangent axis (the filter's R) in ``sigma``, its catalog row ``index``, its band magnitude
-    ``mag`` (the catalog's) and the σ of its measured magnitude ``mag_sigma`` [mag] (NaN without a light budget)."""
+    ``mag`` (the catalog's), the σ of its measured magnitude ``mag_sigma`` [mag] (NaN without a light budget) and,
+    for a spacecraft's several heads, the ``head`` that saw it (None: one sensor)."""
 
     offsets: np.ndarray
     ref_I: np.ndarray
@@ -42,6 +43,11 @@ class StarFrames:
     index: np.ndarray
     mag: np.ndarray
     mag_sigma: np.ndarray
+    head: np.ndarray | None = None
+
+    def head_index(self):
+        """(M,) int64: the head that saw each star (a spacecraft's several heads; all 0 for one sensor)."""
+        return np.zeros(len(self.ref_I), dtype=np.int64) if self.head is None else np.ascontiguousarray(self.head, dtype=np.int64)
 
     def frame(self, f):
         """(ref_I (N, 3), obs_S (N, 3), ids (N,), σ (N,)) of frame f."""
@@ -63,7 +69,8 @@ class StarVectorSensor:
     most (brightest) stars reported; ``q_BS_true`` true mounting. With a light budget (``photometry``, a
     :class:`startrack.sensor_photometry.SensorPhotometry`) and the frames' sky (``sky``, a
     :class:`navsim.sensors.frame_sky.FrameSky`) a star is reported when the frame's sky lets the sensor detect
-    it, with the σ of its own SNR, instead of every star with ``sigma``.
+    it, with the σ of its own SNR, instead of every star with ``sigma``. On a spacecraft (``occultation``, a
+    :class:`navsim.orbit.earth_disc.EarthDisc` of the frames) the stars behind the Earth are not seen.
     """
 
     star_vectors: np.ndarray
@@ -77,6 +84,7 @@ class StarVectorSensor:
     photometry: object = None
     sky: object = None
     identification: object = None  # navsim.sensors.star_prior.PriorIdentification
+    occultation: object = None  # navsim.orbit.earth_disc.EarthDisc: the stars the Earth hides from a spacecraft
 
     def start(self, seed, q_IB_frames, t_frames, v_I=None, noise=True, air=None):
         """A run's sensor: every frame's stars drawn from ``seed`` for the true attitudes q_IB_frames
@@ -128,6 +136,9 @@ class StarVectorSensor:
         """
         q_IS = rot.multiply(np.atleast_2d(q_IB_true), self.q_BS_true)
         frame, index = self._in_field(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0])))
+        if self.occultation is not None:
+            seen = ~self.occultation.hides(self.star_vectors[index], frame)
+            frame, index = frame[seen], index[seen]
         ref_I = self.star_vectors[index]
         seen_I = ref_I if v_I is None else apparent(ref_I, np.asarray(v_I)[frame], _rows(air, frame))
         sigma = np.full(len(index), self.sigma)

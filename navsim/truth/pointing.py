@@ -4,7 +4,8 @@ orbit's geocentric position r and velocity v (N, 3) [m, m/s] and the geocentric 
 [s] (GCRS axes throughout); :func:`reference_rates` gives the rate and acceleration the controller feeds forward.
 
 - :class:`Nadir`: the local-vertical, local-horizontal frame (LVLH): +z_B to nadir (−r̂), +y_B against the orbit's
-  angular momentum (−(r × v)/|r × v|), +x_B = y_B × z_B, about the velocity; turned by a fixed yaw about +z_B.
+  angular momentum (−(r × v)/|r × v|), +x_B = y_B × z_B, about the velocity; turned by a fixed yaw about +z_B and by
+  ``offsets`` held from given times with slews between them (an Earth-observation spacecraft's off-nadir looks).
 - :class:`SunPointing`: a body axis on the Sun and a second body axis as near as it goes to celestial north, or
   with ``yaw_steering`` to nadir (the rotation about the Sun line then follows the orbit, keeping the Earth on one
   side of the spacecraft).
@@ -46,13 +47,16 @@ def aligned(primary_B, primary_I, secondary_B, secondary_I):
 
 @dataclass(frozen=True)
 class Nadir:
-    """LVLH pointing (module docstring), turned by ``yaw`` [rad] about +z_B."""
+    """LVLH pointing (module docstring), turned by ``yaw`` [rad] about +z_B, then by the body-axes offsets of
+    ``offsets`` (a :class:`Targets` of rotations from the yawed LVLH frame, with its slews; None: none)."""
 
     yaw: float = 0.0
+    offsets: object = None
 
     def attitude(self, t, r, v, sun):
         q = aligned([0.0, 0.0, 1.0], -r, [0.0, 1.0, 0.0], -np.cross(r, v))
-        return rot.multiply(q, rot.from_rotation_vector(np.array([0.0, 0.0, self.yaw])))
+        q = rot.multiply(q, rot.from_rotation_vector(np.array([0.0, 0.0, self.yaw])))
+        return q if self.offsets is None else rot.normalize(rot.multiply(q, self.offsets.attitude(t, r, v, sun)))
 
 
 @dataclass(frozen=True)
@@ -103,6 +107,14 @@ class Targets:
             duration = slew_angle(0.0, angle, self.max_rate, self.max_acceleration)[1] if angle > 0.0 else 0.0
             out.append((start, np.asarray(q_from, dtype=float), phi / angle if angle > 0.0 else np.zeros(3), angle, duration))
         return out
+
+    def late(self):
+        """The index of the first target whose slew has not ended at the next target's start, or None."""
+        slews = self.slews()
+        for k, (start, _, _, _, duration) in enumerate(slews[:-1]):
+            if start + duration > slews[k + 1][0]:
+                return k + 1
+        return None
 
     def attitude(self, t, r, v, sun):
         t = np.asarray(t, dtype=float)

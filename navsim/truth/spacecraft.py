@@ -32,7 +32,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.wgs84 import GM
-from navsim.kinematics_jit import quat_derivative
 from startrack.errors import InputError
 from startrack.jit import njit
 from startrack.rotation_jit import quat_multiply, quat_to_matrix
@@ -127,18 +126,41 @@ class Spacecraft:
 
 
 @njit
-def _derivatives(q, omega, h, tau_m, J, J_inv, G, limits, r_I):
-    """(q̇, ω̇, ḣ_w) of the module docstring's equations."""
+def _derivatives(y, tau_m, J, J_inv, G, limits, r_I, out):
+    """ẏ of y = (q (4), ω (3), h_w (n)) by the module docstring's equations, written into ``out``."""
     inertia_w, _, _, viscous, coulomb, mu = limits
-    speed = h / inertia_w
-    h_dot = tau_m - viscous * speed - coulomb * np.tanh(speed / COULOMB_SMOOTHING)
-    H = J @ omega + G @ h
-    torque = -(G @ h_dot) - np.cross(omega, H)
+    n = G.shape[1]
+    w0, w1, w2 = y[4], y[5], y[6]
+    H = np.empty(3)
+    torque = np.zeros(3)
+    for i in range(3):
+        H[i] = J[i, 0] * w0 + J[i, 1] * w1 + J[i, 2] * w2
+    for k in range(n):
+        speed = y[7 + k] / inertia_w
+        h_dot = tau_m[k] - viscous * speed - coulomb * np.tanh(speed / COULOMB_SMOOTHING)
+        out[7 + k] = h_dot
+        for i in range(3):
+            H[i] += G[i, k] * y[7 + k]
+            torque[i] -= G[i, k] * h_dot
+    torque[0] -= w1 * H[2] - w2 * H[1]
+    torque[1] -= w2 * H[0] - w0 * H[2]
+    torque[2] -= w0 * H[1] - w1 * H[0]
     if mu > 0.0:
-        r_B = quat_to_matrix(q).T @ r_I
-        rn = np.sqrt(np.sum(r_B * r_B))
-        torque += 3.0 * mu / rn**5 * np.cross(r_B, J @ r_B)
-    return quat_derivative(q, omega), J_inv @ torque, h_dot
+        C = quat_to_matrix(y[0:4])
+        r_B = C.T @ r_I
+        rn2 = r_B[0] ** 2 + r_B[1] ** 2 + r_B[2] ** 2
+        scale = 3.0 * mu / (rn2 * rn2 * np.sqrt(rn2))
+        Jr = J @ r_B
+        torque[0] += scale * (r_B[1] * Jr[2] - r_B[2] * Jr[1])
+        torque[1] += scale * (r_B[2] * Jr[0] - r_B[0] * Jr[2])
+        torque[2] += scale * (r_B[0] * Jr[1] - r_B[1] * Jr[0])
+    x, yq, z, w = y[0], y[1], y[2], y[3]
+    out[0] = 0.5 * (w * w0 + yq * w2 - z * w1)
+    out[1] = 0.5 * (w * w1 - x * w2 + z * w0)
+    out[2] = 0.5 * (w * w2 + x * w1 - yq * w0)
+    out[3] = -0.5 * (x * w0 + yq * w1 + z * w2)
+    for i in range(3):
+        out[4 + i] = J_inv[i, 0] * torque[0] + J_inv[i, 1] * torque[1] + J_inv[i, 2] * torque[2]
 
 
 @njit
@@ -188,29 +210,37 @@ def _simulate(J, G, limits, gains, dt, steps, q_ref, omega_ref, domega_ref, r_I,
     tau_log = np.empty((K, n))
     cut_log = np.zeros(K, dtype=np.bool_)
     error_log = np.empty(K)
-    q = q_ref[0].copy()
-    omega = quat_to_matrix(q).T @ quat_to_matrix(q_ref[0]) @ omega_ref[0]
-    h = h0.copy()
+    y = np.empty(7 + n)
+    y[0:4] = q_ref[0]
+    y[4:7] = omega_ref[0]  # the body starts on the reference: C_BR = I
+    y[7:] = h0
     integral = np.zeros(3)
-    q_out[0] = q
-    w_out[0] = omega
+    q_out[0] = y[0:4]
+    w_out[0] = y[4:7]
+    k1, k2, k3, k4, stage = np.empty(7 + n), np.empty(7 + n), np.empty(7 + n), np.empty(7 + n), np.empty(7 + n)
     for k in range(K):
-        command, error_log[k] = _command(q, omega, h, q_ref[k], omega_ref[k], domega_ref[k], J, G, G_pinv, gains,
-                                             integral, dt * steps, k == 0 or not cut_log[k - 1])
-        tau, cut_log[k] = _limited(command, h, limits)
-        h_log[k] = h
+        command, error_log[k] = _command(y[0:4], y[4:7], y[7:], q_ref[k], omega_ref[k], domega_ref[k], J, G, G_pinv, gains,
+                                         integral, dt * steps, k == 0 or not cut_log[k - 1])
+        tau, cut_log[k] = _limited(command, y[7:], limits)
+        h_log[k] = y[7:]
         tau_log[k] = tau
+        r = r_I[k]
         for s in range(steps):
-            k1q, k1w, k1h = _derivatives(q, omega, h, tau, J, J_inv, G, limits, r_I[k])
-            k2q, k2w, k2h = _derivatives(q + 0.5 * dt * k1q, omega + 0.5 * dt * k1w, h + 0.5 * dt * k1h, tau, J, J_inv, G,
-                                         limits, r_I[k])
-            k3q, k3w, k3h = _derivatives(q + 0.5 * dt * k2q, omega + 0.5 * dt * k2w, h + 0.5 * dt * k2h, tau, J, J_inv, G,
-                                         limits, r_I[k])
-            k4q, k4w, k4h = _derivatives(q + dt * k3q, omega + dt * k3w, h + dt * k3h, tau, J, J_inv, G, limits, r_I[k])
-            q = q + dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q)
-            q /= np.sqrt(np.sum(q * q))
-            omega = omega + dt / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w)
-            h = h + dt / 6.0 * (k1h + 2.0 * k2h + 2.0 * k3h + k4h)
-            q_out[k * steps + s + 1] = q
-            w_out[k * steps + s + 1] = omega
+            _derivatives(y, tau, J, J_inv, G, limits, r, k1)
+            for i in range(7 + n):
+                stage[i] = y[i] + 0.5 * dt * k1[i]
+            _derivatives(stage, tau, J, J_inv, G, limits, r, k2)
+            for i in range(7 + n):
+                stage[i] = y[i] + 0.5 * dt * k2[i]
+            _derivatives(stage, tau, J, J_inv, G, limits, r, k3)
+            for i in range(7 + n):
+                stage[i] = y[i] + dt * k3[i]
+            _derivatives(stage, tau, J, J_inv, G, limits, r, k4)
+            for i in range(7 + n):
+                y[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            norm = np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2 + y[3] ** 2)
+            for i in range(4):
+                y[i] /= norm
+            q_out[k * steps + s + 1] = y[0:4]
+            w_out[k * steps + s + 1] = y[4:7]
     return q_out, w_out, h_log, tau_log, cut_log, error_log

@@ -84,7 +84,8 @@ def declination_divisions(run):
     which the logged addresses (l_d, l_ra) and flat indices agree (eq. 7-8 and the flat index
     of document 000), searched over the grids whose ring count covers the largest l_d.
     """
-    image = ((run.scenario or {}).get("star_sensor") or {}).get("image")
+    sensor = (run.scenario or {}).get("star_sensor")
+    image = sensor.get("image") if isinstance(sensor, dict) else None  # a spacecraft's heads have no image chain
     if image and "catalog_nd" in image:
         return int(image["catalog_nd"])
     s = run.series

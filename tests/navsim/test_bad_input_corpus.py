@@ -14,6 +14,7 @@ import pytest
 from navsim import cli
 from navsim.attitude.scenario import SCHEMA
 from navsim.navigation import scenario as navigation
+from navsim.spacecraft import scenario as spacecraft
 from navsim.scenario.schema import ListOfTables, Table, Tagged, Value
 from navsim.studies import schema as study_schema
 from tests.support import run_cli
@@ -21,12 +22,16 @@ from tests.support import run_cli
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
 BASES = {name: DATA / f"base_{name}.toml" for name in ("constant", "image", "segments", "rigid", "navigation",
-                                                              "route", "sins_cns", "sins_cns_photometry")}
+                                                              "route", "sins_cns", "sins_cns_photometry", "spacecraft",
+                                                              "spacecraft_targets", "spacecraft_tle")}
 STUDY = ROOT / "scenarios" / "paper003_precision.toml"
 #: Which base scenario reaches the keys below each table of the attitude and the navigation schema
 #: (the first match wins; the schema's default otherwise).
 NAV_BASE_OF = (("star_sensor.photometry", "sins_cns_photometry"), ("star_sensor", "sins_cns"), ("faults", "sins_cns"),
                ("trajectory.route", "route"))
+#: ... and of the spacecraft schema.
+SPACECRAFT_BASE_OF = (("pointing.targets", "spacecraft_targets"), ("orbit.state", "spacecraft_targets"),
+                      ("orbit.tle", "spacecraft_tle"))
 BASE_OF = (("truth.sinusoidal_axis", "image"), ("truth.rate_segments", "segments"), ("truth.rigid_body", "rigid"),
            ("star_sensor.image", "image"), ("faults.attitude_jumps", "image"), ("faults.false_star_storms", "image"),
            ("faults.tracking_failure_probes", "image"))
@@ -113,6 +118,8 @@ def _item_cases(item, path, base):
         valid = next(dict(row) for row in items if not kind or row[item.tag] == kind)
         label = f"{path}[{kind}]" if kind else f"{path}[0]"
         for key, spec in table.entries.items():
+            if not isinstance(spec, Value):  # a table inside an array's item (a head's faults): its own keys' cases
+                continue                      # are those of the same table at the top (the attitude kind's faults)
             for bad, value in bad_values(spec):
                 yield f"{label}.{key}: {bad}", base, path, toml([{**valid, key: value}])
         if kind:
@@ -121,7 +128,8 @@ def _item_cases(item, path, base):
         yield f"{path}: an unknown {item.tag}", base, path, toml([{item.tag: "fly"}])
 
 
-SCENARIO_CASES = scenario_cases(SCHEMA, BASE_OF, "constant") + scenario_cases(navigation.SCHEMA, NAV_BASE_OF, "navigation")
+SCENARIO_CASES = (scenario_cases(SCHEMA, BASE_OF, "constant") + scenario_cases(navigation.SCHEMA, NAV_BASE_OF, "navigation")
+                  + scenario_cases(spacecraft.SCHEMA, SPACECRAFT_BASE_OF, "spacecraft"))
 
 
 def assert_one_clear_line(status, err, culprit, out=None):
@@ -150,7 +158,8 @@ REQUIRED = [("duration_s", "constant"), ("truth.profile", "constant"), ("gyro.ra
             ("name", "navigation"), ("trajectory.start.lat_deg", "navigation"), ("trajectory.segments", "navigation"),
             ("imu.rate_hz", "navigation"), ("baro.rate_hz", "navigation"), ("aiding.position.sigma_ned_m", "navigation"),
             ("gravity.model", "navigation"), ("star_sensor.photometry.aperture_mm", "sins_cns_photometry"),
-            ("trajectory.route.waypoints", "route")]
+            ("trajectory.route.waypoints", "route"), ("epoch_utc", "spacecraft"), ("pointing.law", "spacecraft"),
+            ("star_sensor.0.mounting_rotvec_deg", "spacecraft"), ("star_sensor.1.rate_hz", "spacecraft")]
 
 
 @pytest.mark.parametrize("key, base", REQUIRED)
@@ -159,7 +168,7 @@ def test_a_missing_required_key_is_named(tmp_path, capsys, key, base):
     node = data
     *parents, last = key.split(".")
     for part in parents:
-        node = node[part]
+        node = node[int(part)] if isinstance(node, list) else node[part]
     del node[last]
     path = tmp_path / "missing.toml"
     path.write_text(_to_toml(data))
@@ -219,6 +228,37 @@ CROSS_KEY = [
     ("navigation", 'epoch_utc="2024-13-01T00:00:00"', "epoch_utc"),
     ("navigation", 'epoch_utc="2024-03-20T00:00:00+02:00"', "epoch_utc"),
     ("navigation", "trajectory.start={lat_deg = 45.0}", "trajectory.start.lon_deg"),
+    # spacecraft (issue 51): an impossible TLE, an orbit below the surface, an unknown attitude law, and the other rules
+    ("spacecraft_tle", 'orbit.tle=["1 25544U 98067A   08264.51782528 -.00002182  00000-0 -11606-4 0  2928", '
+                           '"2 25544  51.6416 247.4627 0006703 130.5360 325.0288 15.72125391563537"]', "orbit.tle"),
+    ("spacecraft_tle", 'orbit.tle=["1 25544U 98067A   08264.51782528 -.00002182  00000-0 -11606-4 0  2927"]', "orbit.tle"),
+    ("spacecraft_tle", 'orbit.tle=["1 25544U 98067A   08264.51782528 -.00002182  00000-0 -11606-4 0  2927", '
+                           '"2 25544  51.6416 247.4627 0006703 130.5360 325.0288 17.50000000563535"]', "orbit.tle"),
+    ("spacecraft", "orbit.elements.height_km=50.0", "orbit.elements.height_km"),
+    ("spacecraft", "orbit.elements.eccentricity=0.5", "orbit.elements.height_km"),       # the perigee inside the Earth
+    ("spacecraft", "orbit.state={position_km = [6000.0, 0.0, 0.0], velocity_km_per_s = [0.0, 7.5, 0.0]}", "orbit"),
+    ("spacecraft", 'orbit.elements={height_km = 500.0, inclination_deg = 97.0}', "raan_deg"),
+    ("spacecraft", 'orbit.propagator="sgp4"', "orbit.propagator"),                      # sgp4 without a TLE
+    ("spacecraft", 'pointing.law="sideways"', "pointing.law"),
+    ("spacecraft", 'pointing.law="sun"', "pointing.offsets"),                           # nadir's offsets on another law
+    ("spacecraft_tle", 'pointing.law="targets"', "pointing.targets"),                   # no targets
+    ("spacecraft_targets", "pointing.targets.1.start_s=0.0", "pointing.targets[1].start_s"),    # out of time order
+    ("spacecraft_targets", "pointing.targets=[{start_s = 0.0, ra_deg = 250.0, dec_deg = 0.0}, {start_s = 10.0, ra_deg = 300.0, "
+                           "dec_deg = 0.0}, {start_s = 20.0, ra_deg = 250.0, dec_deg = 0.0}]", "pointing.targets[1].start_s"),
+    ("spacecraft_targets", "pointing.targets.0.start_s=10.0", "pointing.targets[0].start_s"),
+    ("spacecraft", "star_sensor.1.rate_hz=2.0", "star_sensor[1].rate_hz"),               # another frame clock
+    ("spacecraft", 'star_sensor.1.measurement="attitude"', "star_sensor[1].measurement"),
+    ("spacecraft", 'star_sensor.0.fidelity="image"', "star_sensor[0].fidelity"),
+    ("spacecraft", "star_sensor.3.fov_deg=10.0", "star_sensor.3"),                       # no fourth head to change
+    ("spacecraft", "star_sensor={rate_hz = 1.0, fov_deg = 20.0, mounting_rotvec_deg = [0.0, 0.0, 0.0]}", "star_sensor"),
+    ("spacecraft", "gyro.rate_hz=1.5", "star_sensor[0].rate_hz"),
+    ("spacecraft", "spacecraft.controller.rate_hz=3.0", "spacecraft.truth_rate_hz"),
+    ("spacecraft", "spacecraft.inertia_kg_m2=[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]", "inertia_kg_m2"),
+    ("spacecraft", "spacecraft.wheels.initial_momentum_N_m_s=[0.1, 0.2]", "initial_momentum_N_m_s"),
+    ("spacecraft", "orbits=2.0", "duration_s"),                                           # both
+    ("spacecraft", "duration_s=1e6", "duration_s"),                                       # more than a run holds
+    ("spacecraft", "settle_s=300.0", "settle_s"),
+    ("spacecraft", 'epoch_utc="2025-02-30T00:00:00"', "epoch_utc"),
     # the uncertainty of a model air the processing does not correct with
     ("sins_cns", "star_sensor.refraction={correction = false, pressure_sigma_percent = 3.0}", "star_sensor.refraction"),
 ]

@@ -20,6 +20,7 @@ FLOORS = (
     {"studies"},                                             # the source documents' experiments
     {"build", "typeset", "star_run"},                        # what the run kinds share
     {"attitude", "navigation"},                              # the run kinds
+    {"spacecraft"},                                          # the run kind that builds on the attitude kind
     {"kinds"},                                               # their registry
     {"simulation"},                                          # the front door
     {"campaign", "report"},
