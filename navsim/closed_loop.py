@@ -22,6 +22,7 @@ it is tested equal to the step-by-step loop.
 """
 
 import dataclasses
+import functools
 import time
 from dataclasses import dataclass
 
@@ -74,7 +75,9 @@ def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compi
             sensor_run.lose_track()
         prediction = filt.sensor_prediction(imu[k - 1]) if sensor_run.uses_prediction else (None, None)
         request = FrameRequest(index=j, t=k * grid.dt, truth=truth.at(k), q_IS_pred=prediction[0],
-                               omega_S_pred=prediction[1], prior=filt.sensor_prior() if sensor_run.uses_prior else None)
+                               omega_S_pred=prediction[1], prior=filt.sensor_prior() if sensor_run.uses_prior else None,
+                               predict=functools.partial(filt.sensor_prediction, imu[k - 1]) if sensor_run.uses_prediction
+                               else None)
         frame = sensor_run.observe(request)
         update = fuse(filt, frame)
         sensor_run.after_update(update)

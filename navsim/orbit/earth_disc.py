@@ -6,6 +6,14 @@ allowance). As in :mod:`navsim.orbit.eclipse`, stretching the coordinates along 
 the ellipsoid into a sphere of radius a + h: a line of sight meets the ellipsoid exactly when its stretched image
 meets the sphere, so what the disc hides is exact; the limb's angle from a direction is the stretched frame's (off
 by up to f = 0.3 % of it).
+
+The sunlit Earth's light at the spacecraft (:meth:`EarthDisc.albedo_irradiance`), the stray light a baffle lets
+through when the limb is near a field: the Earth as a Lambert sphere of Bond albedo A (its geometric albedo 2A/3)
+seen at the phase angle α (Sun-Earth-spacecraft) from the distance r,
+
+    E_⊕ / E_☉ = (2A/3) (R/r)² Φ(α),   Φ(α) = (sin α + (π − α) cos α)/π   (Russell 1916; Lester et al. 1979),
+
+0 over the night side (α = π): its irradiance normal to the line of sight as a fraction of the Sun's.
 """
 
 from dataclasses import dataclass
@@ -46,6 +54,14 @@ class EarthDisc:
     def hides(self, u_I, frame):
         """True for the directions ``u_I`` (N, 3) at frames ``frame`` (N,) that meet the raised ellipsoid."""
         return self.limb_angle(u_I, frame) < 0.0
+
+    def albedo_irradiance(self, sun, albedo=0.3):
+        """E_⊕ / E_☉ (F,) at every frame (module docstring) with the geocentric Sun at ``sun`` (F, 3) [m]."""
+        r = np.atleast_2d(self.r_I)
+        distance = np.linalg.norm(r, axis=-1)
+        alpha = angular_distance(r / distance[:, None], sun / np.linalg.norm(sun, axis=-1, keepdims=True))
+        phase = (np.sin(alpha) + (np.pi - alpha) * np.cos(alpha)) / np.pi
+        return 2.0 * albedo / 3.0 * (R_EARTH / distance) ** 2 * phase
 
     def angular_radius(self):
         """The disc's angular radius (F,) [rad] at every frame (in the stretched frame)."""

@@ -1,4 +1,6 @@
-"""A spacecraft's star-sensor heads (2-3, or one) as one sensor of the closed loop, at vector fidelity.
+"""A spacecraft's star-sensor heads (2-3, or one) as one sensor of the closed loop, at vector fidelity
+(:class:`StarHeads`) or image fidelity (:class:`ImageHeads`: each head renders, detects and identifies its own frame
+with its own prediction, and the frame fuses every head's stars).
 
 Each head is a :class:`~navsim.sensors.star_vector.StarVectorSensor` or an
 :class:`~navsim.sensors.star_vector.AttitudeFixSensor` with its own mounting, field, exclusions and faults (all
@@ -22,6 +24,7 @@ import numpy as np
 
 from navsim.earth.apparent import fix_rotation
 from navsim.sensors.recorded_run import RecordedRun
+from navsim.sensors.star_image import LOG_FIELDS, TIMING_FIELDS
 from navsim.sensors.star_sensor import StarFrame, isotropic_covariance
 from navsim.sensors.star_vector import Record, StarFrames
 from startrack import rotation as rot
@@ -122,3 +125,120 @@ class HeadsRun(RecordedRun):
         ref_I, obs_S, _, sigma = r.stars.frame(j)
         heads = r.stars.head[r.stars.offsets[j] : r.stars.offsets[j + 1]]
         return StarFrame(mode="tracking", ref_I=ref_I, obs_S=obs_S, cov_S=isotropic_covariance(obs_S, sigma), heads=heads)
+
+
+#: A head's frame modes in the order the heads' frame takes the best of them (a scalar per frame for the reports).
+MODE_ORDER = ("tracking", "subcatalog", "lost_in_space", "stacked", "prior", "no_fix", "excluded", "outage", "dropped")
+#: An identified star farther than this from where the truth puts its catalog star is a wrong identification [px].
+WRONG_PX = 5.0
+#: The heads' per-frame log (H per field): each head's mode, detections, identified stars, particle hits and wrong
+#: identifications (the truth's check), beside the scalar fields of one sensor (their sums, the best mode, head 0's
+#: pointing).
+HEAD_FIELDS = ("head_mode", "head_detected", "head_identified", "head_hits", "head_wrong")
+
+
+@dataclass(frozen=True)
+class ImageHeads:
+    """The heads at image fidelity: ``heads`` (:class:`~navsim.sensors.star_image.ImageStarSensor`, each with its
+    true mounting, faults, exclusions, stray light and particle hits), their ``names``, nominal mountings ``q_BS``
+    (H, 4), the σ [rad] of each head's mounting error drawn per run (``misalignment_sigma``) and whether its processing
+    aberrates the identified stars' catalog directions with the orbit's velocity (``aberration_correction``)."""
+
+    heads: tuple
+    names: tuple
+    q_BS: np.ndarray
+    misalignment_sigma: tuple
+    aberration_correction: tuple
+
+    def start(self, seed, n_frames):
+        """A run's sensor (:class:`ImageHeadsRun`): each head's child of the SeedSequence ``seed`` spawns three, the
+        mounting draw, the false stars and particle hits, the rendering."""
+        runs = []
+        for head, sigma, child in zip(self.heads, self.misalignment_sigma, seed.spawn(len(self.heads))):
+            draw_ss, storm_ss, render_ss = child.spawn(3)
+            error = sigma * np.random.default_rng(draw_ss).standard_normal(3)
+            head = replace(head, q_BS_true=rot.multiply(head.q_BS_true, rot.from_rotation_vector(error)))
+            runs.append(head.start(np.random.default_rng(storm_ss), np.random.default_rng(render_ss), n_frames))
+        return ImageHeadsRun(runs, self.q_BS, self.aberration_correction)
+
+
+@dataclass(frozen=True)
+class _Verdict:
+    """A head's share of the filter's verdict on a frame (what :meth:`ImageRun.after_update` reads)."""
+
+    n_accepted: int
+
+
+class ImageHeadsRun:
+    """The per-run sensor of :class:`ImageHeads`: each head observes with its own predicted attitude
+    (``request.predict(h)``) and the frame fuses their stars together, each with its head."""
+
+    uses_prediction = True
+    uses_prior = False
+
+    def __init__(self, runs, q_BS, aberration_correction):
+        self.runs, self.q_BS, self.correction = runs, q_BS, aberration_correction
+        H = len(runs)
+        self.log_fields = {**LOG_FIELDS, **{name: ((H,), np.int32, 0) for name in HEAD_FIELDS}}
+        self.timing_fields = TIMING_FIELDS
+        self.q_BS_true = np.array([run.sensor.q_BS_true for run in runs])
+        self._heads = np.zeros(0, dtype=np.int64)
+
+    @property
+    def sample(self):
+        return self.runs[0].sample
+
+    def record(self):
+        return None
+
+    def lose_track(self):
+        for run in self.runs:
+            run.lose_track()
+
+    def after_update(self, update):
+        """Each head's tracking follows the filter's verdict on its own stars."""
+        for h, run in enumerate(self.runs):
+            run.after_update(None if update is None else _Verdict(int(np.count_nonzero(update.accepted[self._heads == h]))))
+
+    def observe(self, request):
+        frames = []
+        for h, run in enumerate(self.runs):
+            q_IS, omega_S = request.predict(h)
+            frames.append(run.observe(replace(request, q_IS_pred=q_IS, omega_S_pred=omega_S)))
+        self._heads = np.concatenate([np.full(len(f.ref_I), h) for h, f in enumerate(frames)]).astype(np.int64)
+        best = min(frames, key=lambda f: MODE_ORDER.index(f.mode))
+        info = {**frames[0].info, "mode": best.info["mode"],
+                "n_detected": sum(f.info.get("n_detected", 0) for f in frames),
+                "n_identified": sum(f.info.get("n_identified", 0) for f in frames),
+                "n_stacked": sum(f.n_stacked for f in frames),
+                "id_ms": float(np.nansum([f.info.get("id_ms", np.nan) for f in frames])),
+                "head_mode": [f.info["mode"] for f in frames], "head_detected": [f.info.get("n_detected", 0) for f in frames],
+                "head_identified": [f.info.get("n_identified", 0) for f in frames],
+                "head_hits": [run.last_hits for run in self.runs],
+                "head_wrong": [self._wrong(request, h, f) for h, f in enumerate(frames)]}
+        fix = next(((f.fix_q_IS, h) for h, f in enumerate(frames) if f.fix_q_IS is not None), None)
+        v_I = request.truth.v_I
+        ref_I = [aberrate(f.ref_I, np.asarray(v_I)) if c and v_I is not None and len(f.ref_I) else f.ref_I
+                 for f, c in zip(frames, self.correction)]
+        return StarFrame(mode=best.mode, reason=best.reason, ref_I=np.vstack(ref_I),
+                         obs_S=np.vstack([f.obs_S for f in frames]), cov_S=np.concatenate([f.cov_S for f in frames]),
+                         n_stacked=info["n_stacked"], fix_q_IS=None if fix is None else self._as_head_0(*fix), info=info,
+                         heads=self._heads)
+
+    def _as_head_0(self, q_IS, head):
+        """Head ``head``'s fix as the attitude of head 0 through the nominal mountings (the filter re-initialises
+        from head 0's): q_IS ⊗ q_BS,h⁻¹ ⊗ q_BS,0."""
+        return rot.multiply(rot.multiply(q_IS, rot.conjugate(self.q_BS[head])), self.q_BS[0])
+
+    def _wrong(self, request, head, frame):
+        """The head's identified stars that the truth places more than :data:`WRONG_PX` from where it measured them
+        (their catalog star's apparent direction through the true attitude and mounting)."""
+        if not len(frame.ref_I):
+            return 0
+        run = self.runs[head]
+        camera = run.sensor.camera
+        q_IS = rot.multiply(request.truth.q_IB, run.sensor.q_BS_true)
+        seen = frame.ref_I if request.truth.v_I is None else aberrate(frame.ref_I, np.asarray(request.truth.v_I))
+        true = rot.rotate(rot.conjugate(q_IS), seen)
+        angle = np.arccos(np.clip(np.sum(true * frame.obs_S, axis=1), -1.0, 1.0))
+        return int(np.count_nonzero(angle * camera.focal_px > WRONG_PX))

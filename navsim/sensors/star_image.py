@@ -69,7 +69,9 @@ class ImageStarSensor:
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
     tracked (004's set-up), the true mounting and the faults; with a light budget (``photometry``) the frames'
     sky (``sky``). Each fused star's direction and its covariance come from its position fit
-    (:mod:`startrack.psf_fit`); the drawn stars are also the catalog the fit's neighbours come from."""
+    (:mod:`startrack.psf_fit`); the drawn stars are also the catalog the fit's neighbours come from. On a spacecraft:
+    the particle hits of its orbit (``radiation``, a :class:`navsim.sensors.radiation_hits.RadiationHits`) and the
+    stars the Earth hides (``occultation``, a :class:`navsim.orbit.earth_disc.EarthDisc` of the frames)."""
 
     camera: object
     model: object
@@ -85,6 +87,8 @@ class ImageStarSensor:
     faults: object
     photometry: object = None
     sky: object = None
+    radiation: object = None
+    occultation: object = None
 
     @property
     def catalog(self):
@@ -108,6 +112,9 @@ class ImageStarSensor:
             index, directions = field_stars(self.stars_I, rot.rotate(q_IS_true, np.array([0.0, 0.0, 1.0])),
                                             self.field_radius, v_I, air)
             mags = self.stars_mag[index]
+        if self.occultation is not None:
+            seen = ~self.occultation.hides(directions, np.full(len(directions), frame))
+            directions, mags = directions[seen], mags[seen]
         if self.sky is None:
             return directions, mags
         return directions, self.sky.extinguished(np.full(len(mags), frame), mags, directions)
@@ -141,6 +148,7 @@ class ImageRun:
         self._sample_at, self._last = n_frames // 2, n_frames - 1
         self._R_SB_true = rot.to_matrix(sensor.q_BS_true).T
         self.sample = None
+        self.last_hits = 0  # the particle hits drawn into the last frame
 
     def record(self):
         return None
@@ -223,7 +231,7 @@ class ImageRun:
         stars_I, stars_mag = s.drawn_stars(q_IS_true, request.truth.v_I, request.index, request.truth.air)
         frame = render_star_field(camera, model, q_IS_true, stars_I, stars_mag, self._render_rng,
                                   omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
-                                  extra_sources=self._false_stars(request.t))
+                                  extra_sources=self._false_stars(request.t) + self._hits(request.index))
         b, sigma_n = model.background_dn, model.noise_dn
         if full:
             found = detect(frame.image, background=b, sigma_n=sigma_n, a=s.detection_sigmas,
@@ -281,6 +289,15 @@ class ImageRun:
         v0 = rng.uniform(0, camera.height - 1, count)
         du, dv = rng.normal(0, 3.0, (2, count))
         return tuple(cosmic_ray(a, b, a + c, b + d, 4.0e4) for a, b, c, d in zip(u0, v0, du, dv))
+
+    def _hits(self, frame):
+        """The particle hits of frame ``frame`` (:class:`~navsim.sensors.radiation_hits.RadiationHits`; none without
+        radiation), drawn from the false-star stream after the storms'."""
+        if self.sensor.radiation is None:
+            return ()
+        hits = self.sensor.radiation.draw(frame, self._storm_rng, self.sensor.camera.width, self.sensor.camera.height)
+        self.last_hits = len(hits[0])
+        return self.sensor.radiation.sources(hits)
 
     def _identified(self, result, found, uv_pred, predicted):
         """(ref_I, obs_S, detection index of each, mode, reason) of the identification; while tracking,

@@ -43,8 +43,8 @@ class FrameRequest:
     """What the loop knows at a frame: its index and time [s], the truth record of the frame (for
     the star sensor :class:`~navsim.truth.profiles.FrameTruth`: q_IB and the body rate over the last
     gyro interval [rad/s], from which the sky is seen) and, for a sensor run that ``uses_prediction``,
-    the filter's prediction of the sensor attitude q_IS and of the rate in sensor axes [rad/s]; for one that
-    ``uses_prior``, the filter's :class:`SensorPrior`."""
+    the filter's prediction of the sensor attitude q_IS and of the rate in sensor axes [rad/s] (of a spacecraft's
+    head h: ``predict(h)``); for one that ``uses_prior``, the filter's :class:`SensorPrior`."""
 
     index: int
     t: float
@@ -52,6 +52,7 @@ class FrameRequest:
     q_IS_pred: np.ndarray | None = None
     omega_S_pred: np.ndarray | None = None
     prior: object = None
+    predict: object = None
 
 
 @dataclass(frozen=True)

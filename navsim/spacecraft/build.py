@@ -8,15 +8,20 @@ from navsim.attitude import build as attitude_build
 from navsim.build.star_sensor import star_sensor
 from navsim.earth.bodies import geocentric
 from navsim.earth.frames import c_ei
+from navsim.orbit.earth_disc import EarthDisc
 from navsim.orbit.elements import J2, Elements, sun_synchronous_inclination
 from navsim.orbit.numerical import Forces, NumericalOrbit
+from navsim.orbit.radiation import ParticleFlux
 from navsim.orbit.sgp4_orbit import SGP4Orbit
 from navsim.scenario.star_sensor_fields import mounting
+from navsim.sensors.radiation_hits import RadiationHits
+from navsim.sensors.stray_light import Baffle, StrayLight
 from navsim.truth.pointing import Nadir, SunPointing, Targets
 from navsim.truth.spacecraft import Controller, Spacecraft, Wheels
 from startrack import rotation as rot
 from startrack import units
 from startrack.attitude_angles import quaternion_from_radec_roll
+from startrack.bands import band
 from startrack.errors import InputError
 
 #: The pyramid's wheel elevation above the body's x-y plane [rad]: atan(1/√2), the four axes equally spread.
@@ -126,9 +131,43 @@ def gyro(scenario):
     return attitude_build.gyro(scenario)
 
 
-def head_sensor(head, star_catalog, frame_interval, epoch):
-    """One head's vector-fidelity sensor (:func:`navsim.build.star_sensor.star_sensor` of its table and its faults)."""
-    return star_sensor({"star_sensor": head, "faults": head["faults"]}, star_catalog, frame_interval, epoch)
+def head_sensor(head, star_catalog, frame_interval, epoch, lanes=()):
+    """One head's sensor (:func:`navsim.build.star_sensor.star_sensor` of its table and its faults; ``lanes`` the
+    run's compile-ahead lanes at image fidelity)."""
+    return star_sensor({"star_sensor": head, "faults": head["faults"]}, star_catalog, frame_interval, epoch, lanes)
+
+
+def stray_light(head, sky, frames):
+    """The head's :class:`~navsim.sensors.stray_light.StrayLight` at the frames: its baffle against the sunlit Earth
+    (``head['stray_light']``), the limb's angle from its boresight (``sky``, its :class:`HeadSky`)."""
+    table = head["stray_light"]
+    baffle = Baffle(pst_ref=table["pst"], angle_ref=float(np.radians(table["angle_deg"])), slope=table["slope"])
+    ratio = EarthDisc(frames.r_I).albedo_irradiance(frames.sun, table["earth_albedo"])
+    return StrayLight.of_earth(sky.limb_angle, ratio, band(head["band"]), baffle, table["pixel_um"], table["qe"])
+
+
+def particle_flux(scenario):
+    """The :class:`~navsim.orbit.radiation.ParticleFlux` of ``scenario['radiation']``, or None."""
+    r = scenario.data.get("radiation")
+    if r is None:
+        return None
+    return ParticleFlux(background=r["background_per_cm2_s"], saa_peak=r["saa_peak_per_cm2_s"], saa_lat_deg=r["saa_lat_deg"],
+                        saa_lon_deg=r["saa_lon_deg"], saa_lat_width_deg=r["saa_lat_width_deg"],
+                        saa_lon_width_deg=r["saa_lon_width_deg"], saa_height_m=1e3 * r["saa_height_km"],
+                        saa_height_exponent=r["saa_height_exponent"], horn_peak=r["horn_peak_per_cm2_s"],
+                        horn_lat_deg=r["horn_lat_deg"], horn_width_deg=r["horn_width_deg"])
+
+
+def radiation_hits(scenario, head, frames):
+    """The head's :class:`~navsim.sensors.radiation_hits.RadiationHits` in the orbit's flux at the frames (its detector
+    of the image table's size, exposure and the stray-light table's pixel pitch), or None without radiation."""
+    flux = particle_flux(scenario)
+    if flux is None:
+        return None
+    r, image = scenario["radiation"], head["image"]
+    return RadiationHits.of_flux(flux.flux(*frames.geodetic), image["width_px"], image["height_px"], image["exposure_s"],
+                                 thickness_um=r["thickness_um"], pixel_um=head["stray_light"]["pixel_um"],
+                                 electrons_per_um=r["electrons_per_um"], spread=r["spread"])
 
 
 def mountings(scenario):

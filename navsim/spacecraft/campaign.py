@@ -24,6 +24,11 @@ def pool(finished, settle):
             z = np.array([r["mounting_arcsec"]["normalised_error"] for r in per_run])
             entry["mounting_normalised_error"] = {"rms": [float(v) for v in np.sqrt(np.mean(z**2, axis=0))],
                                                   "within_3_sigma": float(np.mean(np.abs(z) <= 3.0))}
+        if "image" in first:
+            images = [r["image"] for r in per_run]
+            entry["image"] = {key: int(sum(i[key] for i in images)) for key in
+                              ("hits", "frames_with_hits", "frames_lost_with_hits", "frames_lost_without_hits",
+                               "wrong_identifications")}
         heads.append(entry)
     out["heads"] = heads
     return out

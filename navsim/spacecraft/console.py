@@ -20,7 +20,16 @@ def run_lines(summary):
                      f"per frame; about its boresight: cross {head['cross_boresight_rms_arcsec']:.2f}\" roll "
                      f"{head['roll_rms_arcsec']:.2f}\" (ratio {head['roll_to_cross_boresight']:.2f})"
                      + (f"; excluded: {excluded}" if excluded else ""))
+        if "image" in head:
+            lines.append(image_line(head["image"]))
     return lines
+
+
+def image_line(image):
+    """A head's image chain: particle hits, the frames they cost, wrong identifications."""
+    return (f"{'':<20}{image['hits']} particle hits in {image['frames_with_hits']} frames, {image['frames_lost_with_hits']} of "
+            f"them without a star ({image['frames_lost_without_hits']} without hits); {image['wrong_identifications']} "
+            "wrong identifications")
 
 
 def campaign_lines(summary):
@@ -30,4 +39,6 @@ def campaign_lines(summary):
         lines.append(f"{head['name']:<20}availability {100 * head['availability']['mean']:.1f} %, cross "
                      f"{head['cross_boresight_rms_arcsec']['mean']:.2f}\" roll {head['roll_rms_arcsec']['mean']:.2f}\" "
                      f"(ratio {head['roll_to_cross_boresight']['mean']:.2f})")
+        if "image" in head:
+            lines.append(image_line(head["image"]))
     return lines

@@ -13,16 +13,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.attitude.run import NEES_DOF, TRUTH_SOURCES, VECTOR_LANES, budget_parts, calibration_summary, check_truth_off  # noqa: F401 (the kind interface: the attitude kind's)
+from navsim import star_run
+from navsim.attitude.run import (  # noqa: F401 (the kind interface: the attitude kind's)
+    IMAGE_LANES,
+    NEES_DOF,
+    TRUTH_SOURCES,
+    VECTOR_LANES,
+    budget_parts,
+    calibration_summary,
+    check_truth_off,
+)
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.earth.bodies import geocentric
-from navsim.earth.frames import slowly, tt_epoch
+from navsim.earth.frames import c_ei, slowly, tt_epoch
+from navsim.earth.wgs84 import ecef_to_geodetic
 from navsim.estimation.attitude_filter import AttitudeFilter
 from navsim.estimation.consistency import nees
 from navsim.orbit.earth_disc import EarthDisc
 from navsim.orbit.eclipse import PENUMBRA, UMBRA, shadow
 from navsim.records import RunResult
-from navsim.sensors.star_heads import StarHeads
+from navsim.sensors.star_heads import ImageHeads, StarHeads
 from navsim.spacecraft import build
 from navsim.spacecraft.exclusion import excluding, head_sky
 from navsim.spacecraft.summary import summarize
@@ -39,7 +49,8 @@ from startrack.star_catalog import load_star_catalog
 class Frames:
     """The truth at the F star-sensor frames: times t [s], the spacecraft's geocentric position ``r_I`` and velocity
     ``v_sat`` (F, 3) [m, m/s], its barycentric velocity ``v_I`` (F, 3) [m/s] (what aberrates the stars), the sunlit
-    fraction and shadow state (F,) (:mod:`navsim.orbit.eclipse`), and each head's :class:`HeadSky`."""
+    fraction and shadow state (F,) (:mod:`navsim.orbit.eclipse`), the geocentric Sun (F, 3) [m], the geodetic
+    position (L, λ, h) (F,) each [rad, rad, m], and each head's :class:`HeadSky`."""
 
     t: np.ndarray
     r_I: np.ndarray
@@ -47,6 +58,8 @@ class Frames:
     v_I: np.ndarray
     sunlit: np.ndarray
     shadow: np.ndarray
+    sun: np.ndarray
+    geodetic: tuple
     heads: tuple
 
 
@@ -68,8 +81,9 @@ class Prepared:
 
 
 def lanes(scenario):
-    """The compile-ahead lanes of a run: the inertial sensors' and the attitude filter's kernels."""
-    return VECTOR_LANES
+    """The compile-ahead lanes of a run: the image chain's and the filter's at image fidelity, else the inertial
+    sensors' and the attitude filter's."""
+    return IMAGE_LANES if scenario["star_sensor"][0]["fidelity"] == "image" else VECTOR_LANES
 
 
 def motion(scenario, orbit, n_truth):
@@ -77,7 +91,7 @@ def motion(scenario, orbit, n_truth):
     (:meth:`navsim.truth.spacecraft.Spacecraft.simulate`), and the control grid's times."""
     body, momentum = build.spacecraft(scenario)
     truth_hz, control_hz = scenario["spacecraft"]["truth_rate_hz"], scenario["spacecraft"]["controller"]["rate_hz"]
-    steps = int(round(truth_hz / control_hz))
+    steps = round(truth_hz / control_hz)
     t = np.arange(-(-n_truth // steps)) / control_hz
     r, v = orbit.states(t)
     sun, _ = geocentric(scenario["epoch_utc"], t)
@@ -92,7 +106,7 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     check_truth_off(scenario, truth_off)
     heads = scenario["star_sensor"]
     gyro_hz, truth_hz = scenario["gyro"]["rate_hz"], scenario["spacecraft"]["truth_rate_hz"]
-    ratio, factor = int(round(gyro_hz / heads[0]["rate_hz"])), int(round(truth_hz / gyro_hz))
+    ratio, factor = round(gyro_hz / heads[0]["rate_hz"]), round(truth_hz / gyro_hz)
     n_gyro = int(np.floor(scenario["duration_s"] * gyro_hz + 1e-9))
     orbit = build.orbit(scenario)
     moving, _ = motion(scenario, orbit, n_gyro * factor)
@@ -103,17 +117,26 @@ def prepare(scenario, star_catalog=None, truth_off=frozenset()):
     if heads[0]["measurement"] == "stars" and star_catalog is None:
         star_catalog = load_star_catalog(epoch=scenario["epoch_jyear"])
     frames = frame_truth(scenario, orbit, truth, grid)
+    truth = dataclasses.replace(truth, v_I=frames.v_I, frame_ratio=ratio)
     q_BS, q_BS_true = build.mountings(scenario)
     sensors = []
     for head, sky in zip(heads, frames.heads):
-        sensor = build.head_sensor(head, star_catalog, ratio * grid.dt, scenario["epoch_jyear"])
-        if hasattr(sensor, "occultation"):  # star vectors: those behind the Earth and its bright limb are not seen
+        sensor = build.head_sensor(head, star_catalog, ratio * grid.dt, scenario["epoch_jyear"], lanes(scenario))
+        if hasattr(sensor, "occultation"):  # the stars behind the Earth and its bright limb are not seen
             disc = EarthDisc(frames.r_I, 1e3 * head["earth_limb_height_km"], tuple(build.pole(scenario)))
             sensor = dataclasses.replace(sensor, occultation=disc)
+        if head["fidelity"] == "image":
+            sensor = dataclasses.replace(sensor, sky=build.stray_light(head, sky, frames),
+                                         radiation=build.radiation_hits(scenario, head, frames))
         sensors.append(excluding(sensor, sky, frames.t))
-    sensor = StarHeads(heads=tuple(sensors), names=tuple(h["name"] for h in heads),
-                       aberration_correction=tuple(h["aberration_correction"] for h in heads),
-                       misalignment_sigma=tuple(float(units.arcsec_to_rad(h["misalignment_sigma_arcsec"])) for h in heads))
+    names = tuple(h["name"] for h in heads)
+    sigmas = tuple(float(units.arcsec_to_rad(h["misalignment_sigma_arcsec"])) for h in heads)
+    if heads[0]["fidelity"] == "image":
+        sensor = ImageHeads(heads=tuple(sensors), names=names, q_BS=q_BS, misalignment_sigma=sigmas,
+                            aberration_correction=tuple(h["aberration_correction"] for h in heads))
+    else:
+        sensor = StarHeads(heads=tuple(sensors), names=names, misalignment_sigma=sigmas,
+                           aberration_correction=tuple(h["aberration_correction"] for h in heads))
     return Prepared(scenario=scenario, truth=truth, grid=grid, frames=frames, motion=moving, gyro=build.gyro(scenario),
                     sensor=sensor, q_BS=q_BS, R_BS=rot.to_matrix(q_BS), q_BS_true=q_BS_true)
 
@@ -130,7 +153,9 @@ def frame_truth(scenario, orbit, truth, grid):
     _, q_BS_true = build.mountings(scenario)
     q_IB = truth.q_IB[grid.frame_k]
     skies = tuple(head_sky(head, q_IB, q, r, sun, moon, axis) for head, q in zip(scenario["star_sensor"], q_BS_true))
-    return Frames(t=t, r_I=r, v_sat=v, v_I=v_I, sunlit=sunlit, shadow=state, heads=skies)
+    r_e = np.einsum("fij,fj->fi", c_ei(epoch, t), r)
+    geodetic = ecef_to_geodetic(r_e[:, 0], r_e[:, 1], r_e[:, 2])
+    return Frames(t=t, r_I=r, v_sat=v, v_I=v_I, sunlit=sunlit, shadow=state, sun=sun, geodetic=geodetic, heads=skies)
 
 
 def simulate(prepared, seed, compiled=True):
@@ -146,18 +171,22 @@ def simulate(prepared, seed, compiled=True):
         dtheta0 = -units.arcsec_to_rad(np.asarray(scenario["filter"]["initial_attitude_error_arcsec"], dtype=float))
     filt = AttitudeFilter(rot.multiply(p.truth.q_IB[0], rot.from_rotation_vector(dtheta0)), np.zeros(3), config)
     frame_k = grid.frame_k
-    sensor_run = p.sensor.start(sensor_ss, p.truth.q_IB[frame_k], p.truth.t[frame_k], p.frames.v_I)
+    if isinstance(p.sensor, ImageHeads):
+        sensor_run = p.sensor.start(sensor_ss, grid.n_frames)
+    else:
+        sensor_run = p.sensor.start(sensor_ss, p.truth.q_IB[frame_k], p.truth.t[frame_k], p.frames.v_I)
     log = run_loop(filt, sensor_run, record.omega, p.truth, grid, None, (), compiled)
     series = {"t": p.truth.t[frame_k], "q_true": p.truth.q_IB[frame_k], "bias_true": record.bias[frame_k - 1], **log.arrays}
     series["attitude_error"] = rot.attitude_error(series["q_est"], series["q_true"])
     series["nees"] = nees(series["P"][:, :NEES_DOF, :NEES_DOF],
                           np.concatenate([series["attitude_error"], series["bias_true"] - series["bias_est"]], axis=1))
-    series.update(sky_series(p.frames, sensor_run.record()))
-    summary = summarize(p, seed, series, sensor_run, filt).replace(
-        gyro_calibration=calibration_summary(filt, record.matrix),
-        timing={"wall_seconds": round(time.perf_counter() - started, 4)})
+    series.update(sky_series(p.frames, sensor_run.record() or series))
+    summary = summarize(p, seed, series, sensor_run, filt).replace(gyro_calibration=calibration_summary(filt, record.matrix))
+    summary, timing = star_run.finish(summary, series, log, (), series["t"] >= scenario["settle_s"])
+    summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
     series["P_diag"] = np.diagonal(series.pop("P"), axis1=1, axis2=2).copy()
-    return RunResult(summary=summary, series=series, scenario=scenario.data)
+    return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,
+                     timing_series=log.timing)
 
 
 def sky_series(frames, record):
@@ -174,7 +203,10 @@ def sky_series(frames, record):
 
 
 def head_counts(record, heads):
-    """(F, H) int: the stars each head gave each frame (0 or 1 for fixes), as the filter took them."""
+    """(F, H) int: the stars each head gave each frame (0 or 1 for fixes), as the filter took them: from the record at
+    vector fidelity, from the image chain's log (``head_identified``) at image fidelity."""
+    if isinstance(record, dict):
+        return record["head_identified"]
     if record.fixes is not None:
         return np.asarray(record.available, dtype=np.int32).reshape(len(record.available), heads)
     stars = record.stars

@@ -126,7 +126,36 @@ HEAD = Table({
     "aberration_correction": Value("bool", default=True,
                                    doc="the processing corrects the stars' aberration with the orbit's velocity"),
     "faults": Table(dict(FAULTS)),
+    "stray_light": Table({
+        "pst": Value("float", default=1e-7, minimum=0.0, maximum=1.0,
+                     doc="the baffle's point-source transmittance at angle_deg (image fidelity)"),
+        "angle_deg": Value("float", default=20.0, exclusive_minimum=0.0, maximum=180.0),
+        "slope": Value("float", default=3.0, minimum=0.0, maximum=20.0, doc="PST falls as the angle to this power"),
+        "pixel_um": Value("float", default=5.5, exclusive_minimum=0.0, maximum=100.0),
+        "qe": Value("float", default=0.6, exclusive_minimum=0.0, maximum=1.0),
+        "earth_albedo": Value("float", default=0.3, minimum=0.0, maximum=1.0, doc="the Earth's Bond albedo"),
+    }, doc="the sunlit Earth's light through the baffle (navsim.sensors.stray_light), image fidelity"),
 })
+
+#: The particle flux of the orbit and what a hit leaves in a detector (navsim.orbit.radiation,
+#: navsim.sensors.radiation_hits): image fidelity.
+RADIATION = Table({
+    "background_per_cm2_s": Value("float", default=3.0, minimum=0.0, maximum=1e7),
+    "saa_peak_per_cm2_s": Value("float", default=1000.0, minimum=0.0, maximum=1e7),
+    "saa_lat_deg": Value("float", default=-26.0, minimum=-90.0, maximum=90.0),
+    "saa_lon_deg": Value("float", default=-50.0, minimum=-360.0, maximum=360.0),
+    "saa_lat_width_deg": Value("float", default=12.0, exclusive_minimum=0.0, maximum=90.0),
+    "saa_lon_width_deg": Value("float", default=25.0, exclusive_minimum=0.0, maximum=180.0),
+    "saa_height_km": Value("float", default=550.0, exclusive_minimum=0.0, maximum=1e5),
+    "saa_height_exponent": Value("float", default=2.0, minimum=-10.0, maximum=10.0),
+    "horn_peak_per_cm2_s": Value("float", default=100.0, minimum=0.0, maximum=1e7),
+    "horn_lat_deg": Value("float", default=65.0, minimum=0.0, maximum=90.0),
+    "horn_width_deg": Value("float", default=5.0, exclusive_minimum=0.0, maximum=90.0),
+    "thickness_um": Value("float", default=10.0, exclusive_minimum=0.0, maximum=1000.0,
+                          doc="the detector's sensitive layer"),
+    "electrons_per_um": Value("float", default=300.0, exclusive_minimum=0.0, maximum=1e6),
+    "spread": Value("float", default=0.5, minimum=0.0, maximum=3.0, doc="σ of the log-normal charge spread"),
+}, optional=True, doc="particle hits in the heads' frames (image fidelity)")
 
 SCHEMA = Table({
     "name": Value("str"),
@@ -143,6 +172,7 @@ SCHEMA = Table({
     "gyro": Table({"preset": GYRO_ERRORS["preset"], "rate_hz": Value("float", exclusive_minimum=0.0, maximum=1e4), **GYRO_ERRORS}),
     "star_sensor": ListOfTables(HEAD, required=True, min_length=1, doc="the heads, [[star_sensor]] each"),
     "filter": ATTITUDE_SCHEMA.entries["filter"],
+    "radiation": RADIATION,
 })
 
 
@@ -158,6 +188,8 @@ def validate(data, source="<scenario>"):
     _check_pointing(checked["pointing"], checked["duration_s"], source)
     _check_heads(checked, source)
     _check_rates(checked, source)
+    if checked.get("radiation") is not None and checked["star_sensor"][0]["fidelity"] != "image":
+        raise InputError(f"{source}: radiation: particle hits act on frames: the heads need fidelity = 'image'")
     checked["epoch_jyear"] = julian_year(checked["epoch_utc"])
     if checked["settle_s"] is None:
         checked["settle_s"] = 0.1 * checked["duration_s"]
@@ -282,12 +314,14 @@ def _check_heads(checked, source):
             check_faults(head["faults"], head["fidelity"], source)
         except InputError as error:
             raise InputError(str(error).replace("star_sensor.", f"{where}.").replace("faults.", f"{where}.faults.")) from None
-        if head["fidelity"] != "vector":
-            raise InputError(f"{source}: {where}.fidelity: a spacecraft's heads run at vector fidelity")
-        for key in ("measurement", "rate_hz"):
+        for kind in ("gyro_bias_steps", "attitude_jumps", "tracking_failure_probes"):
+            if head["faults"].get(kind):
+                raise InputError(f"{source}: {where}.faults.{kind}: not a head's fault (a head takes outages, dropped "
+                                 "frames and false-star storms)")
+        for key in ("fidelity", "measurement", "rate_hz"):
             if head[key] != heads[0][key]:
                 raise InputError(f"{source}: {where}.{key}: {head[key]!r}, but star_sensor[0].{key} is {heads[0][key]!r}: "
-                                 "the heads share one kind of measurement and one frame clock")
+                                 "the heads share one fidelity, one kind of measurement and one frame clock")
         head["name"] = head["name"] or f"head {k + 1}"
     names = [head["name"] for head in heads]
     if len(set(names)) != len(names):

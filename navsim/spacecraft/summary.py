@@ -6,6 +6,7 @@ import numpy as np
 from navsim.attitude.run import NEES_DOF
 from navsim.estimation.consistency import nees_statistics
 from navsim.orbit.eclipse import PENUMBRA, UMBRA
+from navsim.sensors.star_sensor import MODES
 from navsim.spacecraft.exclusion import REASONS
 from navsim.spacecraft.records import RunSummary
 from startrack import rotation as rot
@@ -40,6 +41,8 @@ def heads_summary(prepared, series, sensor_run, filt, steady):
                  "measurements_per_frame": float(np.mean(counts)),
                  "cross_boresight_rms_arcsec": _rms(cross) / ARCSEC, "roll_rms_arcsec": _rms(roll) / ARCSEC}
         entry["roll_to_cross_boresight"] = entry["roll_rms_arcsec"] / entry["cross_boresight_rms_arcsec"]
+        if "head_mode" in series:
+            entry["image"] = image_summary(series, h, sky.reason >= 0)
         if mount is not None and filt.config.mountings[h] != "ignore":
             span = slice(mount.start + 3 * h, mount.start + 3 * h + 3)
             nominal = rot.conjugate(prepared.q_BS[h])
@@ -51,6 +54,18 @@ def heads_summary(prepared, series, sensor_run, filt, steady):
                                         "normalised_error": [float(v) for v in (estimate - true) / sigma]}
         out.append(entry)
     return out
+
+
+def image_summary(series, h, excluded):
+    """Head ``h``'s image chain over the run: frames per mode, identified stars per frame, the particle hits (frames
+    with hits, and those of them the head took no star from though the sky let it), the wrong identifications."""
+    mode, identified, hits = series["head_mode"][:, h], series["head_identified"][:, h], series["head_hits"][:, h]
+    hit = hits > 0
+    return {"frames_per_mode": {name: int(np.sum(mode == code)) for code, name in enumerate(MODES) if np.any(mode == code)},
+            "identified_per_frame": float(np.mean(identified)), "hits": int(hits.sum()), "frames_with_hits": int(hit.sum()),
+            "frames_lost_with_hits": int(np.sum(hit & (identified == 0) & ~excluded)),
+            "frames_lost_without_hits": int(np.sum(~hit & (identified == 0) & ~excluded)),
+            "wrong_identifications": int(series["head_wrong"][:, h].sum())}
 
 
 def orbit_summary(prepared, series):

@@ -140,15 +140,19 @@ class FrameTruth:
 @dataclass(frozen=True)
 class TruthRecord:
     """The truth on the gyro grid: times t (M+1,) [s], attitude q_IB (M+1, 4) and the mean body rate
-    of each gyro interval omega_mean (M, 3) [rad/s] (what an ideal rate-integrating gyro reports)."""
+    of each gyro interval omega_mean (M, 3) [rad/s] (what an ideal rate-integrating gyro reports); for a
+    spacecraft, the barycentric velocity ``v_I`` (F, 3) [m/s] at its frames, one every ``frame_ratio`` samples."""
 
     t: np.ndarray
     q_IB: np.ndarray
     omega_mean: np.ndarray
+    v_I: np.ndarray | None = None
+    frame_ratio: int = 1
 
     def at(self, k):
         """The :class:`FrameTruth` of the frame that closes gyro interval k (sample k)."""
-        return FrameTruth(q_IB=self.q_IB[k], omega_B=self.omega_mean[k - 1])
+        v_I = None if self.v_I is None else self.v_I[k // self.frame_ratio - 1]
+        return FrameTruth(q_IB=self.q_IB[k], omega_B=self.omega_mean[k - 1], v_I=v_I)
 
 
 def sample_truth(profile, q0, n_gyro, gyro_hz, factor):
