@@ -72,4 +72,4 @@ lock: $(UV)
 	$(LOCK) requirements/bootstrap.in -o requirements/bootstrap.txt
 
 clean:
-	rm -rf $(VENV) .cache .pytest_cache .hypothesis reports/out benchmarks/.venv-cedar benchmarks/.venv-tetra3rs benchmarks/work
+	rm -rf $(VENV) .cache .pytest_cache .hypothesis reports/out benchmarks/.venv-cedar benchmarks/.venv-tetra3rs benchmarks/.venv-basilisk benchmarks/work
