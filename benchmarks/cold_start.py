@@ -6,7 +6,7 @@ directory; the built tables stay cached):
 - every compile-ahead task of an image-fidelity attitude run (``navsim.attitude.run.IMAGE_LANES``) alone: wall
   and CPU seconds -- their sum is about what one process compiling at first call pays (a kernel two tasks
   share counted in each; the set-up before
-  ``startrack.precompile``);
+  ``startrack.compiled.compile_ahead``);
 - the lanes at once (``compile_ahead``: the first here, the other spawned), wall;
 - then, on those kernels, the demo (``navsim run scenarios/demo.toml --report``) as ``make demo`` runs it, and
   the same demo once more (everything loaded).
@@ -62,7 +62,7 @@ def measure(work):
             wall, cpu = _timed(_task(task), env)
             tasks[task] = {"wall_s": wall, "cpu_s": cpu}
     env["NUMBA_CACHE_DIR"] = str(work / "lanes")
-    lanes = f"from startrack.precompile import compile_ahead; compile_ahead({ATTITUDE_IMAGE!r})"
+    lanes = f"from startrack.compiled.compile_ahead import compile_ahead; compile_ahead({ATTITUDE_IMAGE!r})"
     lanes_wall, lanes_cpu = _timed([sys.executable, "-c", lanes], env)
     demo_wall, _ = _timed(_demo(work / "demo"), env)
     again_wall, _ = _timed(_demo(work / "demo_again"), env)

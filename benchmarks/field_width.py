@@ -4,9 +4,9 @@ solved blind by the plate solver.
 Wide set: ``--frames`` frames per lens, 1024 x 768 and 1600 x 1067 px, field across the width uniform in
 60-120 deg, the fisheye lenses of the equidistant model with radial terms (equidistant k = 0, equisolid
 k1 = -1/24, k2 = 1/1920; stereographic k1 = 1/12, k2 = 1/120; each k1 jittered by +-0.02), rendered from the
-Hipparcos-2 stars to V 8.5 (``startrack.synthetic.rendered_sky``), detected as ``startrack solve`` does and
+Hipparcos-2 stars to V 8.5 (``startrack.image.synthetic.rendered_sky``), detected as ``startrack solve`` does and
 solved with the default search (no field of view given).  Narrow set: pinhole frames of 2-5 deg (|k1| <=
-0.1), 1024 x 768 px, rendered from the Gaia DR3 sky to G 10 (``startrack.gaia_catalog``: the stars a real
+0.1), 1024 x 768 px, rendered from the Gaia DR3 sky to G 10 (``startrack.catalog.gaia``: the stars a real
 narrow frame shows, not only Hipparcos's) in a 2 s exposure (a telephoto lens or small telescope: the
 default sensor's 0.1 s sees to V ~ 8, this one to V ~ 10.5) and solved with the default search too.
 
@@ -36,7 +36,7 @@ NARROW_EXPOSURE_S = 2.0
 def _centre_error(result, camera, q_IS):
     """Angle [rad] between the solved and the true direction of the image centre."""
     centre = [[(camera.width - 1) / 2.0, (camera.height - 1) / 2.0]]
-    from startrack.rotation import to_matrix
+    from startrack.geometry.rotation import to_matrix
 
     truth = to_matrix(q_IS) @ camera.unproject(centre)[0]
     solved = to_matrix(result.q_IS) @ result.camera.unproject(centre)[0]
@@ -44,7 +44,7 @@ def _centre_error(result, camera, q_IS):
 
 
 def _solve(solver, sky, fov_hint=None):
-    from startrack.detection import detect
+    from startrack.image.detection import detect
 
     found = detect(sky.image, mesh_px=64, saturation_dn=sky.full_scale, reject_single_pixels=True, reject_extended=True)
     sigma = np.hypot(found.sigma_u, found.sigma_v) / math.sqrt(2.0)
@@ -62,8 +62,8 @@ def _outcome(result, camera, q_IS):
 
 
 def _frames_wide(rng, n):
-    from startrack.camera import Camera
-    from startrack.units import DEG
+    from startrack.base.units import DEG
+    from startrack.camera.model import Camera
 
     for lens, (k1, k2) in LENSES.items():
         for _ in range(n):
@@ -74,8 +74,8 @@ def _frames_wide(rng, n):
 
 
 def _frames_narrow(rng, n):
-    from startrack.camera import Camera
-    from startrack.units import DEG
+    from startrack.base.units import DEG
+    from startrack.camera.model import Camera
 
     for _ in range(n):
         fov = float(rng.uniform(2.0, 5.0))
@@ -83,7 +83,7 @@ def _frames_narrow(rng, n):
 
 
 def run_set(name, frames, stars, solver, rng, sensor=None):
-    from startrack.synthetic import rendered_sky
+    from startrack.image.synthetic import rendered_sky
 
     rows = []
     for lens, fov, camera in frames:
@@ -118,8 +118,8 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--only", choices=("wide", "narrow"))
     args = parser.parse_args()
+    from startrack.catalog.hipparcos import load_star_catalog
     from startrack.identify.plate_solver import PlateSolver
-    from startrack.star_catalog import load_star_catalog
 
     wide_rng, narrow_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(args.seed).spawn(2))
     rows, solver = [], PlateSolver(progress=True)  # the default search, 2-160 deg
@@ -127,8 +127,8 @@ def main():
         rows += run_set("wide", _frames_wide(wide_rng, args.frames), load_star_catalog(2000.0).brighter_than(8.5),
                         solver, wide_rng)
     if args.only in (None, "narrow"):
-        from startrack.gaia_catalog import load_gaia_catalog
-        from startrack.render import SensorModel
+        from startrack.catalog.gaia import load_gaia_catalog
+        from startrack.image.render import SensorModel
 
         rows += run_set("narrow", _frames_narrow(narrow_rng, args.frames), load_gaia_catalog(2000.0),
                         solver, narrow_rng,

@@ -1,8 +1,8 @@
-"""startrack's FITS WCS (TAN-SIP, startrack.wcs) read by astrometry.net's own tools, against the camera model.
+"""startrack's FITS WCS (TAN-SIP, startrack.camera.wcs) read by astrometry.net's own tools, against the camera model.
 
 For cameras from a pinhole to a 40 deg barrel lens and four attitudes (two at the celestial poles), the
 solution's header is written as a ``.wcs`` file; astrometry.net's ``wcs-xy2rd`` maps 500 random pixels
-to RA/Dec, compared with startrack's camera model (:meth:`startrack.camera.Camera.unproject`), and
+to RA/Dec, compared with startrack's camera model (:meth:`startrack.camera.model.Camera.unproject`), and
 ``wcs-rd2xy`` maps those directions back to pixels.  astrometry.net comes from the Debian package
 ``astrometry.net`` (``apt-get install astrometry.net``); without it the script says so and writes nothing.
 Measures, never asserts.
@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 from astropy.io import fits
 
-from startrack.camera import Camera
-from startrack.rotation import from_rotation_vector, to_matrix
-from startrack.sphere import vector_to_radec
-from startrack.units import DEG
-from startrack.wcs import frame_wcs
+from startrack.base.units import DEG
+from startrack.camera.model import Camera
+from startrack.camera.wcs import frame_wcs
+from startrack.geometry.rotation import from_rotation_vector, to_matrix
+from startrack.geometry.sphere import vector_to_radec
 
 HERE = Path(__file__).resolve().parent
 CAMERAS = {"pinhole 12 deg": (12.0, 0.0, 0.0), "pincushion 20 deg": (20.0, 0.05, 0.0),

@@ -2,27 +2,27 @@
 package (Source Extractor).
 
 Speed. Frames: 1024 x 1024 px, 20 deg field, Hipparcos-2 stars to V = 6.5 at seeded random attitudes,
-default :class:`~startrack.render.SensorModel` (0.671 px PSF, 12-bit ADC, b ~ 101 DN, sigma_n ~ 10 DN),
+default :class:`~startrack.image.render.SensorModel` (0.671 px PSF, 12-bit ADC, b ~ 101 DN, sigma_n ~ 10 DN),
 100 ms exposure, body rate 0.5 deg/s (smear ~2.5 px).  Measured per frame (median ms): render; detect +
 centroid (background estimated from the frame, and given); the position fit at the bound
-(:mod:`startrack.psf_fit`) of the 12 brightest unsaturated stars (what a frame fuses: the scenario's
+(:mod:`startrack.image.psf_fit`) of the 12 brightest unsaturated stars (what a frame fuses: the scenario's
 ``max_identified_stars``); window mode (8 windows of 11 x 11: render + detect + fit).  Centroid error: RMS
 distance to the true (track-averaged) centroid of the matched stars that are neither saturated nor on the
 edge.  ``sep`` (if importable) runs on the same frames: sep.Background + sep.extract at 5 sigma (isophotal
 barycentre x, y), and sep.extract with the known background.
 
 Accuracy against the bound (``accuracy``). 256 x 256 frames of 16 stars on a grid at random sub-pixel
-phases, rendered by :mod:`startrack.render` with a 16-bit sensor (gain 20 e-/DN, full well 2e6 e-: no star
+phases, rendered by :mod:`startrack.image.render` with a 16-bit sensor (gain 20 e-/DN, full well 2e6 e-: no star
 saturates up to SNR 1000; 0.671 px PSF, read noise 20 e-, dark 2 e- per pixel), each star's smear |Δ| 0, 2,
 5 or 10 px in a random direction. The charge of each star is log-uniform from SNR 5 to 1000 by either
 definition of the SNR: 004's (eq. 1: the noise-free peak above the background over σ_n, as
-:func:`startrack.detection.detect` reports it) and the flux SNR N/σ_N (the bound on the flux); both
+:func:`startrack.image.detection.detect` reports it) and the flux SNR N/σ_N (the bound on the flux); both
 tables are written. Per (SNR, smear) bin: the RMS error of each estimator over the RMS of the
 bound at the true positions (both axes pooled; 1 is the bound); for the estimators that give a σ, the
 variance of the normalised errors e/σ (1 for an honest σ) and the share beyond 3σ (0.27 % for a Gaussian).
-Estimators: the fit of eq. (1)-(2) of startrack.psf_fit started from the detection where one was found,
+Estimators: the fit of eq. (1)-(2) of startrack.image.psf_fit started from the detection where one was found,
 and from a prediction 0.3 px off (a tracking window) for every star; the thresholded centroid of
-:func:`startrack.detection.detect` with its σ; sep's isophotal barycentre with its errx2/erry2, and
+:func:`startrack.image.detection.detect` with its σ; sep's isophotal barycentre with its errx2/erry2, and
 sep.winpos (windowed centroid, σ_w = √(σ² + |Δ|²/12)) from the detection.
 
 Writes benchmarks/results/image_chain.json; asserts nothing.
@@ -40,12 +40,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from startrack.camera import Camera
-from startrack.detection import detect, detect_windows
-from startrack.psf_fit import PixelNoise, centroid_bound, fit_stars, information, track_offsets
-from startrack.render import SensorModel, Sources, Windows, expected_charge, render, render_star_field, star_sources
-from startrack.star_catalog import load_star_catalog
-from startrack.units import DEG
+from startrack.base.units import DEG
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.image.detection import detect, detect_windows
+from startrack.image.psf_fit import PixelNoise, centroid_bound, fit_stars, information, track_offsets
+from startrack.image.render import SensorModel, Sources, Windows, expected_charge, render, render_star_field, star_sources
 
 N_FRAMES = 20
 REPEATS = 5

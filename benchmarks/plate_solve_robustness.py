@@ -53,9 +53,9 @@ import sky_impairments as sky  # noqa: E402
 from astrometry_net import solve as astrometry_solve  # noqa: E402
 from astrometry_net import unavailable as astrometry_unavailable  # noqa: E402
 
+from startrack.base.units import ARCSEC, DEG  # noqa: E402
 from startrack.commands.detect import detect_frame  # noqa: E402
-from startrack.image_io import Frame  # noqa: E402
-from startrack.units import ARCSEC, DEG  # noqa: E402
+from startrack.image.files import Frame  # noqa: E402
 
 CATALOG_MAG = 9.0
 PEER_MAG = 8.0
@@ -98,7 +98,7 @@ def all_frames(args, names):
               for j in range(len(sky.IMPAIRMENTS[name].levels)) for k in range(args.frames)]
     missing = [w for w in wanted if f"{w[0]}-{w[1]}-{w[2]:03d}" not in frames]
     if missing:
-        from startrack.star_catalog import load_star_catalog
+        from startrack.catalog.hipparcos import load_star_catalog
 
         stars = load_star_catalog(2000.0).brighter_than(CATALOG_MAG)
         with open(path, "a") as stream:

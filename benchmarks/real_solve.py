@@ -6,17 +6,17 @@ solvers as the same centroids, brightest first, with the image size and nothing 
 
 * real: the eight ESA frames of ``../shared/realsky/`` (tetra3's test data, 11.4 deg; truth: cedar-solve's
   own no-FOV solutions in reference.json, whose Alt40_Azi45 attitude is ~90" off);
-* synthetic: frames rendered by :func:`startrack.synthetic.rendered_sky` (1024 x 768, field of
+* synthetic: frames rendered by :func:`startrack.image.synthetic.rendered_sky` (1024 x 768, field of
   view uniform in 8-30 deg, radial distortion k1 uniform in +-0.2, Hipparcos-2 stars V <= 8.5);
 * jpeg: rendered frames (10-33 deg) scaled to 8 bits and JPEG-compressed at quality 60-95
-  (:func:`~startrack.synthetic.as_jpeg`), the block noise of an ordinary camera's JPEG;
-* crowd: 1000-5000 false detections (uniform or clustered, :func:`~startrack.synthetic.noise_crowd`)
+  (:func:`~startrack.image.synthetic.as_jpeg`), the block noise of an ordinary camera's JPEG;
+* crowd: 1000-5000 false detections (uniform or clustered, :func:`~startrack.image.synthetic.noise_crowd`)
   on a 33 deg frame, alone (nothing must be answered) or with the 150 brightest stars of the field.
 
 Scores, per solver and set: success = answered and the pointing of the image centre within 60" of the
 truth (real: 120", the reference's own error on one frame); wrong = answered with the pointing more
 than 0.1 deg off (or, for a crowd without stars, answered at all); the field-of-view error of the
-successes (cedar's FOV and startrack's :attr:`~startrack.camera.Camera.angular_width`, both the angle
+successes (cedar's FOV and startrack's :attr:`~startrack.camera.model.Camera.angular_width`, both the angle
 the width subtends); solve ms = wall time of the solver call alone (centroids in, answer out),
 median / p95 / max.  cedar-solve runs in its own venv (``sh benchmarks/peers/setup_venvs.sh``) with its
 database for 8-30 deg, V <= 8 built once from the same Hipparcos-2 stars (``generate_database`` at its
@@ -58,11 +58,11 @@ ROOT = HERE.parent
 REALSKY = ROOT.parent / "shared" / "realsky"
 sys.path.insert(0, str(HERE))
 
-from startrack.attitude_angles import matrix_from_radec_roll  # noqa: E402
-from startrack.camera import Camera  # noqa: E402
+from startrack.base.units import ARCSEC, DEG  # noqa: E402
+from startrack.camera.model import Camera  # noqa: E402
 from startrack.commands.detect import detect_frame  # noqa: E402
-from startrack.image_io import Frame, read_frame  # noqa: E402
-from startrack.units import ARCSEC, DEG  # noqa: E402
+from startrack.geometry.attitude_angles import matrix_from_radec_roll  # noqa: E402
+from startrack.image.files import Frame, read_frame  # noqa: E402
 
 WIDTH, HEIGHT = 1024, 768
 SUCCESS_ANGLE = {"real": 120.0 * ARCSEC}
@@ -103,8 +103,8 @@ def real_frames():
 
 def synthetic_frames(n, seed, jpeg):
     """``n`` rendered frames (8-30 deg, |k1| <= 0.2), or JPEG-compressed ones (10-33 deg), detected."""
-    from startrack.star_catalog import load_star_catalog
-    from startrack.synthetic import as_jpeg, rendered_sky
+    from startrack.catalog.hipparcos import load_star_catalog
+    from startrack.image.synthetic import as_jpeg, rendered_sky
 
     stars = load_star_catalog(2000.0).brighter_than(8.5)
     frames = []
@@ -123,8 +123,8 @@ def synthetic_frames(n, seed, jpeg):
 
 def crowd_frames(n, seed):
     """``n`` crowds of 1000-5000 false detections on a 33 deg frame, every other one with its 150 brightest stars."""
-    from startrack.star_catalog import load_star_catalog
-    from startrack.synthetic import noise_crowd, random_attitude
+    from startrack.catalog.hipparcos import load_star_catalog
+    from startrack.image.synthetic import noise_crowd, random_attitude
 
     stars = load_star_catalog(2000.0).brighter_than(8.0)
     camera = Camera.from_fov(33.0 * DEG, WIDTH, HEIGHT)
@@ -326,13 +326,13 @@ def stream_latency(image, frames=200):
     on stdin, from the line written to the answer read) beside the same detection and solve called in this
     process, interleaved frame by frame (``frames`` pairs after one warm-up each, so that the machine's
     drifts fall on both alike): medians and the median of the pairs' differences, the stream's own cost."""
-    from startrack.cli import build_parser
+    from startrack.commands import build_parser
     from startrack.commands.detect import detection_options
-    from startrack.commands.solve import _frame_solver
+    from startrack.commands.solve import frame_solver
     from startrack.commands.solve_input import image_frame
 
     args = build_parser().parse_args(["solve", str(image)])
-    solver, options = _frame_solver(args), detection_options(args)
+    solver, options = frame_solver(args), detection_options(args)
     command = [str(Path(sys.executable).parent / "startrack"), "solve", "--batch", "-", "--json"]
     stream = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
 

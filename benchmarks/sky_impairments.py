@@ -2,12 +2,12 @@
 
 A *scene* is a camera (1024 x 768, field of view across the width uniform in the benchmark's range,
 Brown radial distortion k1 uniform in +-0.1, principal point at the centre), a uniformly random
-attitude and a sensor (:class:`startrack.render.SensorModel`, 0.2 s) under a faint uniform sky of
+attitude and a sensor (:class:`startrack.image.render.SensorModel`, 0.2 s) under a faint uniform sky of
 200 e-/px/s.  Frame k of every bin is the same scene (paired comparison between levels); each impairment
 draws from its own stream ``SeedSequence([seed, k, impairment, level])``.
 
 Pixel impairments change the exposure before the noise (:func:`expose`): the noise-free star charge
-(:func:`startrack.render.expected_charge`) times a transmission map (cloud, trees), plus a sky map
+(:func:`startrack.image.render.expected_charge`) times a transmission map (cloud, trees), plus a sky map
 (light pollution, moonlight, cloud glow) and extra charge (streaks); hot pixels and defocus through
 the sensor model; JPEG after it.  Centroid impairments change the detected list (positions, fluxes,
 false stars).  The units of each level are in :data:`IMPAIRMENTS`.
@@ -21,10 +21,10 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from startrack.camera import Camera
-from startrack.render import SensorModel, expected_charge, star_sources
-from startrack.synthetic import as_jpeg, random_attitude
-from startrack.units import DEG
+from startrack.base.units import DEG
+from startrack.camera.model import Camera
+from startrack.image.render import SensorModel, expected_charge, star_sources
+from startrack.image.synthetic import as_jpeg, random_attitude
 
 WIDTH, HEIGHT = 1024, 768
 #: The night sky of every scene [e-/px/s]: faint, but trees are darker.
@@ -67,7 +67,7 @@ def exposure_of(scene_):
 
 
 def expose(scene_, stars, exposure, rng):
-    """(image, full scale) of the scene's stars through ``exposure`` (noise model of startrack.render)."""
+    """(image, full scale) of the scene's stars through ``exposure`` (noise model of startrack.image.render)."""
     sensor, camera = exposure.sensor, scene_.camera
     sources, _ = star_sources(camera, sensor, scene_.q_IS, stars.vectors, stars.v_mag)
     charge = expected_charge(sensor, HEIGHT, WIDTH, (sources,)) * exposure.transmission + exposure.charge_e

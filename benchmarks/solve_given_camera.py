@@ -36,8 +36,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from startrack.star_catalog import load_star_catalog  # noqa: E402
-from startrack.units import ARCSEC  # noqa: E402
+from startrack.base.units import ARCSEC  # noqa: E402
+from startrack.catalog.hipparcos import load_star_catalog  # noqa: E402
 from tests.pinhole_frames import Pinhole, attitude_error, make_frame, pixel_crb  # noqa: E402
 
 
@@ -83,7 +83,7 @@ def run_cli(batch, extra, sigma):
 
 
 def run_layer(camera, sigma, frames):
-    from startrack.camera import Camera
+    from startrack.camera.model import Camera
     from startrack.identify.calibrated import CalibratedSolver
 
     solver = CalibratedSolver(Camera.from_fov(np.radians(camera.fov_deg), camera.width, camera.height),

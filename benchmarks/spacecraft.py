@@ -48,8 +48,8 @@ from navsim.estimation.consistency import nees_statistics
 from navsim.kinds import resolve_scenario
 from navsim.orbit.elements import J2
 from navsim.spacecraft import build
-from startrack import rotation as rot
-from startrack.units import ARCSEC, DEG, HOUR
+from startrack.base.units import ARCSEC, DEG, HOUR
+from startrack.geometry import rotation as rot
 
 BASILISK = {"python": HERE / ".venv-basilisk" / "bin" / "python", "runner": HERE / "peers" / "basilisk_runner.py"}
 ARW_DEG_PER_SQRT_H, RRW_DEG_PER_H_PER_SQRT_H, BIAS_DEG_PER_H = 0.002, 0.0002, 0.01

@@ -65,8 +65,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import star_id_frames as sif  # noqa: E402
-from startrack.star_catalog import load_star_catalog  # noqa: E402
-from startrack.units import ARCSEC  # noqa: E402
+
+from startrack.base.units import ARCSEC  # noqa: E402
+from startrack.catalog.hipparcos import load_star_catalog  # noqa: E402
 
 FALSE_MATCH_ANGLE = 60.0 * ARCSEC  # 1 arcmin
 CRB_DRAWS_PER_FRAME = 200
@@ -120,7 +121,7 @@ def write_hip_main(path, stars):
 
     Fields 1-14 of the I/239 ReadMe are written, the ones cedar-solve's loader reads being HIP
     (2), Vmag (6), RAdeg (9), DEdeg (10), pmRA (13) and pmDE (14): positions at the catalog's epoch,
-    proper motions 0.00 (already applied), V of :mod:`startrack.star_catalog`.
+    proper motions 0.00 (already applied), V of :mod:`startrack.catalog.hipparcos`.
     """
     ra_deg, dec_deg = np.degrees(stars.ra), np.degrees(stars.dec)
     lines = []

@@ -2,11 +2,11 @@
 
 Sensor (issue 6, "Benchmark against peers"): ideal pinhole, 16 deg across a 1024 x 1024 image
 (rectangular field, principal point at the image centre), stars with V <= 6.0 from Hipparcos-2
-propagated to J2000.0 (:func:`startrack.star_catalog.load_star_catalog`), centroid noise 0.1 px
+propagated to J2000.0 (:func:`startrack.catalog.hipparcos.load_star_catalog`), centroid noise 0.1 px
 per axis (Gaussian, independent).
 
 Per frame: a uniformly random attitude q_IS; every catalogue star whose image falls on the sensor
-is projected (:class:`startrack.camera.Camera`).  Star images closer than ``BLEND_RADIUS_PX``
+is projected (:class:`startrack.camera.model.Camera`).  Star images closer than ``BLEND_RADIUS_PX``
 merge into one centroid (a real centroider cannot split them; Hipparcos has ~30 such pairs with
 V <= 6, e.g. alpha Centauri A/B): flux-weighted mean position, summed flux, truth HIP of the
 brightest member, the other members listed in ``blend_hip``.  Then Gaussian noise is added to
@@ -42,11 +42,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from startrack.attitude_angles import radec_roll_from_quaternion
-from startrack.camera import Camera
-from startrack.star_catalog import StarCatalog, load_star_catalog
-from startrack.units import DEG
-
+from startrack.base.units import DEG
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import StarCatalog, load_star_catalog
+from startrack.geometry.attitude_angles import radec_roll_from_quaternion
 
 FOV_DEG = 16.0
 WIDTH_PX = 1024

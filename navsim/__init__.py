@@ -15,7 +15,7 @@ package of its own behind one registry (:mod:`navsim.kinds`) and one front door
 PDF reports live in :mod:`navsim.report` (not imported here: it loads matplotlib and typst).
 """
 
-from startrack.lazy import lazy_exports
+from startrack import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "navsim.campaign.montecarlo": ("run_campaign",),

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.estimation.consistency import mean_square_band
-from startrack.errors import InputError
+from startrack import InputError
 
 #: The format of a covariance analysis's ``summary.json`` and of a covariance budget's ``budget.json``.
 SUMMARY_FORMAT = "navsim.covariance-summary/1"

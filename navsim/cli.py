@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from navsim.places import check_output, publish
-from startrack.errors import ArgumentParser, InputError, run_command
+from startrack import ArgumentParser, InputError, run_command
 
 # Each command imports what it needs when it runs, so ``navsim --help`` starts at once.
 
@@ -37,7 +37,7 @@ def _print_summary(kind, summary, out):
 
 def _run(args):
     from navsim.kinds import STUDY, resolve_scenario
-    from startrack.paths import check_file
+    from startrack import check_file
 
     _check_seed(args.seed)
     scenario = resolve_scenario(args.scenario, args.set or ())
@@ -81,7 +81,7 @@ def _run_simulation(scenario, args):
 
 def _report(args):
     from navsim.report import write_report
-    from startrack.paths import check_file
+    from startrack import check_file
 
     check_file(args.output, "-o", (".pdf",))
     print(write_report(args.directory, args.output))
@@ -180,7 +180,7 @@ def _covariance(args):
     from navsim.kinds import resolve_scenario, run_kind
     from navsim.output import write_covariance
     from navsim.simulation import covariance
-    from startrack.paths import check_file
+    from startrack import check_file
 
     scenario = resolve_scenario(args.scenario, args.set or ())
     run_kind(scenario, "a covariance analysis")  # a static study has none: one clear line now
@@ -206,7 +206,7 @@ def _covariance(args):
 
 def _sky(args):
     from navsim.kinds import resolve_scenario, run_kind
-    from startrack.paths import check_file
+    from startrack import check_file
 
     scenario = resolve_scenario(args.scenario, args.set or ())
     if args.report:

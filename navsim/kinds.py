@@ -14,7 +14,7 @@ A **run kind** is a package providing (each name loaded on first use; :mod:`navs
     validate(data, source) -> dict                its schema and cross-key rules, derived defaults filled
     prepare(scenario, star_catalog, truth_off)    the seed-free part of a run (``.scenario`` on it)
     simulate(prepared, seed, compiled) -> RunResult
-    lanes(scenario)                               the kernels a run compiles ahead (startrack.precompile)
+    lanes(scenario)                               the kernels a run compiles ahead (startrack.compiled.compile_ahead)
     TRUTH_SOURCES, check_truth_off(scenario, names)   the error sources a run can switch off in its truth
     budget_parts(scenario), summarize_budget(...), budget_text(budget)   its error budget (InputError if none)
     check_tuning(scenario)                        an InputError when filter tuning cannot judge it
@@ -37,7 +37,7 @@ from pathlib import Path
 
 from navsim import attitude, navigation, spacecraft, studies
 from navsim.scenario import Scenario, apply_overrides, read_scenario_file
-from startrack.errors import InputError
+from startrack import InputError
 
 #: The names every run kind provides (module docstring).
 INTERFACE = ("NAME", "TABLE", "validate", "prepare", "simulate", "lanes", "TRUTH_SOURCES", "check_truth_off",

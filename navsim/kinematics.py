@@ -1,15 +1,15 @@
 """Quaternion kinematics (docs/design.md): ``q̇_IB = ½ q_IB ⊗ [ω_B, 0]``, the ``q̇ = ½ Ω(ω) q`` of
 eq. 9 of 000, its RK4 integration and the boresight of eq. 10 of 000.
 
-The rotation helpers (product, conjugate, rotation vectors, matrices) are :mod:`startrack.rotation`;
+The rotation helpers (product, conjugate, rotation vectors, matrices) are :mod:`startrack.geometry.rotation`;
 the compiled per-step twin of this module is :mod:`navsim.kinematics_jit`. Arrays carry a leading
 batch shape ``(..., 4)`` / ``(..., 3)``.
 """
 
 import numpy as np
 
-from startrack.rotation import from_rotation_vector, multiply, rotate, skew
-from startrack.sphere import vector_to_radec
+from startrack import rotation as rot
+from startrack import vector_to_radec
 
 
 def omega_matrix(omega):
@@ -21,7 +21,7 @@ def omega_matrix(omega):
     omega = np.asarray(omega, dtype=float)
     shape = omega.shape[:-1]
     out = np.zeros(shape + (4, 4))
-    out[..., :3, :3] = -skew(omega)
+    out[..., :3, :3] = -rot.skew(omega)
     out[..., :3, 3] = omega
     out[..., 3, :3] = -omega
     return out
@@ -61,7 +61,7 @@ def rk4_step(q, omega_start, omega_mid, omega_end, dt):
 
 def propagate_constant_rate(q, omega, dt):
     """Exact propagation under a constant body rate: ``q ⊗ exp(ω dt / 2)``."""
-    return multiply(q, from_rotation_vector(np.asarray(omega, dtype=float) * dt))
+    return rot.multiply(q, rot.from_rotation_vector(np.asarray(omega, dtype=float) * dt))
 
 
 def boresight_radec(q_IB, R_BS=None):
@@ -73,5 +73,5 @@ def boresight_radec(q_IB, R_BS=None):
     """
     q_IB = np.asarray(q_IB, dtype=float)
     axis_B = np.array([0.0, 0.0, 1.0]) if R_BS is None else np.asarray(R_BS, dtype=float)[:, 2]
-    b = rotate(q_IB, np.broadcast_to(axis_B, q_IB.shape[:-1] + (3,)))
+    b = rot.rotate(q_IB, np.broadcast_to(axis_B, q_IB.shape[:-1] + (3,)))
     return vector_to_radec(b)

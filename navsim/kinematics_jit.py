@@ -3,7 +3,7 @@ for the compiled filter and truth loops. Tested equal to the vectorised function
 
 import numpy as np
 
-from startrack.jit import njit
+from startrack import njit
 
 
 @njit

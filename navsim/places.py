@@ -15,8 +15,7 @@ import os
 import shutil
 from pathlib import Path
 
-from startrack.errors import InputError
-from startrack.paths import probe_directory
+from startrack import InputError, probe_directory
 
 MARKER = "navsim-output.json"
 KINDS = ("run", "study", "campaign", "budget", "covariance", "sweep")

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
 
-from startrack.errors import InputError
+from startrack import InputError
 
 RUN_FORMAT = "navsim.run-summary/1"
 CAMPAIGN_FORMAT = "navsim.campaign-summary/1"

@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 from navsim import studies
 from navsim.kinds import KINDS, STUDY, resolve_scenario, run_kind
 from navsim.studies import STUDIES, StudyResult
-from startrack.errors import InputError
+from startrack import InputError
 
 
 def prepare(scenario, overrides=(), star_catalog=None, truth_off=frozenset()):

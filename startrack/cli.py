@@ -4,25 +4,10 @@ Bad input of any kind ends with one line ``startrack: error: ...`` and exit
 status 2; no traceback reaches the user.
 """
 
-import argparse
-import importlib
 import sys
 
-from startrack.errors import ArgumentParser, run_command
-
-#: Sub-command modules under ``startrack.commands``, in the order ``--help`` lists them.
-COMMANDS = ("catalog", "address", "render", "detect", "solve", "serve")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = ArgumentParser(
-        prog="startrack",
-        description="Star sensor: navigation catalog, rendering, centroiding, identification, attitude.",
-    )
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMANDS:
-        importlib.import_module(f"startrack.commands.{name}").register(subparsers)
-    return parser
+from startrack.base.errors import run_command
+from startrack.commands import build_parser
 
 
 def main(argv=None) -> int:

@@ -1,6 +1,6 @@
-"""Compile-ahead tasks of the tests of :mod:`startrack.precompile` (importable by its spawned lanes)."""
+"""Compile-ahead tasks of the tests of :mod:`startrack.compiled.compile_ahead` (importable by its spawned lanes)."""
 
-from startrack.jit import njit
+from startrack.compiled.numba_setup import njit
 
 
 @njit

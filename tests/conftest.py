@@ -24,16 +24,16 @@ def pytest_configure(config):
 @pytest.fixture(autouse=True, scope="session")
 def _kernels_compiled_ahead():
     """The kernels of the image chain, the plate solver and the INS compiled first, on both cores
-    (``startrack.precompile``), by the first worker to get here while the others wait (then find them
+    (``startrack.compiled.compile_ahead``), by the first worker to get here while the others wait (then find them
     compiled): no test's output depends on whether it is the first to need them, and the suite compiles
     them once, in about half the time of one core."""
     from navsim.attitude.run import IMAGE_LANES
     from navsim.navigation.run import VECTOR_LANES
-    from startrack.precompile import compile_ahead
+    from startrack.compiled.compile_ahead import compile_ahead
 
     with open(Path(os.environ["STARTRACK_CACHE_DIR"]) / "compile-ahead.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        compile_ahead((*IMAGE_LANES, ("startrack.identify.warmup:plate_solver",), *VECTOR_LANES))
+        compile_ahead((*IMAGE_LANES, ("startrack.compile_tasks:plate_solver",), *VECTOR_LANES))
     yield
 
 

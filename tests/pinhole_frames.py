@@ -1,6 +1,6 @@
 """Centroid frames of an ideal pinhole star camera, made without the project's camera, projection or
 identification helpers: numpy and scipy's Rotation on the Hipparcos-2 directions of
-:func:`startrack.star_catalog.load_star_catalog` (the catalog is the one thing shared with the solver).
+:func:`startrack.catalog.hipparcos.load_star_catalog` (the catalog is the one thing shared with the solver).
 
 Camera: ``fov_deg`` across the width of a ``width`` x ``height`` image, f = (W/2) / tan(fov/2) [px],
 principal point ((W-1)/2, (H-1)/2), u = cx + f x/z, v = cy + f y/z in the sensor frame S (+z boresight,

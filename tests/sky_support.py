@@ -4,7 +4,8 @@ stars of them and back, and the Sun's light deflection that skyfield applies and
 import erfa
 import numpy as np
 
-from startrack import sphere, units
+from startrack.base import units
+from startrack.geometry import sphere
 
 
 def random_directions(n, seed=0):

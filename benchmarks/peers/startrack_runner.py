@@ -1,8 +1,8 @@
 """Run startrack's star identifier on benchmark frames; runs in the project's own .venv.
 
-Catalog: the navigation catalog of 000 (:func:`startrack.navigation_catalog.load_navigation_catalog`)
+Catalog: the navigation catalog of 000 (:func:`startrack.catalog.navigation.load_navigation_catalog`)
 for V <= ``--mag``, the 16 deg field and the frames' epoch, other parameters at their defaults;
-built once and cached in :func:`startrack.cache.cache_dir`.  Identifier:
+built once and cached in :func:`startrack.base.cache_dir.cache_dir`.  Identifier:
 ``StarIdentifier(catalog, camera, centroid_sigma_px=...)`` with the benchmark's pinhole camera and
 its stated centroid noise, other options at their defaults.
 
@@ -19,9 +19,8 @@ import sys
 import time
 
 import numpy as np
-from scipy.spatial.transform import Rotation
-
 from runner_io import common_arguments, read_frames, run_frames, timed, write_meta
+from scipy.spatial.transform import Rotation
 
 NOT_IMPORTABLE = 3
 
@@ -34,12 +33,13 @@ def main():
     parser.add_argument("--methods", default="tracking,subcatalog", help="strategies for frames with a prior")
     args = parser.parse_args()
     try:
-        from startrack.identify.identifier import Prior, StarIdentifier
+        from startrack.identify.identifier import StarIdentifier
+        from startrack.identify.prior import Prior
     except ImportError as error:
         print(f"startrack identifier not importable: {error}", file=sys.stderr)
         return NOT_IMPORTABLE
-    from startrack.camera import Camera
-    from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
+    from startrack.camera.model import Camera
+    from startrack.catalog.navigation import NavigationCatalogParams, load_navigation_catalog
 
     fov = np.radians(args.fov_deg)
     camera = Camera.from_fov(fov, args.width, args.height)

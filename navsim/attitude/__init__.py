@@ -7,7 +7,7 @@ simulate, summarize), ``records`` (its run and campaign summaries), ``campaign``
 are the run-kind interface of :mod:`navsim.kinds`, each loaded on first use.
 """
 
-from startrack.lazy import lazy_exports
+from startrack import lazy_exports
 
 #: The kind's name, and the table that marks a scenario of it (None: a scenario no other kind claims).
 NAME, TABLE = "attitude", None

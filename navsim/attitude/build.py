@@ -9,9 +9,8 @@ from navsim.build.inertial import gyro_model
 from navsim.estimation.attitude_filter import AttitudeFilterConfig
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis
+from startrack import quaternion_from_radec_roll, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.attitude_angles import quaternion_from_radec_roll
 
 
 def initial_attitude(scenario):

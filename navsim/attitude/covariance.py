@@ -29,9 +29,8 @@ from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.star_sensor import isotropic_covariance
 from navsim.sensors.star_vector import AttitudeFixSensor
 from navsim.truth.profiles import sample_truth
+from startrack import load_star_catalog, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.star_catalog import load_star_catalog
 
 #: The error sources, in order, with their labels.
 COVARIANCE_SOURCES = {"initial": "filter's initial attitude error", "gyro_bias": "gyro bias (turn-on, random walk, instability)",

@@ -25,20 +25,18 @@ from navsim.records import RunResult
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.faults import apply_bias_steps
 from navsim.truth.profiles import sample_truth
+from startrack import InputError, load_star_catalog, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
 
 #: The attitude filter's NEES is over its attitude and gyro-bias errors.
 NEES_DOF = 6
-#: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity, balanced on two cores
+#: The lanes of a run compiled ahead (:mod:`startrack.compiled.compile_ahead`) at image fidelity, balanced on two cores
 #: (40-46 s each on the test machine, benchmarks/cold_start.py): the identifier's pattern searches and the
 #: position fit, against the inertial sensor, the filter and tracking (which loads what the first lane
 #: compiled before it gets there).
-IMAGE_LANES = (("startrack.identify.warmup:pattern_search", "startrack.warmup:psf_fit"),
+IMAGE_LANES = (("startrack.compile_tasks:pattern_search", "startrack.compile_tasks:psf_fit"),
                ("navsim.sensors.warmup:inertial_sensors", "navsim.estimation.warmup:attitude_filter",
-                "startrack.identify.warmup:star_tracking"))
+                "startrack.compile_tasks:star_tracking"))
 #: At vector fidelity: one lane (compiling ahead then only says what is compiled, once).
 VECTOR_LANES = (("navsim.sensors.warmup:inertial_sensors", "navsim.estimation.warmup:attitude_filter"),)
 #: The error sources a run can switch off in the truth alone: none (an error budget is the navigation kind's).

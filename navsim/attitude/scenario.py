@@ -1,7 +1,7 @@
 """The attitude kind's scenario (docs/design.md, "The attitude scenario"): a star sensor and a gyro on a
 truth attitude profile, no trajectory. Its strict schema (:data:`SCHEMA`: units in the key names, every
 value bounded) and cross-key rules (:func:`validate`); every problem is one
-:class:`~startrack.errors.InputError` naming the file, the key and what is wrong.
+:class:`~startrack.base.errors.InputError` naming the file, the key and what is wrong.
 """
 
 import numpy as np
@@ -11,7 +11,7 @@ from navsim.scenario import checked_table, only_chosen
 from navsim.scenario.inertial_fields import GYRO_ERRORS, MAX_ARCSEC, MAX_ARW, MAX_BIAS, MAX_RATE, MAX_RRW
 from navsim.scenario.schema import ListOfTables, Table, Value, is_multiple
 from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor
-from startrack.errors import InputError
+from startrack import InputError
 
 PROFILES = ("constant_rate", "sinusoidal_axis", "rate_segments", "rigid_body")
 #: What one run holds in memory: gyro samples, truth samples (the finer grid) and star-sensor frames.

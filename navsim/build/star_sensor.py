@@ -12,17 +12,21 @@ from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_prior import PriorIdentification
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
 from navsim.studies import observers as observer_kinds
-from startrack import units
-from startrack.bands import band
-from startrack.camera import Camera
-from startrack.detectors import detector
-from startrack.errors import InputError
-from startrack.identify.identifier import StarIdentifier
-from startrack.identify.prior_match import PriorMatch
-from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-from startrack.precompile import compile_ahead
-from startrack.render import SensorModel
-from startrack.sensor_photometry import SensorPhotometry
+from startrack import (
+    Camera,
+    InputError,
+    NavigationCatalogParams,
+    PriorMatch,
+    SensorModel,
+    SensorPhotometry,
+    StarIdentifier,
+    band,
+    compile_ahead,
+    detector,
+    load_navigation_catalog,
+    read_camera_file,
+    units,
+)
 
 #: The grey-level range of a sensor with a light budget: 16 bits over its full well (bias included).
 PHYSICAL_FULL_SCALE_DN = 65536
@@ -30,9 +34,9 @@ PHYSICAL_FULL_SCALE_DN = 65536
 
 def star_sensor(scenario, star_catalog, frame_interval, epoch, lanes=()):
     """The star sensor of ``scenario['star_sensor']`` (vector or image fidelity) with the faults that
-    act on it; ``star_catalog`` a :class:`startrack.star_catalog.StarCatalog` (stars measured or
+    act on it; ``star_catalog`` a :class:`startrack.catalog.hipparcos.StarCatalog` (stars measured or
     rendered), ``frame_interval`` the time between frames [s], ``epoch`` the catalog's [Julian year],
-    ``lanes`` the run's compile-ahead lanes (:mod:`startrack.precompile`; image fidelity); an attitude-fix
+    ``lanes`` the run's compile-ahead lanes (:mod:`startrack.compiled.compile_ahead`; image fidelity); an attitude-fix
     sensor needs no catalog (None)."""
     sensor = scenario["star_sensor"]
     _, q_BS_true = mounting(scenario["star_sensor"])
@@ -78,16 +82,16 @@ def prior_identification(sensor, stars):
 
 
 def camera(sensor):
-    """The :class:`startrack.camera.Camera` of a ``star_sensor`` table with an image table: its camera file's, or an
+    """The :class:`startrack.camera.model.Camera` of a ``star_sensor`` table with an image table: its camera file's, or an
     ideal pinhole of the field and the size."""
     image, fov = sensor["image"], float(units.deg_to_rad(sensor["fov_deg"]))
     if image["camera_file"] is not None:  # a calibrated camera (startrack solve --write-camera)
-        return dataclasses.replace(Camera.from_file(image["camera_file"]), circular_fov=image["field"] == "circular")
+        return dataclasses.replace(read_camera_file(image["camera_file"]).camera, circular_fov=image["field"] == "circular")
     return Camera.from_fov(fov, image["width_px"], image["height_px"], circular_fov=image["field"] == "circular")
 
 
 def photometry(sensor, sensor_camera=None):
-    """The :class:`startrack.sensor_photometry.SensorPhotometry` of a ``star_sensor`` table's light budget, or None
+    """The :class:`startrack.image.sensor_photometry.SensorPhotometry` of a ``star_sensor`` table's light budget, or None
     (no ``photometry`` table): its band, detector (the preset with the table's overrides), aperture and optics, the
     image table's exposure, PSF and detection threshold, and the pixel scale of ``sensor_camera`` (default:
     :func:`camera`)."""
@@ -104,7 +108,7 @@ def photometry(sensor, sensor_camera=None):
 
 
 def sensor_model(sensor, budget):
-    """The renderer's :class:`startrack.render.SensorModel` of a ``star_sensor`` table's image table: with a light
+    """The renderer's :class:`startrack.image.render.SensorModel` of a ``star_sensor`` table's image table: with a light
     budget (``budget``, :func:`photometry`) its detector's zero point, read noise, dark current and full well (16 bits
     over the well); otherwise (None) the image table's zero point and read noise."""
     image = sensor["image"]

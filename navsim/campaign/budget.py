@@ -25,7 +25,7 @@ from navsim.campaign.montecarlo import finished_series, run_campaign
 from navsim.kinds import resolve_scenario, run_kind
 from navsim.output import write_json, write_npz
 from navsim.places import check_output, mark, output_kind
-from startrack.errors import InputError
+from startrack import InputError
 
 #: Runs per source by default.
 DEFAULT_RUNS = 5

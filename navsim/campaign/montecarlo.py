@@ -39,8 +39,7 @@ from navsim.scenario import Scenario
 from navsim.simulation import prepare, simulate
 from navsim.studies import observers
 from navsim.studies.common import add_timing
-from startrack.errors import InputError, interrupted
-from startrack.precompile import compile_ahead
+from startrack import InputError, compile_ahead, interrupted
 
 RUN_DIR = "run_{:05d}"
 
@@ -244,7 +243,7 @@ def _environment(values):
 
 def _run_pool(scenario, chunks, n_workers, bar, truth_off=()):
     """Local processes (freshly spawned, single-threaded BLAS), after the kernels are compiled here (once
-    for every worker, on every core: :mod:`startrack.precompile`); on Ctrl-C the pending chunks are
+    for every worker, on every core: :mod:`startrack.compiled.compile_ahead`); on Ctrl-C the pending chunks are
     cancelled and the workers stopped at once."""
     compile_ahead(run_kind(scenario, "a Monte Carlo campaign").lanes(scenario))
     with _environment(SINGLE_THREADED_BLAS):

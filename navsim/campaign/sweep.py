@@ -27,7 +27,7 @@ from navsim.kinds import resolve_scenario, run_kind, scenario_from_dict
 from navsim.output import write_json
 from navsim.places import check_output, mark
 from navsim.scenario import parse_override
-from startrack.errors import InputError
+from startrack import InputError
 
 FORMAT = "navsim.sweep/1"
 METHODS = ("covariance", "montecarlo")

@@ -1,7 +1,7 @@
 """Apparent star directions seen from a moving observer, and what the star sensor's processing does
 with them.
 
-A star of catalog (ICRS, natural) direction u is seen at a(u) = ``startrack.aberration.aberrate(u,
+A star of catalog (ICRS, natural) direction u is seen at a(u) = ``startrack.catalog.apparent_place.aberrate(u,
 v_I)`` by an observer of barycentric velocity v_I (the Earth's orbit, its rotation and the vehicle:
 :func:`navsim.earth.orientation.observer_velocity`), up to 20.5" + v/c. Across a star sensor's field
 the displacement is a rotation (about b × v for the boresight b) plus a differential part of at most
@@ -18,8 +18,8 @@ refraction acts on the aberrated direction (the light's direction at the observe
 import numpy as np
 
 from navsim.earth.refraction import refract
+from startrack import aberrate
 from startrack import rotation as rot
-from startrack.aberration import aberrate
 
 
 def apparent(u_I, v_I, air=None):

@@ -46,7 +46,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erfcx
 
-
 #: The Earth's mean radius [m] for the atmosphere's curvature (the ellipsoid's flattening is below its accuracy).
 EARTH_RADIUS = 6371000.0
 #: COESA 1976: g0 M / R* [K/m], the radius r0 of the geopotential height [m].
@@ -138,7 +137,7 @@ class Extinction:
 
 
 def extinction(band, h, relative_humidity=0.4, temperature_c=15.0):
-    """The :class:`Extinction` of ``band`` (a :class:`startrack.bands.Band`) for observers at heights ``h``
+    """The :class:`Extinction` of ``band`` (a :class:`startrack.photometry.bands.Band`) for observers at heights ``h``
     [m], the ground air's relative humidity (0-1) and temperature [°C] (Schaefer's defaults 40 %, 15 °C)."""
     h = np.asarray(h, dtype=float)
     x = band.centre_um / 0.55

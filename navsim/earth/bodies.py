@@ -17,7 +17,7 @@ import numpy as np
 
 from navsim.earth.frames import local_up, slowly, tt_epoch
 from navsim.earth.wgs84 import geodetic_to_ecef
-from startrack.sphere import angular_distance
+from startrack import angular_distance
 
 #: The astronomical unit [m] (IAU 2012).
 AU = erfa.DAU

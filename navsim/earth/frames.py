@@ -5,17 +5,15 @@ C_ab rotates b-frame vectors into a (v_a = C_ab v_b); ω_ab^c is the rate of fra
 in c axes. Compiled functions of vectors return component tuples (see :mod:`navsim.earth.wgs84`).
 """
 
-from datetime import datetime, timedelta
-
 import contextlib
 import warnings
+from datetime import datetime, timedelta
 
 import erfa
 import numpy as np
 
 from navsim.earth.wgs84 import OMEGA_IE, radii
-from startrack.errors import InputError
-from startrack.jit import njit
+from startrack import InputError, njit
 
 
 def c_en(lat, lon):
@@ -97,7 +95,7 @@ def _utc(epoch_utc, t):
 
 def tt_epoch(epoch_utc, t=0.0):
     """Two-part TT Julian date (tt1, tt2) of ``t`` [s] after the UTC epoch ``epoch_utc`` (TT is TDB
-    within 2 ms: what :func:`startrack.aberration.earth_barycentric_velocity` takes)."""
+    within 2 ms: what :func:`startrack.catalog.apparent_place.earth_barycentric_velocity` takes)."""
     with utc_offsets_extrapolated():
         return erfa.taitt(*erfa.utctai(*_utc(epoch_utc, t)))
 

@@ -24,8 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.wgs84 import E2, GAMMA_E, K_SOMIGLIANA, A, F, M
-from startrack.errors import InputError
-from startrack.jit import njit
+from startrack import InputError, njit
 
 
 @njit

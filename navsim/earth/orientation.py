@@ -1,7 +1,7 @@
 """The Earth's orientation and the observer's velocity at the frames of a run.
 
 C_ie (ICRS axes from ITRS axes) is :func:`navsim.earth.frames.c_ei` (pyerfa's ``c2t06a``) and the
-barycentric velocity of the geocentre comes from the ephemeris of :mod:`startrack.aberration`
+barycentric velocity of the geocentre comes from the ephemeris of :mod:`startrack.catalog.apparent_place`
 (``erfa.epv00``, on the grid of :func:`navsim.earth.frames.slowly`); both depend on time only, so a scenario computes them once for its frame times
 (:class:`EarthOrientation`), for the truth and the filter alike. The observer's velocity relative
 to the solar-system barycentre, which sets the aberration of the stars it sees, is (ICRS axes)
@@ -18,10 +18,9 @@ import numpy as np
 
 from navsim.earth.frames import c_ei, q_en, slowly, tt_epoch
 from navsim.earth.wgs84 import OMEGA_IE, geodetic_to_ecef
+from startrack import earth_barycentric_velocity, njit
 from startrack import rotation as rot
-from startrack.aberration import earth_barycentric_velocity
-from startrack.jit import njit
-from startrack.rotation_jit import quat_to_matrix
+from startrack import rotation_kernels as rk
 
 #: Tolerance [s] of :meth:`EarthOrientation.index` (frame times are multiples of the IMU interval).
 TIME_TOLERANCE = 1e-6
@@ -60,5 +59,5 @@ def observer_velocity(c_ie, v_earth, lat, lon, h, v_n):
     [rad, rad, m] with NED ground velocity v_n (3,), for C_ie (3, 3) and the geocentre's v_earth (3,)
     (module docstring)."""
     x, y, _ = geodetic_to_ecef(lat, lon, h)
-    v_e = quat_to_matrix(np.array(q_en(lat, lon))) @ v_n + np.array([-OMEGA_IE * y, OMEGA_IE * x, 0.0])
+    v_e = rk.quat_to_matrix(np.array(q_en(lat, lon))) @ v_n + np.array([-OMEGA_IE * y, OMEGA_IE * x, 0.0])
     return v_earth + c_ie @ v_e

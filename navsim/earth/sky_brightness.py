@@ -51,8 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.atmosphere import extinction
-from startrack.bands import band as photometric_band
-from startrack.errors import InputError
+from startrack import InputError
+from startrack import band as photometric_band
 
 #: KS91 eq. 1: B [nL] = 34.08 exp(20.7233 − 0.92104 μ), i.e. μ = NL_ZERO − 2.5 log10(B).
 NL_ZERO = 20.7233 / 0.92104 + 2.5 * np.log10(34.08)
@@ -141,7 +141,7 @@ class SkyBrightness:
 
 
 def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.0, air=None):
-    """The :class:`SkyBrightness` of ``band_name`` (a :class:`startrack.bands.Band`'s name) for the
+    """The :class:`SkyBrightness` of ``band_name`` (a :class:`startrack.photometry.bands.Band`'s name) for the
     :class:`Sightline` ``geometry``; the ground air's humidity (0-1) and temperature [°C] set its aerosols
     and water vapour (:func:`navsim.earth.atmosphere.extinction`), or ``air`` gives the observer's
     :class:`~navsim.earth.atmosphere.Extinction` itself."""

@@ -20,9 +20,9 @@ import numpy as np
 
 from navsim.earth.frames import OMEGA_IE, c_en, q_en
 from navsim.earth.wgs84 import E2, A, radii
+from startrack import njit
 from startrack import rotation as rot
-from startrack.jit import njit
-from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix
+from startrack import rotation_kernels as rk
 
 
 @njit
@@ -58,7 +58,7 @@ def curvature(C, h):
 def axis_of(q):
     """(c0, c1, c2) = C_ew[2, :], the Earth's axis in w (eq. 1: ω_ie^w = ω_ie C_ew[2, :]ᵀ; c0, c1 the c of eq. 2 and
     c2 = −sin L), of the unit quaternion q_ew (4,) or 4-tuple, as scalars (the third row of
-    :func:`startrack.rotation_jit.quat_to_matrix`, without allocating it)."""
+    :func:`startrack.geometry.rotation_kernels.quat_to_matrix`, without allocating it)."""
     x, y, z, w = q[0], q[1], q[2], q[3]
     return 2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)
 
@@ -109,7 +109,7 @@ def frame_angles(C):
 def _angles_of_rows(q):
     out = np.empty((q.shape[0], 3))
     for i in range(q.shape[0]):
-        out[i] = frame_angles(quat_to_matrix(q[i]))
+        out[i] = frame_angles(rk.quat_to_matrix(q[i]))
     return out
 
 
@@ -125,12 +125,12 @@ def _ned_rows(q, v_w, q_wb):
     """[L, λ [rad], v_n (3), q_nb (4)] (K, 9) of the rows q_ew (K, 4), v_w (K, 3), q_wb (K, 4) (:func:`to_ned`)."""
     out = np.empty((q.shape[0], 9))
     for i in range(q.shape[0]):
-        out[i, 0], out[i, 1], alpha = frame_angles(quat_to_matrix(q[i]))
-        q_nw = quat_from_rotation_vector(np.array([0.0, 0.0, alpha]))
-        C_nw = quat_to_matrix(q_nw)
+        out[i, 0], out[i, 1], alpha = frame_angles(rk.quat_to_matrix(q[i]))
+        q_nw = rk.quat_from_rotation_vector(np.array([0.0, 0.0, alpha]))
+        C_nw = rk.quat_to_matrix(q_nw)
         for r in range(3):
             out[i, 2 + r] = C_nw[r, 0] * v_w[i, 0] + C_nw[r, 1] * v_w[i, 1] + C_nw[r, 2] * v_w[i, 2]
-        out[i, 5:9] = quat_multiply(q_nw, q_wb[i])
+        out[i, 5:9] = rk.quat_multiply(q_nw, q_wb[i])
     return out
 
 

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from startrack.jit import njit
+from startrack import njit
 
 #: Semi-major axis a [m].
 A = 6378137.0

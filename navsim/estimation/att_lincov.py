@@ -19,7 +19,7 @@ import numpy as np
 
 from navsim.estimation.kernels import fix_residual, star_residuals, transition
 from navsim.estimation.lincov import allocate_log, keep, propagate, trimmed, update
-from startrack.jit import njit
+from startrack import njit
 
 #: The measurements of a pass, per frame f of F: identified stars (rows ``star_offsets[f]:star_offsets[f+1]`` of
 #: the catalog directions ``star_ref`` (M, 3) in I, the noise-free directions ``star_obs`` (M, 3) in S through the

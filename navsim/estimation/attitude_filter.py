@@ -39,8 +39,8 @@ from navsim.estimation.consistency import chi2_quantile
 from navsim.estimation.kernels import FilterModel
 from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult, star_covariances
+from startrack import InputError
 from startrack import rotation as rot
-from startrack.errors import InputError
 
 #: The groups of extra states in error-state order, with their sizes.
 GROUPS = (("bias_instability", 3), ("scale_factor", 3), ("gyro_misalignment", 6), ("mounting", 3))

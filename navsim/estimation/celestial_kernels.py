@@ -24,22 +24,22 @@ import numpy as np
 from navsim.estimation.kernels import fix_residual, gate_stars, star_residuals, tangent_basis
 from navsim.estimation.linalg import joseph_update, mm
 from navsim.estimation.nav_kernels import DP, flush, gated_update, reset
-from startrack.jit import njit
-from startrack.rotation_jit import quat_multiply, quat_to_matrix
+from startrack import njit
+from startrack import rotation_kernels as rk
 
 
 @njit
 def inertial_attitude(nav, q_ie):
     """q_IB of the INS, q_ie ⊗ q_ew ⊗ q_wb (C_ib = C_ie C_ew C_wb), for the navigation state ``nav`` and the
     Earth's orientation q_ie (4,) at the time of the update."""
-    return quat_multiply(quat_multiply(q_ie, nav[0:4]), nav[8:12])
+    return rk.quat_multiply(rk.quat_multiply(q_ie, nav[0:4]), nav[8:12])
 
 
 @njit
 def attitude_jacobian(nav, n):
     """A (3, n) with δθ_b = A x (eq. 1 of the module): C_bw in the φ columns and −C_bw's first two columns in the
     δθ_x, δθ_y columns."""
-    C_bw = quat_to_matrix(nav[8:12]).T
+    C_bw = rk.quat_to_matrix(nav[8:12]).T
     A = np.zeros((3, n))
     for i in range(3):
         for j in range(3):
@@ -78,7 +78,7 @@ def fix_terms(nav, q_BS, q_ie, q_IS, R_S, layout, rho_I):
     H = np.empty((3, layout.n))
     _chain(H_att, attitude_jacobian(nav, layout.n), layout.mounting, H)
     if layout.refraction >= 0:
-        H[:, layout.refraction] = -(quat_to_matrix(q_IB).T @ rho_I)
+        H[:, layout.refraction] = -(rk.quat_to_matrix(q_IB).T @ rho_I)
     return z, H, R
 
 
@@ -105,7 +105,7 @@ def star_terms(nav, q_BS, q_ie, ref_I, obs_S, cov_S, layout, shift_I):
     z, H_att, R = star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, 6, 3)
     A = attitude_jacobian(nav, layout.n)
     H = np.empty((z.shape[0], 2, layout.n))
-    R_SI = quat_to_matrix(q_BS).T @ quat_to_matrix(q_IB).T
+    R_SI = rk.quat_to_matrix(q_BS).T @ rk.quat_to_matrix(q_IB).T
     for k in range(z.shape[0]):
         _chain(H_att[k], A, layout.mounting, H[k])
         if layout.refraction >= 0:

@@ -24,8 +24,8 @@ import numpy as np
 
 from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t, solve3
 from navsim.kinematics_jit import rk4_hold
-from startrack.jit import njit
-from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, rotation_vector, skew
+from startrack import njit
+from startrack import rotation_kernels as rk
 
 #: What the filter assumes of the gyro and which states it carries: ARW σ_v [rad/√s], RRW σ_u
 #: [rad/s^(3/2)], the bias instability's σ_g [rad/s] and correlation time τ [s], random walk of the
@@ -75,7 +75,7 @@ def transition(omega, dt, n, model):
         a = np.sin(wt) / w
         b = (1.0 - np.cos(wt)) / (w * w)
         c = (wt - np.sin(wt)) / w**3
-    W = skew(omega)
+    W = rk.skew(omega)
     W2 = mm(W, W)
     F = np.eye(n)
     for i in range(3):
@@ -269,8 +269,8 @@ def star_residuals(q_IB, q_BS, ref_I, obs_S, cov_S, n, mount_col):
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     R = np.empty((m, 2, 2))
-    R_IB = quat_to_matrix(q_IB)
-    R_SB = quat_to_matrix(q_BS).T
+    R_IB = rk.quat_to_matrix(q_IB)
+    R_SB = rk.quat_to_matrix(q_BS).T
     for k in range(m):
         _star_row(R_IB, R_SB, ref_I[k], obs_S[k], cov_S[k], z[k], H[k], R[k], mount_col)
     return z, H, R
@@ -289,12 +289,12 @@ def _star_row(R_IB, R_SB, ref_I, obs_S, cov_S, z, H, R, mount_col):
     R[0, 0] = np.sum(e1 * c1)
     R[0, 1] = R[1, 0] = 0.5 * (np.sum(e1 * c2) + np.sum(e2 * c1))
     R[1, 1] = np.sum(e2 * c2)
-    A = R_SB @ skew(b_hat)
+    A = R_SB @ rk.skew(b_hat)
     for j in range(3):
         H[0, j] = e1[0] * A[0, j] + e1[1] * A[1, j] + e1[2] * A[2, j]
         H[1, j] = e2[0] * A[0, j] + e2[1] * A[1, j] + e2[2] * A[2, j]
     if mount_col >= 0:
-        B = skew(s_hat)
+        B = rk.skew(s_hat)
         for j in range(3):
             H[0, mount_col + j] = e1[0] * B[0, j] + e1[1] * B[1, j] + e1[2] * B[2, j]
             H[1, mount_col + j] = e2[0] * B[0, j] + e2[1] * B[1, j] + e2[2] * B[2, j]
@@ -308,10 +308,10 @@ def head_residuals(x, heads, ref_I, obs_S, cov_S, n, model):
     z = np.empty((m, 2))
     H = np.zeros((m, 2, n))
     R = np.empty((m, 2, 2))
-    R_IB = quat_to_matrix(x[0:4])
+    R_IB = rk.quat_to_matrix(x[0:4])
     for k in range(m):
         h = heads[k]
-        _star_row(R_IB, quat_to_matrix(q_BS_of(x, h)).T, ref_I[k], obs_S[k], cov_S[k], z[k], H[k], R[k],
+        _star_row(R_IB, rk.quat_to_matrix(q_BS_of(x, h)).T, ref_I[k], obs_S[k], cov_S[k], z[k], H[k], R[k],
                   mounting_column(model, n, h))
     return z, H, R
 
@@ -335,8 +335,8 @@ def fix_residual(q_IB, q_BS, q_IS, R_S):
     z = δθ + R_BS δm to first order for q_IB,true = q_IB ⊗ δq(δθ) and q_BS,true = q_BS ⊗ δq(δm);
     R = R_BS R_S R_BSᵀ. Returns (z (3,), R_BS, R)."""
     conj = np.array([-1.0, -1.0, -1.0, 1.0])
-    z = rotation_vector(quat_multiply(q_IB * conj, quat_multiply(q_IS, q_BS * conj)))
-    R_BS = quat_to_matrix(q_BS)
+    z = rk.rotation_vector(rk.quat_multiply(q_IB * conj, rk.quat_multiply(q_IS, q_BS * conj)))
+    R_BS = rk.quat_to_matrix(q_BS)
     return z, R_BS, mm_t(mm(R_BS, R_S), R_BS)
 
 
@@ -414,7 +414,7 @@ def reset(x, dx, model):
     q ← q ⊗ δq(δθ), b ← b + δb, g ← g + δg, K ← K + δK, each head's q_BS ← q_BS ⊗ δq(δm). Returns the new x."""
     n = dx.shape[0]
     out = x.copy()
-    q_next = quat_multiply(x[0:4], quat_from_rotation_vector(dx[0:3]))
+    q_next = rk.quat_multiply(x[0:4], rk.quat_from_rotation_vector(dx[0:3]))
     out[0:4] = q_next / np.sqrt(np.sum(q_next * q_next))
     out[4:7] = x[4:7] + dx[3:6]
     if model.n_bi:
@@ -425,7 +425,7 @@ def reset(x, dx, model):
     if model.mounting:
         for h in range(model.heads):
             col = mounting_column(model, n, h)
-            q_BS_next = quat_multiply(q_BS_of(x, h), quat_from_rotation_vector(dx[col : col + 3]))
+            q_BS_next = rk.quat_multiply(q_BS_of(x, h), rk.quat_from_rotation_vector(dx[col : col + 3]))
             out[X_BS + 4 * h : X_BS + 4 * h + 4] = q_BS_next / np.sqrt(np.sum(q_BS_next * q_BS_next))
     return out
 

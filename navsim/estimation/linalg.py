@@ -6,7 +6,7 @@ Small explicit loops beat a BLAS call below ~20 x 20; each function is tested ag
 
 import numpy as np
 
-from startrack.jit import njit
+from startrack import njit
 
 
 @njit

@@ -25,7 +25,7 @@ model is the truth's (W = T = I, the same Φ, Q, H, R) eq. (3) is eq. (2) and Σ
 import numpy as np
 
 from navsim.estimation.linalg import schmidt_gain
-from startrack.jit import njit
+from startrack import njit
 
 
 @njit

@@ -29,19 +29,19 @@ import numpy as np
 
 from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import c_en, local_up
-from navsim.earth.wander import ned_offset, normal, normal_turn, to_ned
 from navsim.earth.orientation import observer_velocity
 from navsim.earth.refraction import refract
+from navsim.earth.wander import ned_offset, normal, normal_turn, to_ned
 from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
-from navsim.estimation.nav_kernels import CALIB_SIZE, NavModel
+from navsim.estimation.nav_kernels import ACCEL_BIAS, ACCEL_SCALE, CALIB_SIZE, GYRO_BIAS, GYRO_SCALE, MOUNTING, NavModel
 from navsim.estimation.treatments import TREATMENTS
 from navsim.estimation.updates import UpdateResult, star_covariances
 from navsim.ins import strapdown
+from navsim.ins.strapdown import HEIGHT, Q_EW, Q_WB, V_W
 from navsim.sensors.star_sensor import SensorPrior
+from startrack import InputError, aberrate
 from startrack import rotation as rot
-from startrack.aberration import aberrate
-from startrack.errors import InputError
 
 #: Which states a baro height updates: the vertical channel (:data:`nav_kernels.BARO_STATES`), or every
 #: estimated state (a white-noise height reference).
@@ -191,7 +191,7 @@ class NavFilter:
         self.sigma_scale = float(config.measurement_noise_scale)
         self.gates = np.array([chi2_quantile(config.gate_probability, dof) for dof in (3, 1, 2)], dtype=float)
         self._calib = np.zeros(CALIB_SIZE)
-        self._calib[12:16] = (0.0, 0.0, 0.0, 1.0) if config.star_sensor is None else rot.normalize(config.star_sensor.q_BS)
+        self._calib[MOUNTING] = (0.0, 0.0, 0.0, 1.0) if config.star_sensor is None else rot.normalize(config.star_sensor.q_BS)
         self._nav = strapdown.initial_state(lat, lon, h, v_n, q_nb)
         T_inv = np.linalg.inv(nav_kernels.public_jacobian(self._nav, self.n, self.layout.gravity))
         self._P = T_inv @ np.array(config.P0) @ T_inv.T
@@ -270,7 +270,7 @@ class NavFilter:
         q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
         a, b = np.empty(3), np.empty(3)
         nav_kernels.correct(np.asarray(last_sample, dtype=float), self._calib, 1.0, self.layout.scale >= 0, a, b)
-        return rot.multiply(q_IB, self._calib[12:16]), rot.to_matrix(self._calib[12:16]).T @ a
+        return rot.multiply(q_IB, self._calib[MOUNTING]), rot.to_matrix(self._calib[MOUNTING]).T @ a
 
     def reinitialise(self, q_IS):
         """Restart the attitude from a star-sensor fix q_IS after a lost track: q_wb = q_ew⁻¹ ⊗ q_ie⁻¹ ⊗
@@ -278,8 +278,8 @@ class NavFilter:
         initial value and its correlations cleared."""
         j = self._frame()
         q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
-        q_wi = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], self._nav[0:4]))
-        self._nav[8:12] = rot.normalize(rot.multiply(rot.multiply(q_wi, q_IS), rot.conjugate(self._calib[12:16])))
+        q_wi = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], self._nav[Q_EW]))
+        self._nav[Q_WB] = rot.normalize(rot.multiply(rot.multiply(q_wi, q_IS), rot.conjugate(self._calib[MOUNTING])))
         self._P[0:3, :] = 0.0
         self._P[:, 0:3] = 0.0
         self._P[0:3, 0:3] = self._P0_attitude
@@ -287,7 +287,7 @@ class NavFilter:
     def disturb(self, rotation_vector):
         """The attitude-jump fault: the estimate is knocked off by ``rotation_vector`` [rad] (body axes),
         as by a disturbance the filter is not told about; P is left as it was."""
-        self._nav[8:12] = rot.normalize(rot.multiply(self._nav[8:12], rot.from_rotation_vector(rotation_vector)))
+        self._nav[Q_WB] = rot.normalize(rot.multiply(self._nav[Q_WB], rot.from_rotation_vector(rotation_vector)))
 
     def _frame(self):
         if self.star_sensor is None:
@@ -299,7 +299,7 @@ class NavFilter:
         (:meth:`_ned`)."""
         o = self.star_sensor.orientation
         lat, lon, v_n, _ = ned
-        return observer_velocity(o.c_ie[j], o.v_earth[j], lat, lon, self._nav[4], v_n)
+        return observer_velocity(o.c_ie[j], o.v_earth[j], lat, lon, self._nav[HEIGHT], v_n)
 
     def sensor_prior(self):
         """The star sensor's :class:`~navsim.sensors.star_sensor.SensorPrior` at this frame: q̂_IS (as
@@ -309,12 +309,12 @@ class NavFilter:
         (:meth:`update_stars`'s)."""
         j = self._frame()
         nav_kernels.flush(self._nav, self._P, self._acc, self.model)
-        R_SB = rot.to_matrix(self._calib[12:16]).T
+        R_SB = rot.to_matrix(self._calib[MOUNTING]).T
         G = R_SB @ celestial_kernels.attitude_jacobian(self._nav, self.layout.n)
         if self.layout.mounting >= 0:
             G[:, self.layout.mounting:self.layout.mounting + 3] += np.eye(3)
         q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
-        q_IS = rot.multiply(q_IB, self._calib[12:16])
+        q_IS = rot.multiply(q_IB, self._calib[MOUNTING])
         if self.layout.refraction >= 0:  # the field turned by ε_r ρ: an attitude error −ε_r R_SI ρ (fix_terms)
             G[:, self.layout.refraction] = -(rot.to_matrix(q_IS).T @ self._refraction_rotation(j, q_IS))
         return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=self._apparent(j))
@@ -352,7 +352,7 @@ class NavFilter:
         if air is None:
             return None
         lat, lon, _, _ = ned
-        a, b = air.coefficients(self._nav[4])
+        a, b = air.coefficients(self._nav[HEIGHT])
         return local_up(self.star_sensor.orientation.c_ie[j], lat, lon), a, b
 
     def _corrected_fix(self, q_IS, j):
@@ -413,7 +413,7 @@ class NavFilter:
     def position(self):
         """(L, λ, h) [rad, rad, m]."""
         lat, lon, _, _ = self._ned()
-        return float(lat), float(lon), float(self._nav[4])
+        return float(lat), float(lon), float(self._nav[HEIGHT])
 
     @property
     def v_n(self):
@@ -425,25 +425,25 @@ class NavFilter:
 
     def _ned(self):
         """(L, λ, v_n, q_nb) of the wander-azimuth solution (:func:`navsim.earth.wander.to_ned`)."""
-        return to_ned(self._nav[0:4], self._nav[5:8], self._nav[8:12])
+        return to_ned(self._nav[Q_EW], self._nav[V_W], self._nav[Q_WB])
 
     @property
     def gyro_bias(self):
-        return self._calib[0:3].copy()
+        return self._calib[GYRO_BIAS].copy()
 
     @property
     def accel_bias(self):
-        return self._calib[3:6].copy()
+        return self._calib[ACCEL_BIAS].copy()
 
     @property
     def scale_factors(self):
         """(ŝ_g, ŝ_a) estimates [-] (zero unless estimated)."""
-        return self._calib[6:9].copy(), self._calib[9:12].copy()
+        return self._calib[GYRO_SCALE].copy(), self._calib[ACCEL_SCALE].copy()
 
     @property
     def q_BS(self):
         """The star-sensor mounting estimate q̂_BS (identity without a star sensor)."""
-        return self._calib[12:16].copy()
+        return self._calib[MOUNTING].copy()
 
 
 def state_names(layout):

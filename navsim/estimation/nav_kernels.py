@@ -36,15 +36,17 @@ from navsim.earth.wander import curvature, earth_rate_w, frame_angles, radii_of_
 from navsim.earth.wgs84 import E2, radii
 from navsim.estimation.linalg import inverse_small, joseph_update, mm, mm_t, van_loan
 from navsim.ins.strapdown import ROW, step
-from startrack.jit import njit
-from startrack.rotation_jit import quat_from_rotation_vector, quat_multiply, quat_to_matrix, skew
+from startrack import njit
+from startrack import rotation_kernels as rk
 
 #: First index of the position error (δθ_x, δθ_y, δh) in the error state.
 DP = 6
 #: The 15 states every navigation filter carries (attitude, velocity, position, the two biases).
 BASE_STATES = 15
-#: Size of the ``calib`` vector: biases, scale factors, mounting quaternion q̂_BS.
+#: Size of the ``calib`` vector: biases, scale factors, mounting quaternion q̂_BS ...
 CALIB_SIZE = 16
+#: ... and its parts: b̂_g, b̂_a, ŝ_g, ŝ_a, q̂_BS.
+GYRO_BIAS, ACCEL_BIAS, GYRO_SCALE, ACCEL_SCALE, MOUNTING = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 16)
 #: Where each optional group of the error state starts (−1: absent), and the state count n.
 Layout = namedtuple("Layout", "n scale mounting gravity refraction")
 #: What the kernels need of the filter's model: the constant continuous noise densities ``q_c`` (n,),
@@ -124,17 +126,17 @@ def continuous_f(C_ew, h, v, f_w, C, C_w, C_f, layout, inv_length):
     w_ie = earth_rate_w(C_ew)
     rho, d_v, d_p = _rho_derivatives(C_ew, h, v)
     d_ie = np.zeros((3, 3))
-    W = skew(w_ie)
+    W = rk.skew(w_ie)
     for i in range(3):
         d_ie[i, 0], d_ie[i, 1] = W[i, 0], W[i, 1]
-    V = skew(v)
+    V = rk.skew(v)
     F = np.zeros((layout.n, layout.n))
-    F[0:3, 0:3] = -skew(w_ie + rho)
+    F[0:3, 0:3] = -rk.skew(w_ie + rho)
     F[0:3, 3:6] = d_v
     F[0:3, 6:9] = d_ie + d_p
     F[0:3, 9:12] = -C
-    F[3:6, 0:3] = skew(f_w)
-    F[3:6, 3:6] = -skew(2.0 * w_ie + rho) + mm(V, d_v)
+    F[3:6, 0:3] = rk.skew(f_w)
+    F[3:6, 3:6] = -rk.skew(2.0 * w_ie + rho) + mm(V, d_v)
     F[3:6, 6:9] = mm(V, 2.0 * d_ie + d_p)
     s = -C_ew[2, 2]
     dgamma = normal_gravity_sine_gradient(s, h)
@@ -162,7 +164,7 @@ def public_jacobian(nav, n, gravity):
     δv_n = C_nw δv, (δN, δE) = −diag(R_M + h, R_N + h) R(α) J (δθ_x, δθ_y) (J = [[0, 1], [−1, 0]], the inverse of the
     position map of :func:`navsim.earth.wander.ned_offset`), δh, δg_n = C_nw δg (``gravity`` its first index, −1:
     none); the other states as they are. α from :func:`navsim.earth.wander.frame_angles`."""
-    C_ew = quat_to_matrix(nav[0:4])
+    C_ew = rk.quat_to_matrix(nav[0:4])
     lat, _, alpha = frame_angles(C_ew)
     ca, sa = np.cos(alpha), np.sin(alpha)
     r_m, r_n = radii(lat)
@@ -201,7 +203,7 @@ def correct(sample, calib, dt, scale, a, b):
 def accumulate(acc, q_nb, dtheta, dv):
     """Add one interval's corrected increments to the covariance accumulator, resolved with the
     attitude q_nb at the start of the interval."""
-    C = quat_to_matrix(q_nb)
+    C = rk.quat_to_matrix(q_nb)
     acc[0] += 1.0
     for i in range(3):
         for j in range(3):
@@ -236,7 +238,7 @@ def flush(nav, P, acc, model):
     C = acc[4:13].reshape(3, 3) / count
     C_w = acc[13:22].reshape(3, 3) / span
     C_f = acc[22:31].reshape(3, 3) / span
-    F = continuous_f(quat_to_matrix(nav[0:4]), nav[4], nav[5:8], acc[1:4] / span, C, C_w, C_f, model.layout, model.gm[3])
+    F = continuous_f(rk.quat_to_matrix(nav[0:4]), nav[4], nav[5:8], acc[1:4] / span, C, C_w, C_f, model.layout, model.gm[3])
     Phi, Q = discretize(F, noise_densities(nav, model), span)
     P_next = mm(Phi, mm(Phi, P).T.copy()) + Q  # Φ (Φ P)ᵀ = Φ P Φᵀ with sparse left factors
     P[:, :] = 0.5 * (P_next + P_next.T)
@@ -262,10 +264,10 @@ def reset(nav, calib, dx, layout):
     """Fold the error estimate dx into the nominal state (in place): C_wb ← exp([φ×]) C_wb,
     v ← v − δv, C_ew ← C_ew exp(−[δθ×]), h ← h − δh, b̂ ← b̂ + (ε, ∇), ŝ ← ŝ + δs, q̂_BS ← q̂_BS ⊗ δq(μ)
     (the gravity disturbance is a consider state: never estimated)."""
-    q = quat_multiply(quat_from_rotation_vector(dx[0:3]), nav[8:12])
+    q = rk.quat_multiply(rk.quat_from_rotation_vector(dx[0:3]), nav[8:12])
     nav[8:12] = q / np.sqrt(np.sum(q * q))
     nav[5:8] -= dx[3:6]
-    q = quat_multiply(nav[0:4], quat_from_rotation_vector(np.array([-dx[DP], -dx[DP + 1], 0.0])))
+    q = rk.quat_multiply(nav[0:4], rk.quat_from_rotation_vector(np.array([-dx[DP], -dx[DP + 1], 0.0])))
     nav[0:4] = q / np.sqrt(np.sum(q * q))
     nav[4] -= dx[DP + 2]
     calib[0:6] += dx[9:15]
@@ -273,7 +275,7 @@ def reset(nav, calib, dx, layout):
         calib[6:12] += dx[layout.scale:layout.scale + 6]
     if layout.mounting >= 0:
         m = layout.mounting
-        q = quat_multiply(calib[12:16], quat_from_rotation_vector(dx[m:m + 3]))
+        q = rk.quat_multiply(calib[12:16], rk.quat_from_rotation_vector(dx[m:m + 3]))
         calib[12:16] = q / np.sqrt(np.sum(q * q))
 
 
@@ -283,7 +285,7 @@ def position_terms(nav, fix, sigma, n):
     NED σ ``sigma`` (3,) [m]: z = the estimate's offset from the fix, horizontal −D⁻¹ J δθ (δθ the rotation that
     turns the fix's normal into the estimate's, in w; D of eq. 2 of :mod:`navsim.earth.wander`), then −δh (down);
     H = [−D⁻¹ J, −e_h] in the position columns, R = C_wn diag(σ²) C_nw."""
-    C_ew = quat_to_matrix(nav[0:4])
+    C_ew = rk.quat_to_matrix(nav[0:4])
     cl = np.cos(fix[0])
     up_fix = np.array([cl * np.cos(fix[1]), cl * np.sin(fix[1]), np.sin(fix[0])])
     up = np.array([-C_ew[0, 2], -C_ew[1, 2], -C_ew[2, 2]])

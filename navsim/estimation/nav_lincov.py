@@ -18,10 +18,18 @@ from navsim.earth.wander import frame_angles
 from navsim.estimation.celestial_kernels import fix_terms, star_terms
 from navsim.estimation.linalg import van_loan
 from navsim.estimation.lincov import allocate_log, keep, propagate, trimmed, update
-from navsim.estimation.nav_kernels import (DP, continuous_f, discretize, noise_densities, position_terms,
-                                           public_jacobian, to_public, to_public_vector)
-from startrack.jit import njit
-from startrack.rotation_jit import quat_to_matrix
+from navsim.estimation.nav_kernels import (
+    DP,
+    continuous_f,
+    discretize,
+    noise_densities,
+    position_terms,
+    public_jacobian,
+    to_public,
+    to_public_vector,
+)
+from startrack import njit
+from startrack import rotation_kernels as rk
 
 #: Where the truth's groups start (−1: absent): ``base`` the :class:`nav_kernels.Layout` of the states the
 #: filter may carry; the Gauss-Markov bias parts (3 each), the misalignments (6 each), the baro bias (1);
@@ -110,7 +118,7 @@ def _interval_means(q_wb, dtheta, dv, k0, k1, dt):
     C, f_n = np.zeros((3, 3)), np.zeros(3)
     G_w, G_f = np.zeros((3, 3, 3)), np.zeros((3, 3, 3))
     for k in range(k0, k1):
-        Ck = quat_to_matrix(q_wb[k])
+        Ck = rk.quat_to_matrix(q_wb[k])
         for a in range(3):
             for i in range(3):
                 C[a, i] += Ck[a, i]
@@ -147,7 +155,7 @@ def _propagate_interval(P, mean, P_f, nav, C, f_n, G_w, G_f, span, tl, truth_q, 
         for i in range(3):
             drive = 0.5 * (gravity_drive[0] + gravity_drive[1]) if i < 2 else gravity_drive[2]
             q[gravity_source, tl.base.gravity + i] += drive * speed
-    C_ew = quat_to_matrix(nav[0:4])
+    C_ew = rk.quat_to_matrix(nav[0:4])
     F_t = truth_f(C_ew, nav[4], nav[5:8], f_n, C, G_w, G_f, tl, inv_length, inv_tau)
     Phi, Q = van_loan(F_t, q, span)
     propagate(P, mean, Phi, Q)
@@ -192,7 +200,7 @@ def _update_aiding(P, mean, P_f, nav, f, meas, tl, W, estimated, baro_estimated)
     """The frame's position fix (H and R of :func:`nav_kernels.position_terms` at the nominal) and baro height
     (H = e_δh − e_baro bias, R the white noise; the filter's R its σ with the bias), in that order."""
     if meas.position_mask[f]:
-        lat, lon, _ = frame_angles(quat_to_matrix(nav[0:4]))
+        lat, lon, _ = frame_angles(rk.quat_to_matrix(nav[0:4]))
         _, H, R_t, _ = position_terms(nav, np.array([lat, lon, nav[4]]), meas.position_sigma, tl.base.n)
         H_t = _embed(H, tl.n)
         update(P, mean, P_f, W, H_t, R_t, meas.r_scale2 * R_t, np.zeros(3), estimated, meas.aiding_source,

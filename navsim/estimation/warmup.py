@@ -1,4 +1,4 @@
-"""The compile-ahead task of the attitude filter (:mod:`startrack.precompile`; the run kinds' ``lanes``).
+"""The compile-ahead task of the attitude filter (:mod:`startrack.compiled.compile_ahead`; the run kinds' ``lanes``).
 
 It calls the filter's kernels through the constructor and the methods a run calls, on made-up inputs of a
 run's shapes and types (the methods convert what they are given, so the kernels see the run's types);

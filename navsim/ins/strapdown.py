@@ -34,13 +34,14 @@ import numpy as np
 from navsim.earth.gravity import normal_gravity_of_sine
 from navsim.earth.wander import axis_of, geodetic, q_ew, to_ned, transport_of_axis
 from navsim.earth.wgs84 import GAMMA_E, OMEGA_IE, A
+from startrack import InputError, njit
 from startrack import rotation as rot
-from startrack.errors import InputError
-from startrack.jit import njit
 
 SIZE = 19
 #: Length of a solution row (q_ew, h, v_w, q_wb): what a log keeps of ``nav``.
 ROW = 12
+#: The parts of a solution row in ``nav``: q_ew, h, v_w, q_wb.
+Q_EW, HEIGHT, V_W, Q_WB = slice(0, 4), 4, slice(5, 8), slice(8, 12)
 
 
 class Log(NamedTuple):
@@ -97,7 +98,7 @@ def _cross(a0, a1, a2, b0, b1, b2):
 @njit
 def _exp(t0, t1, t2):
     """exp(θ/2), the quaternion of the rotation vector θ = (t0, t1, t2) [rad] as a scalar-last 4-tuple (the series
-    below 1e-4 rad of :func:`startrack.rotation_jit.quat_from_rotation_vector`; no allocation)."""
+    below 1e-4 rad of :func:`startrack.geometry.rotation_kernels.quat_from_rotation_vector`; no allocation)."""
     angle = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
     k = 0.5 - angle * angle / 48.0 if angle < 1e-4 else np.sin(0.5 * angle) / angle
     return k * t0, k * t1, k * t2, np.cos(0.5 * angle)
@@ -105,7 +106,7 @@ def _exp(t0, t1, t2):
 
 @njit
 def _product(p, q):
-    """Hamilton product p ⊗ q of scalar-last 4-tuples (:func:`startrack.rotation_jit.quat_multiply`; no
+    """Hamilton product p ⊗ q of scalar-last 4-tuples (:func:`startrack.geometry.rotation_kernels.quat_multiply`; no
     allocation)."""
     return (p[3] * q[0] + p[0] * q[3] + p[1] * q[2] - p[2] * q[1],
             p[3] * q[1] - p[0] * q[2] + p[1] * q[3] + p[2] * q[0],
@@ -123,7 +124,7 @@ def _unit(q):
 @njit
 def _rotated(q, a0, a1, a2):
     """R(q) a for the unit 4-tuple q = (u, w) and a by its components: a + w t + u × t, t = 2 u × a
-    (:func:`startrack.rotation.rotate`; no allocation)."""
+    (:func:`startrack.geometry.rotation.rotate`; no allocation)."""
     t0, t1, t2 = _cross(q[0], q[1], q[2], 2.0 * a0, 2.0 * a1, 2.0 * a2)
     s0, s1, s2 = _cross(q[0], q[1], q[2], t0, t1, t2)
     return a0 + q[3] * t0 + s0, a1 + q[3] * t1 + s1, a2 + q[3] * t2 + s2

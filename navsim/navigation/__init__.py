@@ -11,7 +11,7 @@ summaries), ``campaign`` (what a campaign pools), ``console`` (what the command 
 :mod:`navsim.kinds`, each loaded on first use.
 """
 
-from startrack.lazy import lazy_exports
+from startrack import lazy_exports
 
 #: The kind's name, and the table that marks a scenario of it.
 NAME, TABLE = "navigation", "trajectory"

@@ -16,9 +16,7 @@ from navsim.build.star_sensor import vector_equivalent
 from navsim.navigation import build, exclusion, sky_background
 from navsim.navigation.covariance import nominal
 from navsim.sensors.star_vector import AttitudeFixSensor
-from startrack import units
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
+from startrack import InputError, load_star_catalog, units
 
 #: The summary's format tag.
 FORMAT = "navsim.sky-availability/1"

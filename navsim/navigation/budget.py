@@ -46,7 +46,7 @@ from navsim.navigation.records import RunSummary
 from navsim.navigation.run import TRUTH_SOURCES
 from navsim.navigation.scenario import validate
 from navsim.scenario import Scenario, apply_overrides
-from startrack.errors import InputError
+from startrack import InputError
 
 FORMAT = "navsim.error-budget/2"
 

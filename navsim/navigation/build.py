@@ -16,8 +16,7 @@ from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.aiding import PositionFixSensor
 from navsim.sensors.baro import BaroModel
 from navsim.truth.route import profile_of
-from startrack import units
-from startrack.bands import band
+from startrack import band, units
 
 #: Floors of the default initial σ, so that P0 stays positive definite with perfect sensors:
 #: tilt [rad], heading [rad], gyro bias [rad/s], accelerometer bias [m/s²], scale factor [-].

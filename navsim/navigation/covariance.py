@@ -46,9 +46,8 @@ from navsim.sensors.star_sensor import isotropic_covariance
 from navsim.sensors.star_vector import AttitudeFixSensor
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
+from startrack import load_star_catalog, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.star_catalog import load_star_catalog
 
 #: The error sources of the budget, in order, with their labels (those of :data:`navsim.navigation.budget.SOURCES`).
 COVARIANCE_SOURCES = {key: {s.key: s.label for s in BUDGET_SOURCES}[key] for key in ("initial", "inertial", "accel_bias", "gravity", "mounting", "star_noise",

@@ -16,9 +16,8 @@ import numpy as np
 
 from navsim.earth.bodies import SunMoon
 from navsim.truth.sky import inertial_attitude
+from startrack import angular_distance, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.sphere import angular_distance
 
 #: The reasons of an excluded frame, in the order they are tested.
 REASONS = ("Sun in the exclusion cone", "Moon in the exclusion cone", "boresight below the lowest elevation")

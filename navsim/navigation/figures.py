@@ -11,8 +11,7 @@ import numpy as np
 from navsim.navigation.celestial import floor_ned
 from navsim.navigation.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
 from navsim.typeset.figures import COLORS, new_figure
-from startrack import units
-from startrack.sphere import azimuthal_equidistant, radec_to_vector, vector_to_radec
+from startrack import azimuthal_equidistant, radec_to_vector, units, vector_to_radec
 
 NED = ("north", "east", "down")
 #: The radius of the ground-track map's sphere [km] (IUGG mean radius, (2a + b)/3 of WGS-84).

@@ -46,16 +46,14 @@ from navsim.sensors.celestial_aiding import CelestialAidingRun
 from navsim.sensors.faults import apply_bias_steps
 from navsim.truth import trajectory
 from navsim.truth.sky import SkyTruth
+from startrack import InputError, load_star_catalog, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
 
-#: The lanes of a run compiled ahead (:mod:`startrack.precompile`) at image fidelity: the identifier's and
+#: The lanes of a run compiled ahead (:mod:`startrack.compiled.compile_ahead`) at image fidelity: the identifier's and
 #: the position fit's (the INS's kernels compile at first call).
-IMAGE_LANES = (("startrack.identify.warmup:pattern_search",),
-               ("navsim.sensors.warmup:inertial_sensors", "startrack.identify.warmup:star_tracking",
-                "startrack.warmup:psf_fit"))
+IMAGE_LANES = (("startrack.compile_tasks:pattern_search",),
+               ("navsim.sensors.warmup:inertial_sensors", "startrack.compile_tasks:star_tracking",
+                "startrack.compile_tasks:psf_fit"))
 #: Without a star sensor or at vector fidelity: one lane (a campaign's parent compiles it once for its workers).
 VECTOR_LANES = (("navsim.navigation.warmup:run",),)
 

@@ -7,7 +7,7 @@ segment that cannot be flown is named), the IMU (a gyro and an accelerometer, ea
 datasheet fields), an optional baro, position aiding (none: a free INS), an optional star sensor
 (SINS/CNS: the attitude kind's star-sensor keys and its faults), an optional gravity disturbance and
 the filter, whose noise and initial σ come from the datasheets unless given.
-Every problem is one :class:`~startrack.errors.InputError` naming the file, the key and what is wrong.
+Every problem is one :class:`~startrack.base.errors.InputError` naming the file, the key and what is wrong.
 """
 
 import dataclasses
@@ -19,11 +19,20 @@ from navsim.estimation.treatments import TREATMENTS
 from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import ACCELEROMETER_ERRORS, GYRO_ERRORS, MAX_ARCSEC
 from navsim.scenario.schema import REQUIRED, ListOfTables, Table, Tagged, Value, is_multiple
-from navsim.scenario.star_sensor_fields import FAULTS, IDENTIFICATION, PHOTOMETRY, REFRACTION, STAR_SENSOR, check_faults, check_star_sensor, mounting
+from navsim.scenario.star_sensor_fields import (
+    FAULTS,
+    IDENTIFICATION,
+    PHOTOMETRY,
+    REFRACTION,
+    STAR_SENSOR,
+    check_faults,
+    check_star_sensor,
+    mounting,
+)
 from navsim.scenario.star_sensor_presets import PRESETS, with_preset
 from navsim.truth import route, segments, trajectory
+from startrack import InputError
 from startrack import rotation as rot
-from startrack.errors import InputError
 
 #: Bounds: speed [m/s] (below orbital speed), height [m] (the ellipsoid +/- ), a segments start's latitude [deg]
 #: (headings from north are singular at the poles: routes go there), a segment's duration [s].

@@ -21,7 +21,7 @@ JULIAN_YEAR_S = 365.25 * 86400.0
 def frame_sky(scenario, geometry, path, frame_k, photometry, q_BS_true):
     """The :class:`FrameSky` of the frames (samples ``frame_k`` of the trajectory ``path``) with the exclusions'
     :class:`~navsim.navigation.exclusion.SkyGeometry` ``geometry``, for the sensor of light budget ``photometry``
-    (:class:`startrack.sensor_photometry.SensorPhotometry`) mounted at ``q_BS_true``."""
+    (:class:`startrack.image.sensor_photometry.SensorPhotometry`) mounted at ``q_BS_true``."""
     site = scenario["star_sensor"]["photometry"]
     h = path.h[frame_k]
     sight = Sightline(zenith=0.5 * np.pi - geometry.boresight_elevation, sun_zenith=0.5 * np.pi - geometry.sun_elevation,

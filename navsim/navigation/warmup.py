@@ -1,4 +1,4 @@
-"""The compile-ahead task of a navigation run (:mod:`startrack.precompile`; :data:`navsim.navigation.run.VECTOR_LANES`)."""
+"""The compile-ahead task of a navigation run (:mod:`startrack.compiled.compile_ahead`; :data:`navsim.navigation.run.VECTOR_LANES`)."""
 
 from navsim.navigation import run as navigation_run
 from navsim.navigation.scenario import validate

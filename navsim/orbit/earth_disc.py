@@ -23,7 +23,7 @@ import numpy as np
 from navsim.earth.wgs84 import A as R_EARTH
 from navsim.earth.wgs84 import F as FLATTENING
 from navsim.orbit.eclipse import stretched
-from startrack.sphere import angular_distance
+from startrack import angular_distance
 
 
 @dataclass(frozen=True)

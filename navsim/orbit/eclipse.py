@@ -16,7 +16,7 @@ import numpy as np
 
 from navsim.earth.wgs84 import A as R_EARTH
 from navsim.earth.wgs84 import F as FLATTENING
-from startrack.sphere import angular_distance
+from startrack import angular_distance
 
 #: The Sun's radius [m] (IAU 2015 nominal R_☉).
 R_SUN = 6.957e8

@@ -14,7 +14,7 @@ import numpy as np
 
 from navsim.earth.wgs84 import GM
 from navsim.earth.wgs84 import A as R_EARTH
-from startrack.errors import InputError
+from startrack import InputError
 
 #: J2 of EGM2008: −√5 C̄20 (the normalised coefficient, Pavlis et al. 2012).
 J2 = -np.sqrt(5.0) * -4.84165143790815e-4

@@ -21,7 +21,7 @@ from navsim.earth.wgs84 import GM, OMEGA_IE
 from navsim.earth.wgs84 import A as R_EARTH
 from navsim.earth.wgs84 import F as FLATTENING
 from navsim.orbit.elements import J2
-from startrack.errors import InputError
+from startrack import InputError
 
 #: Vallado's Table 8-4: base height [km], density at it [kg/m³], scale height [km].
 EXPONENTIAL_ATMOSPHERE = np.array([

@@ -19,7 +19,7 @@ import numpy as np
 from sgp4.api import WGS72, Satrec
 
 from navsim.earth.frames import c_ei, slowly, utc_epoch, utc_offsets_extrapolated
-from startrack.errors import InputError
+from startrack import InputError
 
 #: SGP4's error codes (sgp4.api.SGP4_ERRORS, Vallado's sgp4unit).
 SGP4_ERRORS = {1: "the mean eccentricity is outside [0, 1)", 2: "the mean motion is below 0",

@@ -20,7 +20,7 @@ from navsim.report.budget import budget_report
 from navsim.report.covariance import covariance_report, sweep_report
 from navsim.report.study import load_study, study_report
 from navsim.typeset.inputs import campaign_runs, directory_kind, load_campaign, load_run, read_json
-from startrack.errors import InputError
+from startrack import InputError
 
 __all__ = ["write_report"]
 

@@ -14,7 +14,7 @@ from navsim.typeset import figures
 from navsim.typeset.document import Document, markup, number, scenario_name, table
 from navsim.typeset.inputs import read_json
 from navsim.typeset.sections import comparison_section, notes_section, scenario_section
-from startrack.errors import InputError
+from startrack import InputError
 
 
 def study_report(study) -> bytes:

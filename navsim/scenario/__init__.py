@@ -13,7 +13,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from startrack.errors import InputError
+from startrack import InputError
 
 
 @dataclass(frozen=True)

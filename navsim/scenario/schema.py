@@ -1,6 +1,6 @@
 """A small strict schema for nested TOML tables: types, ranges, choices, defaults.
 
-Every problem is reported as one :class:`~startrack.errors.InputError` naming the file, the
+Every problem is reported as one :class:`~startrack.base.errors.InputError` naming the file, the
 dotted key and what is wrong ("demo.toml: gyro.rate_hz: must be > 0, got -1").
 """
 
@@ -8,7 +8,7 @@ import copy
 from dataclasses import dataclass, field
 from typing import Any
 
-from startrack.errors import InputError
+from startrack import InputError
 
 REQUIRED = object()
 

@@ -3,11 +3,8 @@
 
 from navsim.scenario.inertial_fields import MAX_ARCSEC, MAX_BIAS
 from navsim.scenario.schema import ListOfTables, Table, Value
+from startrack import BANDS, DETECTORS, InputError, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.bands import BANDS
-from startrack.detectors import DETECTORS
-from startrack.errors import InputError
 
 #: The star sensor's keys: fidelity, measurement, rate, field, noise, mounting and the image table.
 STAR_SENSOR = {
@@ -87,7 +84,7 @@ PHOTOMETRY = Table(
         "transmission": Value("float", default=0.8, exclusive_minimum=0.0, maximum=1.0,
                               doc="of the optics and filter in the band"),
         "detector": Value("str", default="silicon_cmos", choices=tuple(DETECTORS),
-                          doc="the detector preset (startrack.detectors); the keys below override its values"),
+                          doc="the detector preset (startrack.photometry.detectors); the keys below override its values"),
         "qe": Value("float", default=None, exclusive_minimum=0.0, maximum=1.0,
                     doc="quantum efficiency in the band (default: the preset's at the band's centre)"),
         "read_noise_e": Value("float", default=None, minimum=0.0, maximum=1e5),
@@ -229,10 +226,10 @@ def _apply_camera_file(image, source):
     and sets ``width_px`` and ``height_px``; build.py takes the camera from it."""
     if image.get("camera_file") is None:
         return
-    from startrack.camera import Camera
+    from startrack import read_camera_file
 
     try:
-        camera = Camera.from_file(image["camera_file"])
+        camera = read_camera_file(image["camera_file"]).camera
     except InputError as error:
         raise InputError(f"{source}: star_sensor.image.camera_file: {error}") from None
     image["width_px"], image["height_px"] = camera.width, camera.height

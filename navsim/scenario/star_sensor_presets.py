@@ -2,7 +2,7 @@
 a representative design as a bundle of the star sensor's keys, each of which the scenario may still set itself.
 
 - ``swir_day_3deg`` — a narrow-field short-wave infrared sensor for daytime flight (issue 30): H band, an InGaAs
-  array of 640 x 512 pixels of 15 µm (``startrack.detectors``' ``ingaas_swir``), 100 mm aperture and a 3° field
+  array of 640 x 512 pixels of 15 µm (``startrack.photometry.detectors``' ``ingaas_swir``), 100 mm aperture and a 3° field
   (focal length 183 mm, f/1.8), 10 ms exposures, its catalog to H = 7. At 12 km with the Sun 34-50° up and 80° away
   it reaches H 4.5 against an H sky of 9.3 mag/arcsec² (``scenarios/sins_cns_aircraft_day.toml``).
 - ``swir_day_1deg`` — the same array behind a 150 mm aperture at a 1° field (focal length 550 mm, f/3.7), the
@@ -16,7 +16,7 @@ A preset fills only the keys the scenario leaves unset (:func:`with_preset`), so
 keys win; the checked scenario keeps the preset's name beside the values it gave.
 """
 
-from startrack.errors import InputError
+from startrack import InputError
 
 #: The presets (module docstring): the star sensor's keys they set, tables as dictionaries.
 PRESETS = {

@@ -13,7 +13,7 @@ divided by Δt), f = a − g in body axes (at rest on a level table, NED body ax
 - then saturation and quantisation of the accumulated velocity to the LSB.
 
 The synthesis is :func:`navsim.sensors.inertial.synthesize`, shared with the gyro (same seeding).
-Units: SI (m/s², m/s/√s) inside; datasheet conversions in :mod:`startrack.units` (µg, m/s/√h).
+Units: SI (m/s², m/s/√s) inside; datasheet conversions in :mod:`startrack.base.units` (µg, m/s/√h).
 """
 
 from dataclasses import dataclass, field

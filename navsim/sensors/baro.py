@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from startrack.errors import InputError
+from startrack import InputError
 
 
 @dataclass(frozen=True)

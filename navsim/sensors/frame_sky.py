@@ -3,7 +3,7 @@ sensor's band, the air between the sensor and each star, and the trail a star le
 
 Built once per scenario before the runs (seed-free: the nominal truth's geometry,
 :func:`navsim.navigation.sky_background.frame_sky`); a star sensor with a light budget
-(:class:`startrack.sensor_photometry.SensorPhotometry`) takes it to decide which stars of a frame it detects
+(:class:`startrack.image.sensor_photometry.SensorPhotometry`) takes it to decide which stars of a frame it detects
 and how well it places them, at vector fidelity (:mod:`navsim.sensors.star_vector`) and at image fidelity
 (:mod:`navsim.sensors.star_image`: the frame's sky level and the stars' extinguished magnitudes drawn). The
 sky is one level across the field (its gradient over a star sensor's field is a few tenths of a magnitude
@@ -41,14 +41,14 @@ class FrameSky:
 
     def measure(self, frames, seen):
         """(detected (M,), σ (M,) [rad], saturated (M,)) of stars of magnitudes ``seen`` through the air
-        (:meth:`extinguished`) at the frames ``frames`` (:meth:`startrack.sensor_photometry.SensorPhotometry.measure`)."""
+        (:meth:`extinguished`) at the frames ``frames`` (:meth:`startrack.image.sensor_photometry.SensorPhotometry.measure`)."""
         with np.errstate(over="ignore"):
             detected, sigma, saturated = self.photometry.measure(seen, self.sky_e_per_px_s[frames], self.smear_px[frames])
         return detected & np.isfinite(seen), sigma, saturated
 
     def magnitude_sigma(self, frames, seen):
         """σ_m (M,) [mag] of the measured magnitudes of stars of magnitudes ``seen`` through the air at the frames
-        ``frames`` (:meth:`startrack.sensor_photometry.SensorPhotometry.magnitude_sigma`)."""
+        ``frames`` (:meth:`startrack.image.sensor_photometry.SensorPhotometry.magnitude_sigma`)."""
         with np.errstate(over="ignore"):
             return self.photometry.magnitude_sigma(seen, self.sky_e_per_px_s[frames])
 

@@ -17,7 +17,7 @@ Output sample k is the measured rate averaged over its interval [t_(k-1), t_k] o
 - then saturation (clip to ± saturation) and quantisation of the accumulated angle to the
   LSB (so quantisation error does not accumulate).
 
-Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`startrack.units`.
+Units: SI (rad, s) inside; conversions from datasheet units are in :mod:`startrack.base.units`.
 """
 
 from dataclasses import dataclass, field

@@ -15,7 +15,7 @@ quantisation of the accumulated increment.
 
 import numpy as np
 
-from startrack.jit import njit
+from startrack import njit
 
 #: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
 #: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,

@@ -6,14 +6,14 @@ crosses the sensitive layer of thickness t at an incidence θ drawn from the cos
 plane (cos θ = √U) and an azimuth uniform in [0, 2π): its track on the pixels is t tan θ / p long (p the pixel
 pitch), from a uniform point; it leaves Q = q t / cos θ electrons (q per µm of path: ~80 e⁻/µm for a minimum-ionising
 particle, several hundred for the tens of MeV of the anomaly's protons), spread by a log-normal of σ ``spread`` (a
-stand-in for the Landau tail; its mean kept), along the track (:func:`startrack.render.cosmic_ray`, no optics).
+stand-in for the Landau tail; its mean kept), along the track (:func:`startrack.image.render.cosmic_ray`, no optics).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.render import cosmic_ray
+from startrack import cosmic_ray
 
 
 @dataclass(frozen=True)

@@ -27,8 +27,8 @@ from navsim.sensors.recorded_run import RecordedRun
 from navsim.sensors.star_image import LOG_FIELDS, TIMING_FIELDS
 from navsim.sensors.star_sensor import StarFrame, isotropic_covariance
 from navsim.sensors.star_vector import Record, StarFrames
+from startrack import aberrate
 from startrack import rotation as rot
-from startrack.aberration import aberrate
 
 
 @dataclass(frozen=True)

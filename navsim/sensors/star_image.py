@@ -18,7 +18,7 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    corrected by the sub-pixel phases the predictions give (an extension of 004: integer shifts alone
    leave ~0.25 px per axis);
 5. one unit vector per identified star, its position fitted at the Cramér-Rao bound with the smear the
-   predicted rate gives (:mod:`startrack.psf_fit`) and its 2 x 2 covariance carried into the sensor frame
+   predicted rate gives (:mod:`startrack.image.psf_fit`) and its 2 x 2 covariance carried into the sensor frame
    (correlated along the trail; an outlier's scaled by its measured χ²/dof; a star whose fit failed, or
    whose window another catalog star's light reaches -- a blend, which overlapping trails of a turning
    camera hide from the χ² -- not fused), the stacked dim star last with its own measured σ; the
@@ -38,15 +38,23 @@ import numpy as np
 from navsim import kinematics
 from navsim.earth.apparent import field_stars
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covariance
+from startrack import (
+    DimStarCache,
+    PixelNoise,
+    Prior,
+    Windows,
+    concatenate_fits,
+    cosmic_ray,
+    detect,
+    detect_windows,
+    fit_stars,
+    neighbour_reach,
+    render_star_field,
+)
 from startrack import rotation as rot
-from startrack.detection import detect, detect_windows
-from startrack.identify.identifier import Prior
-from startrack.psf_fit import PixelNoise, concatenate, fit_stars, neighbour_reach
-from startrack.render import Windows, cosmic_ray, render_star_field
-from startrack.stacking import DimStarCache
 
 #: σ per axis of a stacked dim-star centroid [px]. The loop uses the phase-corrected centroid
-#: (startrack.stacking: integer shifts average the 4 frames' sub-pixel phases, ~0.25 px per axis, and
+#: (startrack.image.stacking: integer shifts average the 4 frames' sub-pixel phases, ~0.25 px per axis, and
 #: the filter's predictions put the phase back); measured in scenarios/paper004_dim_star.toml over
 #: 24 seeds (176 stacked frames): (0.35, 0.25) px RMS in (u, v), against (0.45, 0.38) px uncorrected.
 STACKED_SIGMA_PX = 0.30
@@ -69,7 +77,7 @@ class ImageStarSensor:
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
     tracked (004's set-up), the true mounting and the faults; with a light budget (``photometry``) the frames'
     sky (``sky``). Each fused star's direction and its covariance come from its position fit
-    (:mod:`startrack.psf_fit`); the drawn stars are also the catalog the fit's neighbours come from. On a spacecraft:
+    (:mod:`startrack.image.psf_fit`); the drawn stars are also the catalog the fit's neighbours come from. On a spacecraft:
     the particle hits of its orbit (``radiation``, a :class:`navsim.sensors.radiation_hits.RadiationHits`) and the
     stars the Earth hides (``occultation``, a :class:`navsim.orbit.earth_disc.EarthDisc` of the frames)."""
 
@@ -242,7 +250,7 @@ class ImageRun:
         return frame.image, windows, found
 
     def _fit(self, image, windows, uv, ref_I, request):
-        """The PSF fits (:func:`startrack.psf_fit.fit_stars`) of the identified stars' detections ``uv`` (N, 2)
+        """The PSF fits (:func:`startrack.image.psf_fit.fit_stars`) of the identified stars' detections ``uv`` (N, 2)
         in the full frame or in the readout window holding each, with the smear the predicted attitude and
         rate give each star over the exposure: positions at the Cramér-Rao bound with their covariance."""
         s, model = self.sensor, self.sensor.frame_model(request.index)
@@ -260,7 +268,7 @@ class ImageRun:
         holder = np.argmin(np.abs(uv[:, None, :] - centres[None]).max(axis=2), axis=1) if len(uv) else np.zeros(0, int)
         fits = [fit_stars(image[w], uv[k:k + 1], smear_px=smear[k], origin=(windows.row0[w], windows.col0[w]),
                           neighbours=near[k:k + 1], **common) for k, w in enumerate(holder)]
-        return concatenate(fits) if fits else fit_stars(image[0], np.zeros((0, 2)), **common)
+        return concatenate_fits(fits) if fits else fit_stars(image[0], np.zeros((0, 2)), **common)
 
     def _neighbours(self, q_IS_pred, ref_I, smear_px):
         """For each identified star of catalog direction ``ref_I`` (N, 3), the predicted centres (M, 2) [px] of

@@ -25,7 +25,7 @@ from navsim.sensors.recorded_run import RecordedRun
 from navsim.sensors.star_prior import Detections, PriorIdentifiedRun
 from navsim.sensors.star_sensor import StarFrame, isotropic_covariance
 from startrack import rotation as rot
-from startrack.sphere import tangent_basis
+from startrack import tangent_basis
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ class StarVectorSensor:
     ``star_vectors`` (M, 3) unit vectors in I, ``star_ids`` (M,), ``star_mags`` (M,) in the sensor's band;
     ``fov`` full cone angle [rad]; ``sigma`` 1σ direction error per tangent axis [rad]; ``max_stars`` the
     most (brightest) stars reported; ``q_BS_true`` true mounting. With a light budget (``photometry``, a
-    :class:`startrack.sensor_photometry.SensorPhotometry`) and the frames' sky (``sky``, a
+    :class:`startrack.image.sensor_photometry.SensorPhotometry`) and the frames' sky (``sky``, a
     :class:`navsim.sensors.frame_sky.FrameSky`) a star is reported when the frame's sky lets the sensor detect
     it, with the σ of its own SNR, instead of every star with ``sigma``. On a spacecraft (``occultation``, a
     :class:`navsim.orbit.earth_disc.EarthDisc` of the frames) the stars behind the Earth are not seen.

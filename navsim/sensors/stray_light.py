@@ -45,7 +45,7 @@ class StrayLight:
     @classmethod
     def of_earth(cls, limb_angle, earth_ratio, band, baffle, pixel_um, qe):
         """The level of the Earth at ``earth_ratio`` (F,) of the Sun's irradiance whose limb is ``limb_angle`` (F,)
-        [rad] from the boresight, in the :class:`startrack.bands.Band` ``band`` (module docstring)."""
+        [rad] from the boresight, in the :class:`startrack.photometry.bands.Band` ``band`` (module docstring)."""
         sun = band.photons_zero * 10.0 ** (-0.4 * SUN_MAGNITUDE[band.name])
         return cls(sky_e_per_px_s=baffle.pst(limb_angle) * earth_ratio * sun * (1e-6 * pixel_um) ** 2 * qe)
 

@@ -1,4 +1,4 @@
-"""The compile-ahead task of the inertial sensors (:mod:`startrack.precompile`; the run kinds' ``lanes``)."""
+"""The compile-ahead task of the inertial sensors (:mod:`startrack.compiled.compile_ahead`; the run kinds' ``lanes``)."""
 
 import numpy as np
 

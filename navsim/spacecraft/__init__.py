@@ -11,7 +11,7 @@ attitude kind (its filter configuration, campaign pooling and report sections). 
 interface of :mod:`navsim.kinds`, each loaded on first use.
 """
 
-from startrack.lazy import lazy_exports
+from startrack import lazy_exports
 
 #: The kind's name, and the table that marks a scenario of it.
 NAME, TABLE = "spacecraft", "orbit"

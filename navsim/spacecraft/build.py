@@ -18,11 +18,8 @@ from navsim.sensors.radiation_hits import RadiationHits
 from navsim.sensors.stray_light import Baffle, StrayLight
 from navsim.truth.pointing import Nadir, SunPointing, Targets
 from navsim.truth.spacecraft import Controller, Spacecraft, Wheels
+from startrack import InputError, band, quaternion_from_radec_roll, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.attitude_angles import quaternion_from_radec_roll
-from startrack.bands import band
-from startrack.errors import InputError
 
 #: The pyramid's wheel elevation above the body's x-y plane [rad]: atan(1/√2), the four axes equally spread.
 PYRAMID_ELEVATION = np.arctan(1.0 / np.sqrt(2.0))

@@ -6,8 +6,8 @@ import functools
 
 from navsim.attitude.covariance import COVARIANCE_QUANTITIES, run_errors
 from navsim.spacecraft.build import mountings
+from startrack import InputError
 from startrack import rotation as rot
-from startrack.errors import InputError
 
 #: The error sources of a covariance analysis: none (it is not built).
 COVARIANCE_SOURCES = {}

@@ -16,9 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.orbit.earth_disc import EarthDisc
+from startrack import angular_distance, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.sphere import angular_distance
 
 #: The reasons of an excluded frame, in the order they are tested.
 REASONS = ("Sun in the exclusion cone", "Moon in the exclusion cone", "Earth's limb in the exclusion cone")

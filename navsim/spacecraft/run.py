@@ -38,11 +38,8 @@ from navsim.spacecraft.exclusion import excluding, head_sky
 from navsim.spacecraft.summary import summarize
 from navsim.truth.pointing import reference_rates
 from navsim.truth.profiles import TruthRecord, interval_mean_rates
+from startrack import InputError, earth_barycentric_velocity, load_star_catalog, units
 from startrack import rotation as rot
-from startrack import units
-from startrack.aberration import earth_barycentric_velocity
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@ orbit, the attitude law, the rigid body with its wheels and controller, the gyro
 (``[[star_sensor]]``, each with its mounting, field, exclusions and faults) and the attitude filter.
 
 Its strict schema (:data:`SCHEMA`: units in the key names, every value bounded) and cross-key rules
-(:func:`validate`); every problem is one :class:`~startrack.errors.InputError` naming the file, the key and what is
+(:func:`validate`); every problem is one :class:`~startrack.base.errors.InputError` naming the file, the key and what is
 wrong: an impossible TLE, an orbit below the surface, an unknown attitude law, a head without its mounting.
 """
 
@@ -18,7 +18,7 @@ from navsim.scenario import checked_table
 from navsim.scenario.inertial_fields import GYRO_ERRORS, MAX_RATE
 from navsim.scenario.schema import ListOfTables, Table, Value, is_multiple
 from navsim.scenario.star_sensor_fields import FAULTS, STAR_SENSOR, check_faults, check_star_sensor
-from startrack.errors import InputError
+from startrack import InputError
 
 #: The attitude laws (navsim.truth.pointing) and the orbit propagators (navsim.orbit).
 LAWS, PROPAGATORS = ("nadir", "sun", "targets"), ("sgp4", "numerical")

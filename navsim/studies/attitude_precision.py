@@ -22,12 +22,17 @@ import numpy as np
 
 from navsim.scenario.schema import Table, Value
 from navsim.studies.common import percent, progress_bar
-from startrack.attitude import SOLVERS, cramer_rao_covariance, get_solver
-from startrack.attitude_angles import quaternion_from_radec_roll, radec_roll_from_quaternion
-from startrack.fov_select import radec_window
-from startrack.rotation import from_matrix, to_matrix
-from startrack.sphere import radec_to_vector
-from startrack.units import ARCSEC
+from startrack import (
+    SOLVERS,
+    cramer_rao_covariance,
+    get_solver,
+    quaternion_from_radec_roll,
+    radec_roll_from_quaternion,
+    radec_to_vector,
+    radec_window,
+    units,
+)
+from startrack import rotation as rot
 
 ANGLES = ("alpha", "delta", "kappa")
 DISTRIBUTIONS = ("radec_window", "uniform", "clustered", "line")
@@ -79,7 +84,7 @@ class SquareSensor:
     def __init__(self, fov, pixel_arcsec):
         self.fov = fov
         self.pixel_arcsec = pixel_arcsec
-        self.focal = 1.0 / np.tan(pixel_arcsec * ARCSEC)    # px
+        self.focal = 1.0 / np.tan(pixel_arcsec * units.ARCSEC)    # px
         self.half = self.focal * np.tan(fov / 2)
 
     def directions(self, xy):
@@ -96,7 +101,7 @@ def angle_errors(q, q_true):
 
 def angle_jacobian(q_true, step=1e-6):
     """∂(α, δ, κ)/∂δθ (3 x 3) for R = R_true exp([δθ×]) (central differences)."""
-    R = to_matrix(q_true)
+    R = rot.to_matrix(q_true)
     J = np.zeros((3, 3))
     for k in range(3):
         columns = []
@@ -105,7 +110,7 @@ def angle_jacobian(q_true, step=1e-6):
             K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
             angle = sign * step
             R_k = R @ (np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K)
-            columns.append(angle_errors(from_matrix(R_k), q_true))
+            columns.append(angle_errors(rot.from_matrix(R_k), q_true))
         J[:, k] = (columns[0] - columns[1]) / (2 * step)
     return J
 
@@ -142,7 +147,7 @@ def star_field(rng, sensor, n, distribution, R_IS, boresight):
 def simulate_point(rng, sensor, n, sigma_arcsec, trials, q_true, distribution, solvers):
     """Monte Carlo of 003 §3.1 at one point: per solver the RMS (α, δ, κ) ["], the largest |error| and
     the first-order prediction, and the Cramér-Rao RMS."""
-    R_IS = to_matrix(q_true)
+    R_IS = rot.to_matrix(q_true)
     J = angle_jacobian(q_true)
     boresight = radec_roll_from_quaternion(q_true)[:2]
     sigma_px = sigma_arcsec / sensor.pixel_arcsec
@@ -160,13 +165,13 @@ def simulate_point(rng, sensor, n, sigma_arcsec, trials, q_true, distribution, s
         for name, solver in solver_of.items():
             errors[name].append(angle_errors(solver.solve(ref, obs, unit_sigma).q_IS, q_true))
             predicted[name].append(scale * np.diag(J @ solver.solve(ref, exact, unit_sigma).P @ J.T))
-    result = {"stars": n, "sigma_arcsec": sigma_arcsec, "crb_rms_arcsec": (np.sqrt(np.mean(crb, axis=0)) / ARCSEC).tolist()}
+    result = {"stars": n, "sigma_arcsec": sigma_arcsec, "crb_rms_arcsec": (np.sqrt(np.mean(crb, axis=0)) / units.ARCSEC).tolist()}
     for name in solvers:
         e = np.array(errors[name])
         result[name] = {
-            "rms_arcsec": (np.sqrt(np.mean(e ** 2, axis=0)) / ARCSEC).tolist(),
-            "max_abs_arcsec": (np.abs(e).max(axis=0) / ARCSEC).tolist(),
-            "predicted_rms_arcsec": (np.sqrt(np.mean(predicted[name], axis=0)) / ARCSEC).tolist(),
+            "rms_arcsec": (np.sqrt(np.mean(e ** 2, axis=0)) / units.ARCSEC).tolist(),
+            "max_abs_arcsec": (np.abs(e).max(axis=0) / units.ARCSEC).tolist(),
+            "predicted_rms_arcsec": (np.sqrt(np.mean(predicted[name], axis=0)) / units.ARCSEC).tolist(),
         }
     return result
 

@@ -26,15 +26,20 @@ from scipy.spatial.transform import Rotation
 
 from navsim.scenario.schema import Table, Value
 from navsim.studies.common import progress_bar
+from startrack import (
+    Camera,
+    NavigationCatalogParams,
+    StarIdentifier,
+    angular_distance,
+    centroid_frame,
+    load_navigation_catalog,
+    load_star_catalog,
+    matrix_from_radec_roll,
+    random_attitude,
+    units,
+    vector_to_radec,
+)
 from startrack import boresight as bs
-from startrack.attitude_angles import matrix_from_radec_roll
-from startrack.camera import Camera
-from startrack.identify import StarIdentifier
-from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-from startrack.sphere import angular_distance, vector_to_radec
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame, random_attitude
-from startrack.units import ARCSEC
 
 FALSE_MATCH_ARCSEC = 60.0
 TRIPLE_METHODS = ("scalar_known_f_normalised", "scalar_known_f_linearised", "scalar_unknown_f_numeric",
@@ -190,7 +195,7 @@ def identification_maps(identifier, camera, stars, maps, false_stars, sigma_px, 
             error = (Rotation.from_quat(result.q_IS).inv() * Rotation.from_quat(frame.q_IS)).as_rotvec()
             crb = np.sqrt(np.diag(result.covariance))
             wrong_ids = bool(np.any(frame.hip[result.matches[:, 0]] != result.matches[:, 1]))
-            false = wrong_ids or np.hypot(error[0], error[1]) > FALSE_MATCH_ARCSEC * ARCSEC
+            false = wrong_ids or np.hypot(error[0], error[1]) > FALSE_MATCH_ARCSEC * units.ARCSEC
             matched = len(result.matches)
         for key, value in (("ok", result.ok and not false), ("false", false), ("ms", result.solve_ms),
                            ("stars", int(np.count_nonzero(frame.hip))), ("matched", matched), ("error", error),
@@ -211,7 +216,7 @@ def run(params, seed, progress=False):
     geometry = MapGeometry(p)
     stars = load_star_catalog().brighter_than(p["mag_limit"])
     optical_seed, identification_seed = np.random.SeedSequence(seed).spawn(2)
-    summary = {"focal_px": geometry.focal, "sigma_arcsec": p["centroid_sigma_px"] / geometry.focal / ARCSEC,
+    summary = {"focal_px": geometry.focal, "sigma_arcsec": p["centroid_sigma_px"] / geometry.focal / units.ARCSEC,
                "catalog_stars": len(stars)}
     arrays = {}
     if p["maps"]:
@@ -245,14 +250,14 @@ def run(params, seed, progress=False):
 def optical_summary(arrays):
     n = arrays["optical_stars"]
     out = {"maps": int(n.size), "stars_per_map": {"mean": float(n.mean()), "min": int(n.min()), "max": int(n.max())},
-           "crb_rms_arcsec": {key: rms(arrays[f"optical_{key}"]) / ARCSEC
+           "crb_rms_arcsec": {key: rms(arrays[f"optical_{key}"]) / units.ARCSEC
                               for key in ("crb_scalar_triple", "crb_vector_triple", "crb_scalar", "crb_vector")},
            "rms_arcsec": {}, "median_arcsec": {}, "failures": {}}
     for method in TRIPLE_METHODS + ALL_STAR_METHODS:
         values = arrays[f"optical_{method}"]
         attempted = values if method != "vector_all_constrained_ipopt" else values[np.isfinite(arrays["optical_casadi_ms"])]
-        out["rms_arcsec"][method] = rms(attempted) / ARCSEC
-        out["median_arcsec"][method] = float(np.nanmedian(attempted) / ARCSEC) if np.isfinite(attempted).any() else None
+        out["rms_arcsec"][method] = rms(attempted) / units.ARCSEC
+        out["median_arcsec"][method] = float(np.nanmedian(attempted) / units.ARCSEC) if np.isfinite(attempted).any() else None
         out["failures"][method] = int(np.count_nonzero(~np.isfinite(attempted)))
     casadi = arrays["optical_casadi_ms"][np.isfinite(arrays["optical_casadi_ms"])]
     out["casadi_maps"] = int(casadi.size)
@@ -272,7 +277,7 @@ def optical_summary(arrays):
 
 def identification_summary(rows, gate, sigma_px):
     ok = rows["ok"]
-    error, crb = rows["error"][ok] / ARCSEC, rows["crb"][ok] / ARCSEC
+    error, crb = rows["error"][ok] / units.ARCSEC, rows["crb"][ok] / units.ARCSEC
     ms = rows["ms"]
     return {
         "gate_sigmas": gate, "gate_px": gate * sigma_px, "maps": int(ok.size),
@@ -382,7 +387,7 @@ def figures(summary, arrays, params):
                   ("vector a, all stars (001 Fig. 3.4)", ALL_STAR_METHODS[2:], "crb_vector"))
         fig, axes = plt.subplots(2, 2, figsize=(10, 6.4))
         for ax, (title, methods, bound) in zip(axes.ravel(), groups):
-            values = {m: arrays[f"optical_{m}"] / ARCSEC for m in methods}
+            values = {m: arrays[f"optical_{m}"] / units.ARCSEC for m in methods}
             finite = np.concatenate([v[np.isfinite(v)] for v in values.values()])
             bins = np.linspace(0.0, np.percentile(finite, 99), 40)
             for m, v in values.items():

@@ -18,10 +18,8 @@ import numpy as np
 
 from navsim.sensors.star_image import STACKED_SIGMA_PX
 from navsim.studies import common
+from startrack import SvdWahba, ThreeStarOptimal, Triad, cramer_rao_covariance, radec_roll_from_quaternion, units
 from startrack import rotation as rot
-from startrack.attitude import SvdWahba, ThreeStarOptimal, Triad, cramer_rao_covariance
-from startrack.attitude_angles import radec_roll_from_quaternion
-from startrack.units import ARCSEC
 
 KEY = "dim_star"
 SOLVERS = ("two_star_triad", "three_star_optimal", "three_star_svd_weighted")
@@ -147,7 +145,7 @@ class DimStarRun:
 
 
 def _rms_arcsec(values, axis=0):
-    return np.sqrt(np.mean(np.square(values), axis=axis)) / ARCSEC
+    return np.sqrt(np.mean(np.square(values), axis=axis)) / units.ARCSEC
 
 
 def _statistics(logs, filters, steady):
@@ -170,8 +168,8 @@ def _statistics(logs, filters, steady):
         if logs[name]:
             variance = np.mean(logs[name], axis=0)
             out[name[:-2]] = {"frames": len(logs[name]),
-                              "rms_cross_roll_arcsec": [float(np.sqrt(0.5 * (variance[0] + variance[1])) / ARCSEC),
-                                                        float(np.sqrt(variance[2]) / ARCSEC)]}
+                              "rms_cross_roll_arcsec": [float(np.sqrt(0.5 * (variance[0] + variance[1])) / units.ARCSEC),
+                                                        float(np.sqrt(variance[2]) / units.ARCSEC)]}
     if filters is not None:
         for name, err in zip(("filter_with_stacking", "filter_without_stacking"), filters):
             out[name] = {"rms_xyz_arcsec": [float(v) for v in _rms_arcsec(err[steady])]}

@@ -11,8 +11,8 @@ by trial.
 import numpy as np
 
 from navsim.studies import common
+from startrack import Prior, StarIdentifier
 from startrack import rotation as rot
-from startrack.identify.identifier import Prior, StarIdentifier
 
 KEY = "tracking_failure_probes"
 METHODS = ("subcatalog", "lost_in_space")

@@ -22,8 +22,7 @@ import numpy as np
 from navsim.earth.frames import OMEGA_IE, earth_rate_n, transport_rate_n
 from navsim.earth.wander import axis_of, geodetic, q_ew, transport_of_axis
 from navsim.earth.wgs84 import radii
-from startrack import units
-from startrack.jit import njit
+from startrack import njit, units
 
 #: Gauss-Legendre nodes on [0, 1] and weights (sum 1).
 _X, _W = np.polynomial.legendre.leggauss(4)

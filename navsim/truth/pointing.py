@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from startrack import InputError
 from startrack import rotation as rot
-from startrack.errors import InputError
 
 
 def _unit(x):

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.kinematics_jit import quat_derivative
+from startrack import njit
 from startrack import rotation as rot
-from startrack.jit import njit
 
 
 def _uniform_step(t):

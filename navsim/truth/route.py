@@ -26,9 +26,8 @@ from navsim.earth.wander import normal, q_ew
 from navsim.earth.wgs84 import A
 from navsim.truth import segments, trajectory
 from navsim.truth.level_frames import FreeAzimuth
-from startrack import units
-from startrack.errors import InputError
-from startrack.rotation_jit import quat_to_matrix
+from startrack import InputError, units
+from startrack import rotation_kernels as rk
 
 #: Steepest bank a route may ask for [deg] (a load factor of 2 g).
 MAX_BANK_DEG = 60.0
@@ -168,7 +167,7 @@ def _fly(q, h, entry, leg, first):
 def _miss(q, h, up):
     """The target's horizontal offset (2,) [m] in f from the position q_ef at height ``h`` [m]: (R + h) times the
     horizontal components of its normal ``up`` (e) in f."""
-    d = quat_to_matrix(q).T @ up
+    d = rk.quat_to_matrix(q).T @ up
     return (A + h) * d[:2]
 
 
@@ -177,7 +176,7 @@ def _initial_guess(q, h, entry, first, target, initial):
     target's speed."""
     if q is None:
         q = q_ew(first.lat_deg * units.DEG, first.lon_deg * units.DEG)
-    d = quat_to_matrix(q).T @ target.up
+    d = rk.quat_to_matrix(q).T @ target.up
     course = math.atan2(d[1], d[0])
     arc = math.atan2(math.hypot(d[0], d[1]), -d[2])
     turn = course if initial else (course - entry.heading + np.pi) % (2.0 * np.pi) - np.pi

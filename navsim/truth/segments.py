@@ -9,7 +9,7 @@ continuous and the IMU increments have no steps. Yaw is the heading (no sideslip
 turn banks by atan(V ψ̇ / g0); a climb pitches by the flight-path angle atan(climb / V).
 
 Keys carry their units (``rate_deg_per_s``); every problem raises one
-:class:`~startrack.errors.InputError` naming the key.
+:class:`~startrack.base.errors.InputError` naming the key.
 """
 
 import math
@@ -19,8 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from navsim.truth.level_frames import North
-from startrack import units
-from startrack.errors import InputError
+from startrack import InputError, units
 
 #: The g of the coordinated-turn bank relation tan φ = V ψ̇ / g [m/s²].
 BANK_GRAVITY = units.STANDARD_GRAVITY

@@ -32,9 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.earth.wgs84 import GM
-from startrack.errors import InputError
-from startrack.jit import njit
-from startrack.rotation_jit import quat_multiply, quat_to_matrix
+from startrack import InputError, njit
+from startrack import rotation_kernels as rk
 
 #: The speed [rad/s] over which the wheels' Coulomb friction changes sign (tanh).
 COULOMB_SMOOTHING = 0.1
@@ -146,7 +145,7 @@ def _derivatives(y, tau_m, J, J_inv, G, limits, r_I, out):
     torque[1] -= w2 * H[0] - w0 * H[2]
     torque[2] -= w0 * H[1] - w1 * H[0]
     if mu > 0.0:
-        C = quat_to_matrix(y[0:4])
+        C = rk.quat_to_matrix(y[0:4])
         r_B = C.T @ r_I
         rn2 = r_B[0] ** 2 + r_B[1] ** 2 + r_B[2] ** 2
         scale = 3.0 * mu / (rn2 * rn2 * np.sqrt(rn2))
@@ -169,10 +168,10 @@ def _command(q, omega, h, q_ref, omega_R, domega_R, J, G, G_pinv, gains, integra
     (3,) ∫δq_v dt is advanced by the interval ``control_dt`` [s] in place when ``integrate`` and the error is inside
     :data:`INTEGRAL_ZONE`."""
     conj = np.array([-q_ref[0], -q_ref[1], -q_ref[2], q_ref[3]])
-    dq = quat_multiply(conj, q)
+    dq = rk.quat_multiply(conj, q)
     if dq[3] < 0.0:
         dq = -dq
-    C_BR = quat_to_matrix(dq).T
+    C_BR = rk.quat_to_matrix(dq).T
     omega_r = C_BR @ omega_R
     domega = omega - omega_r
     error = 2.0 * np.arctan2(np.sqrt(np.sum(dq[0:3] * dq[0:3])), dq[3])

@@ -34,8 +34,8 @@ import numpy as np
 
 from navsim.earth.gravity import disturbance_n, normal_gravity
 from navsim.truth.level_frames import NODES, WEIGHTS
+from startrack import InputError
 from startrack import rotation as rot
-from startrack.errors import InputError
 
 CHUNK = 50_000
 

@@ -7,7 +7,7 @@ that raised leaves ``error.json`` instead), with the aggregate in ``summary.json
 :class:`~navsim.records.CampaignSummary`). Which kind's records they are the caller says (the scenario's
 kind, :mod:`navsim.kinds`). Only the arrays a report
 draws are checked; everything optional may be absent. Bad input raises
-:class:`~startrack.errors.InputError` with one sentence naming the file and the problem.
+:class:`~startrack.base.errors.InputError` with one sentence naming the file and the problem.
 """
 
 import json
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack import InputError
 
 #: A finished or failed run's directory (a leftover ``run_NNNNN.partial`` is neither).
 RUN_NAME = re.compile(r"run_\d{5,}")

@@ -12,8 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.pooling import run_averaged_nees
-from startrack import address
-from startrack.errors import InputError
+from startrack import InputError, address
 
 #: A frame counts as identified when at least this many stars were identified (two fix an attitude).
 MIN_IDENTIFIED = 2

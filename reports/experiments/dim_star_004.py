@@ -31,21 +31,21 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 
-from startrack.attitude_angles import quaternion_from_radec_roll, radec_roll_from_quaternion  # noqa: E402
-from startrack.camera import Camera  # noqa: E402
-from startrack.detection import detect, detect_windows  # noqa: E402
-from startrack.photometry import (  # noqa: E402
+from startrack.base.units import DEG  # noqa: E402
+from startrack.camera.model import Camera  # noqa: E402
+from startrack.catalog.hipparcos import load_star_catalog  # noqa: E402
+from startrack.geometry.attitude_angles import quaternion_from_radec_roll, radec_roll_from_quaternion  # noqa: E402
+from startrack.geometry.sphere import angular_distance, radec_to_vector  # noqa: E402
+from startrack.image.detection import detect, detect_windows  # noqa: E402
+from startrack.image.render import SensorModel, Sources, Windows, expected_charge, render  # noqa: E402
+from startrack.image.stacking import DimStarCache  # noqa: E402
+from startrack.photometry.star_signal import (  # noqa: E402
     detection_threshold,
     snr,
     stackable_snr_range,
     stacked_snr,
     stacked_threshold,
 )
-from startrack.render import SensorModel, Sources, Windows, expected_charge, render  # noqa: E402
-from startrack.sphere import angular_distance, radec_to_vector  # noqa: E402
-from startrack.stacking import DimStarCache  # noqa: E402
-from startrack.star_catalog import load_star_catalog  # noqa: E402
-from startrack.units import DEG  # noqa: E402
 
 ARCMIN = DEG / 60.0
 OUT = Path(__file__).resolve().parents[1] / "out"

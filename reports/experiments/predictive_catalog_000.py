@@ -35,13 +35,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 
-from startrack.camera import Camera  # noqa: E402
+from startrack.base.units import ARCSEC, DEG  # noqa: E402
+from startrack.camera.model import Camera  # noqa: E402
+from startrack.catalog.hipparcos import load_star_catalog  # noqa: E402
+from startrack.catalog.navigation import load_navigation_catalog  # noqa: E402
+from startrack.geometry.sphere import vector_to_radec  # noqa: E402
 from startrack.identify import Prior, StarIdentifier  # noqa: E402
-from startrack.navigation_catalog import load_navigation_catalog  # noqa: E402
-from startrack.sphere import vector_to_radec  # noqa: E402
-from startrack.star_catalog import load_star_catalog  # noqa: E402
-from startrack.synthetic import centroid_frame  # noqa: E402
-from startrack.units import ARCSEC, DEG  # noqa: E402
+from startrack.image.synthetic import centroid_frame  # noqa: E402
 
 AXIS = np.array([math.sqrt(2.0) / 2.0, 0.5, 0.5])
 FRAME_PERIOD_S = 0.5

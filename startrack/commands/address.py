@@ -11,9 +11,9 @@ import json
 
 import numpy as np
 
+from startrack.base.errors import check_range
+from startrack.base.units import DEG
 from startrack.commands.catalog import check_option
-from startrack.errors import check_range
-from startrack.units import DEG
 
 
 def register(subparsers):
@@ -34,8 +34,8 @@ def register(subparsers):
 
 def address_report(ra_deg: float, dec_deg: float, n_d: int, fov_deg: float, max_delta_deg: float) -> dict:
     """The address of boresight (ra_deg, dec_deg) and its redundant neighbours, as a JSON-ready dict."""
-    from startrack import address as addr
-    from startrack.navigation_catalog import base_points, max_base_spacing, sub_catalog_radius
+    from startrack.catalog import address as addr
+    from startrack.catalog.navigation import base_points, max_base_spacing, sub_catalog_radius
 
     ra, dec = ra_deg * DEG, dec_deg * DEG
     base_ra, base_dec, base_vectors = base_points(n_d)

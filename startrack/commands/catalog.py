@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.errors import InputError, check_range
-from startrack.paths import check_directory
-from startrack.units import ARCSEC, DEG
+from startrack.base.errors import InputError, check_range
+from startrack.base.output_paths import check_directory
+from startrack.base.units import ARCSEC, DEG
 
 #: Option -> (low, high) accepted range, in the option's unit.
 _RANGES = {
@@ -63,7 +63,7 @@ def register(subparsers):
 
 def params_from_args(args):
     """NavigationCatalogParams from the parsed options (validated, degrees -> radians)."""
-    from startrack.navigation_catalog import NavigationCatalogParams
+    from startrack.catalog.navigation import NavigationCatalogParams
 
     for option, value in (
         ("--mag", args.mag), ("--fov-deg", args.fov_deg), ("--nd", args.nd),
@@ -87,7 +87,7 @@ def params_from_args(args):
 
 
 def run(args) -> int:
-    from startrack.navigation_catalog import load_navigation_catalog
+    from startrack.catalog.navigation import load_navigation_catalog
 
     params = params_from_args(args)
     check_option("--plot-ra-deg", args.plot_ra_deg)
@@ -162,9 +162,9 @@ def write_catalog_figures(catalog, directory, ra, dec) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from startrack.address import NEIGHBOUR_DIRECTIONS
-    from startrack.navigation_catalog import candidate_mask
-    from startrack.star_catalog import load_star_catalog
+    from startrack.catalog.address import NEIGHBOUR_DIRECTIONS
+    from startrack.catalog.hipparcos import load_star_catalog
+    from startrack.catalog.navigation import candidate_mask
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)

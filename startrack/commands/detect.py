@@ -3,12 +3,12 @@
 Background and noise on a mesh of cells (or given), threshold V_th = b + a sigma_n (eq. 4 of 004),
 8-connected components and a centre-of-gravity centroider, single-pixel events (hot pixels) and
 extended or elongated detections (clouds, streaks) dropped,
-saturation at the full scale of the file's bit depth (:mod:`startrack.image_io`); prints one line
+saturation at the full scale of the file's bit depth (:mod:`startrack.image.files`); prints one line
 per star, brightest first, or JSON.  The same detection, with the same options
 (:func:`add_detection_options`), is the image front end of ``startrack solve``.
 
 With ``--psf-sigma-px`` each star's position is then fitted at the Cramér-Rao bound with its 2 x 2
-covariance (:mod:`startrack.psf_fit`: the Gaussian PSF of that radius, the smear ``--smear-px`` and the
+covariance (:mod:`startrack.image.psf_fit`: the Gaussian PSF of that radius, the smear ``--smear-px`` and the
 star's shot noise through ``--gain-e-per-dn`` when given), flagged when the model does not explain its
 pixels (outlier, edge, saturated, failed) or another detection's light reaches its window (blended).
 """
@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from startrack.errors import InputError, check_range
+from startrack.base.errors import InputError, check_range
 
 #: Largest grey level accepted on the command line [DN] (a 32-bit float frame's useful range).
 MAX_DN = 1e9
@@ -44,7 +44,7 @@ def add_detection_options(parser):
 
 
 def detection_options(args) -> dict:
-    """Keyword arguments of :func:`startrack.detection.detect` from the parsed options (checked)."""
+    """Keyword arguments of :func:`startrack.image.detection.detect` from the parsed options (checked)."""
     check_range("--a", args.a, 0.1, 1000.0)
     for option, value, low in (("--saturation-dn", args.saturation_dn, 1.0), ("--background-dn", args.background_dn, 0.0),
                                ("--sigma-n-dn", args.sigma_n_dn, 1e-6)):
@@ -61,10 +61,10 @@ def detection_options(args) -> dict:
 
 
 def detect_frame(frame, options):
-    """:func:`startrack.detection.detect` of a :class:`startrack.image_io.Frame` with ``options``
+    """:func:`startrack.image.detection.detect` of a :class:`startrack.image.files.Frame` with ``options``
     (:func:`detection_options`; saturation at the frame's full scale unless given); a frame's pixels
-    without data (its mask) take no star within :data:`startrack.fits_io.MASK_MARGIN_PX` of them."""
-    from startrack.detection import detect
+    without data (its mask) take no star within :data:`startrack.image.fits.MASK_MARGIN_PX` of them."""
+    from startrack.image.detection import detect
 
     if options["saturation_dn"] is None:
         options = {**options, "saturation_dn": frame.full_scale}
@@ -73,7 +73,7 @@ def detect_frame(frame, options):
         return found
     from scipy.ndimage import binary_dilation
 
-    from startrack.fits_io import MASK_MARGIN_PX
+    from startrack.image.fits import MASK_MARGIN_PX
 
     near = binary_dilation(frame.mask, iterations=MASK_MARGIN_PX)
     rows = np.clip(np.rint(found.v).astype(int), 0, near.shape[0] - 1)
@@ -82,7 +82,7 @@ def detect_frame(frame, options):
 
 
 def add_fit_options(parser):
-    """The options of the PSF fit (:mod:`startrack.psf_fit`)."""
+    """The options of the PSF fit (:mod:`startrack.image.psf_fit`)."""
     group = parser.add_argument_group("position fit at the Cramér-Rao bound")
     group.add_argument("--psf-sigma-px", type=float, default=None,
                        help="Gaussian PSF radius [px]: fit every star's position and covariance (off by default)")
@@ -115,11 +115,11 @@ def fit_options(args):
 
 
 def fit_frame(frame, found, options):
-    """:func:`startrack.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`),
+    """:func:`startrack.image.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`),
     each detection's neighbours the others: a star whose window another detection's light reaches is ``blended``."""
     import numpy as np
 
-    from startrack.psf_fit import PixelNoise, fit_stars
+    from startrack.image.psf_fit import PixelNoise, fit_stars
 
     sigma, gain, smear = options
     noise = PixelNoise(found.sigma_n, gain_e_per_dn=gain)
@@ -134,7 +134,7 @@ def _fit_dict(fits, i):
             "dof": int(fits.dof[i]), **{flag: bool(getattr(fits, flag)[i]) for flag in FIT_FLAGS}}
 
 
-#: The flags of a position fit (startrack.psf_fit).
+#: The flags of a position fit (startrack.image.psf_fit).
 FIT_FLAGS = ("outlier", "edge", "saturated", "failed", "blended")
 
 
@@ -153,7 +153,7 @@ def register(subparsers):
 
 
 def run(args):
-    from startrack.image_io import read_frame
+    from startrack.image.files import read_frame
 
     options, fitting = detection_options(args), fit_options(args)
     frame = read_frame(args.image, args.hdu)

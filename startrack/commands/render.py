@@ -1,9 +1,9 @@
 """``startrack render``: a synthetic star-sensor frame for a given attitude.
 
 Stars of the Hipparcos-2 catalog (propagated to ``--epoch``) brighter than
-``--mag-limit`` are rendered with the default :class:`~startrack.render.SensorModel`
+``--mag-limit`` are rendered with the default :class:`~startrack.image.render.SensorModel`
 (004's PSF radius and 12-bit ADC) for the boresight (RA, Dec) and roll of
-:mod:`startrack.attitude_angles`, optionally smeared by a body rate; the
+:mod:`startrack.geometry.attitude_angles`, optionally smeared by a body rate; the
 frame is written as a 16-bit PNG or a .npy array.
 """
 
@@ -12,10 +12,10 @@ import math
 
 import numpy as np
 
-from startrack.errors import InputError, check_range
-from startrack.fits_io import FITS_SUFFIXES
-from startrack.paths import check_file
-from startrack.units import DEG
+from startrack.base.errors import InputError, check_range
+from startrack.base.output_paths import check_file
+from startrack.base.units import DEG
+from startrack.image.fits import FITS_SUFFIXES
 
 
 def _rate(text):
@@ -51,11 +51,11 @@ def register(subparsers):
 
 
 def run(args):
-    from startrack.attitude_angles import quaternion_from_radec_roll
-    from startrack.camera import Camera
-    from startrack.image_io import write_image
-    from startrack.render import SensorModel, render_star_field
-    from startrack.star_catalog import load_star_catalog
+    from startrack.camera.model import Camera
+    from startrack.catalog.hipparcos import load_star_catalog
+    from startrack.geometry.attitude_angles import quaternion_from_radec_roll
+    from startrack.image.files import write_image
+    from startrack.image.render import SensorModel, render_star_field
 
     check_range("--ra-deg", args.ra_deg, -360.0, 720.0)
     check_range("--dec-deg", args.dec_deg, -90.0, 90.0)

@@ -27,7 +27,7 @@ import sys
 import time
 from pathlib import Path
 
-from startrack.errors import InputError, run_command
+from startrack.base.errors import InputError, run_command
 from startrack.serve_client import code_version, socket_path
 
 #: Largest request line [bytes] (a command line and a folder name).
@@ -91,11 +91,11 @@ class SolverCache:
         return (camera, args.write_camera is not None, *(getattr(args, name) for name in SOLVER_OPTIONS))
 
     def __call__(self, args):
-        from startrack.commands.solve import _frame_solver
+        from startrack.commands.solve import frame_solver
 
         key = self.key(args)
         if key not in self._solvers:
-            self._solvers[key] = _frame_solver(args)
+            self._solvers[key] = frame_solver(args)
         return self._solvers[key]
 
 
@@ -124,7 +124,7 @@ def _peer_uid(connection):
 
 def _answer(connection, request, solvers):
     """Run the request's ``startrack solve`` here; its exit status."""
-    from startrack.cli import build_parser
+    from startrack.commands import build_parser
     from startrack.commands.solve import run as solve
 
     try:
@@ -189,8 +189,8 @@ def _stop(signum, frame):
 
 
 def run(args):
-    from startrack.cli import build_parser
-    from startrack.memory import reuse_freed_memory
+    from startrack.base.allocator import reuse_freed_memory
+    from startrack.commands import build_parser
 
     reuse_freed_memory()  # one request after another
     path = Path(args.socket) if args.socket else socket_path()

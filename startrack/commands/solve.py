@@ -43,12 +43,12 @@ import math
 
 import numpy as np
 
+from startrack.base.errors import InputError, check_range
+from startrack.base.units import DEG
 from startrack.commands.detect import add_detection_options, detection_options
 from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame
 from startrack.commands.solve_modes import FrameSolver, centroid_sigma, parse_refit
 from startrack.commands.solve_outputs import add_output_options, check_output_options, write_outputs
-from startrack.errors import InputError, check_range
-from startrack.units import DEG
 
 
 def register(subparsers):
@@ -119,7 +119,7 @@ def _pair(option, text):
 
 def _parse_boresight(text, error_deg):
     """(axis (3,), radius [rad]) of ``--boresight-deg RA,DEC`` and its error [deg] (checked before)."""
-    from startrack.sphere import radec_to_vector
+    from startrack.geometry.sphere import radec_to_vector
 
     ra_deg, dec_deg = _pair("--boresight-deg", text)
     check_range("--boresight-deg RA", ra_deg, -360.0, 720.0)
@@ -168,9 +168,9 @@ def _checked_geometry(args):
         raise InputError("--write-camera writes a fitted camera: give no camera, or --refit with it.")
 
 
-def _frame_solver(args):
+def frame_solver(args):
     """The :class:`startrack.commands.solve_modes.FrameSolver` of the options (checked)."""
-    from startrack.camera_file import read_camera_file
+    from startrack.camera.file import read_camera_file
 
     _checked_geometry(args)
     fov_range = _fov_range(args)
@@ -267,15 +267,15 @@ def _line(frame_id, result):
     return text
 
 
-def run(args, frame_solver=_frame_solver):
+def run(args, frame_solver=frame_solver):
     """The command; ``frame_solver(args)`` gives the solver (``startrack serve`` passes one that keeps them)."""
-    from startrack.camera_file import write_camera_file
+    from startrack.camera.file import write_camera_file
 
     options = detection_options(args)
     solver = frame_solver(args)
     check_output_options(args, None if args.batch is not None else len(args.input))
     if args.batch is not None:
-        from startrack.memory import reuse_freed_memory
+        from startrack.base.allocator import reuse_freed_memory
 
         reuse_freed_memory()  # one frame after another
     if args.batch == "-":

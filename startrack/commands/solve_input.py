@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.errors import InputError
-from startrack.fits_io import is_fits
-from startrack.image_io import IMAGE_SUFFIXES
+from startrack.base.errors import InputError
+from startrack.image.files import IMAGE_SUFFIXES
+from startrack.image.fits import is_fits
 
 
 @dataclass(frozen=True)
@@ -152,7 +152,7 @@ def image_frame(path, options, width=None, height=None, hdu=None):
     """The SolveFrame of an image file (a FITS file's HDU ``hdu``): read, size checked against the given one,
     detected."""
     from startrack.commands.detect import detect_frame
-    from startrack.image_io import read_frame
+    from startrack.image.files import read_frame
 
     frame = read_frame(path, hdu)
     rows, cols = frame.image.shape

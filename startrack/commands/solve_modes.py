@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 
 #: Centroid sigma [px] of centroid lists and of a given camera's gates when neither the option nor the
 #: camera file's fit gives one.
@@ -55,7 +55,7 @@ def centroid_sigma(option, camera_file):
 class FrameSolver:
     """The solve of every frame of one ``startrack solve`` run.
 
-    camera_file: a :class:`startrack.camera_file.CameraFile` or None; fov: the field of view [rad] of an
+    camera_file: a :class:`startrack.camera.file.CameraFile` or None; fov: the field of view [rad] of an
     ideal pinhole of the frame's size, or None; refit: intrinsics refitted (None: the camera is used as
     given); sigma_px: centroid sigma of centroid lists and of the given camera's gates [px]; plate:
     keyword arguments of the plate solver (but the epoch); fov_hint [rad] or None; mag_limit, threshold as
@@ -124,8 +124,8 @@ class FrameSolver:
     def _camera_file(self, width, height):
         if self.camera_file is not None:
             return self.camera_file
-        from startrack.camera import Camera
-        from startrack.camera_file import CameraFile
+        from startrack.camera.file import CameraFile
+        from startrack.camera.model import Camera
 
         return CameraFile(Camera.from_fov(self.fov, width, height))
 

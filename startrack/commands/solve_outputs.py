@@ -1,6 +1,6 @@
 """The files ``startrack solve`` writes per solved frame for the astronomers' tools (FITS, astropy.io.fits).
 
-* ``--wcs FILE``: the solution's WCS (:func:`startrack.wcs.frame_wcs`: TAN with SIP of the order the camera
+* ``--wcs FILE``: the solution's WCS (:func:`startrack.camera.wcs.frame_wcs`: TAN with SIP of the order the camera
   model needs, ZPN for a fisheye) as the header of a FITS file without data, as astrometry.net's ``.wcs`` files;
 * ``--new-fits FILE``: the input image with that header -- a FITS input keeps its HDUs and header, its
   earlier celestial WCS replaced; another image is written as the frame read (grey levels);
@@ -11,7 +11,7 @@
 
 With several frames (INPUTs or ``--batch``) a FILE must hold ``{stem}``, replaced by each image's file name
 without its suffix (a JSON Lines frame's id).  Every file is written whole or not at all
-(:func:`startrack.fits_io.write_hdus`); a frame not identified writes none.
+(:func:`startrack.image.fits.write_hdus`); a frame not identified writes none.
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.errors import InputError
-from startrack.fits_io import FITS_SUFFIXES, WCS_KEYWORDS, fits_stem, is_fits, write_hdus
-from startrack.paths import check_file
+from startrack.base.errors import InputError
+from startrack.base.output_paths import check_file
+from startrack.image.fits import FITS_SUFFIXES, WCS_KEYWORDS, fits_stem, is_fits, write_hdus
 
 #: The options, and the file suffixes each takes (astrometry.net's .wcs, .new and .corr are FITS files too).
 OUTPUTS = {"wcs": ("--wcs", FITS_SUFFIXES + (".wcs",)), "new_fits": ("--new-fits", FITS_SUFFIXES + (".new",)),
@@ -40,7 +40,7 @@ def add_output_options(parser):
 def check_output_options(args, frames):
     """Refuse, before any work, a FILE without ``{stem}`` for several frames (``frames``: the number of
     INPUTs, or None for a batch), with another suffix, or where it cannot be written
-    (:func:`startrack.paths.check_file`)."""
+    (:func:`startrack.base.output_paths.check_file`)."""
     for name, (option, suffixes) in OUTPUTS.items():
         template = getattr(args, name)
         if template is None:
@@ -56,7 +56,7 @@ def write_outputs(args, frame, result, epoch):
         return
     from astropy.io import fits
 
-    from startrack.wcs import frame_wcs
+    from startrack.camera.wcs import frame_wcs
 
     solution = frame_wcs(result.camera, result.q_IS)
     stem = _stem(frame.frame_id)
@@ -101,9 +101,9 @@ def _corr(frame, result, header, epoch):
     from astropy.io import fits
     from astropy.wcs import WCS
 
+    from startrack.catalog.hipparcos import HIP_MAX
+    from startrack.geometry.sphere import vector_to_radec
     from startrack.identify.pattern_catalog import load_source
-    from startrack.sphere import vector_to_radec
-    from startrack.star_catalog import HIP_MAX
 
     index = result.matches[:, 0]
     pixels = frame.uv[index] + 1.0

@@ -7,7 +7,8 @@ sub-catalogs' pairs), :mod:`~startrack.identify.pyramid` (the compiled triangle/
 :mod:`~startrack.identify.verify` (prediction, one-to-one matching, SVD refit, false-match probability),
 :mod:`~startrack.identify.lost_in_space` (full sky), :mod:`~startrack.identify.subcatalog` (000 §4),
 :mod:`~startrack.identify.tracking`, :mod:`~startrack.identify.context` (what the strategies share),
-:mod:`~startrack.identify.warmup` (kernels loaded at construction), :mod:`~startrack.identify.result`
+:mod:`~startrack.identify.prior` (what is known before a frame),
+:mod:`~startrack.identify.kernel_loading` (kernels loaded at construction), :mod:`~startrack.identify.result`
 (the result record), :mod:`~startrack.identify.identifier` (:class:`StarIdentifier`, the one call
 per frame; each strategy is one compiled call) and :mod:`~startrack.identify.calibrated`
 (:class:`CalibratedSolver`: catalog and identifier built for a camera, frames taken as the plate solver
@@ -21,11 +22,12 @@ detections) and :mod:`~startrack.identify.plate_solver` (:class:`PlateSolver`). 
 on first use (PEP 562), so a plate solve loads none of the calibrated identifier's tables.
 """
 
-from startrack.lazy import lazy_exports
+from startrack.base.lazy_exports import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.identify.calibrated": ("CalibratedSolver",),
-    "startrack.identify.identifier": ("METHODS", "Prior", "StarIdentifier"),
+    "startrack.identify.identifier": ("METHODS", "StarIdentifier"),
+    "startrack.identify.prior": ("Prior",),
     "startrack.identify.plate_solver": ("PlateSolver",),
     "startrack.identify.result": ("IdentificationResult",),
 })

@@ -23,11 +23,12 @@ import time
 
 import numpy as np
 
-from startrack.attitude import SvdWahba
-from startrack.identify.identifier import Prior, StarIdentifier
+from startrack.attitude.solvers import SvdWahba
+from startrack.geometry.sphere import vector_to_radec
+from startrack.identify.identifier import StarIdentifier
+from startrack.identify.prior import Prior
 from startrack.identify.result import IdentificationResult
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, field_solid_angle
-from startrack.sphere import vector_to_radec
 
 #: Catalog stars the field holds on average at the default depth.
 FIELD_STARS = 15.0
@@ -46,7 +47,7 @@ def default_mag_limit(camera, v_mag) -> float:
 
 
 class CalibratedSolver:
-    """Star identification of frames from one calibrated ``camera`` (:class:`startrack.camera.Camera`).
+    """Star identification of frames from one calibrated ``camera`` (:class:`startrack.camera.model.Camera`).
 
     mag_limit: depth of the navigation catalog [V mag] (default :func:`default_mag_limit`); epoch: of the
     star positions [Julian year]; centroid_sigma_px: the centroid noise the identifier's gates assume
@@ -55,8 +56,8 @@ class CalibratedSolver:
 
     def __init__(self, camera, mag_limit=None, epoch=2000.0, centroid_sigma_px=0.3,
                  threshold=DEFAULT_FALSE_MATCH_THRESHOLD, progress=False):
-        from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-        from startrack.star_catalog import load_star_catalog
+        from startrack.catalog.hipparcos import load_star_catalog
+        from startrack.catalog.navigation import NavigationCatalogParams, load_navigation_catalog
 
         stars = load_star_catalog(epoch)
         self.mag_limit = default_mag_limit(camera, stars.v_mag) if mag_limit is None else float(mag_limit)
@@ -87,7 +88,7 @@ class CalibratedSolver:
     def _weighted(result, sigma, start):
         """``result`` with the stars' own angular sigma (M,) [rad]: the attitude refitted with their weights
         (SVD, efficient), the sigma scaled by sqrt(max(1, chi^2 / dof)) of its residuals (dof = 2 M - 3):
-        estimated sigmas are a lower bound of a real camera's errors, as in :mod:`startrack.camera_fit`."""
+        estimated sigmas are a lower bound of a real camera's errors, as in :mod:`startrack.camera.fit`."""
         solution = SvdWahba().solve(result.ref_I, result.obs_S, sigma)
         chi2 = float(np.sum((solution.residuals / sigma) ** 2))
         scale = math.sqrt(max(1.0, chi2 / max(2 * len(sigma) - 3, 1)))

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from startrack.jit import njit
+from startrack.compiled.numba_setup import njit
 
 
 @njit

@@ -20,7 +20,7 @@ here, gives the tight bound of the same linearisation (001's is 2-3 times wider 
 makes e_ij at least a 3-sigma gate on beta_ij (the 1-norm bounds the 2-norm).
 
 :func:`centroid_directions` turns a frame's centroids into these directions in one compiled call:
-checks, brightest first, the camera model of :class:`startrack.camera.Camera` (pinhole, Brown radial
+checks, brightest first, the camera model of :class:`startrack.camera.model.Camera` (pinhole, Brown radial
 distortion inverted by Newton's method on the radius, as ``Camera.unproject``).
 """
 
@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from startrack.camera_fit import ray_one
-from startrack.jit import njit
-from startrack.sort_jit import argsort
+from startrack.camera.projection_kernels import ray_one
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import argsort
 
 
 @njit
@@ -86,7 +86,7 @@ def brightest_first(flux, count, max_stars):  # pragma: no cover  (compiled)
 def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
     """Unit vector in S of the image point (u, v) [px]: radial distortion removed by Newton's method on the
     radius (r_d = r (1 + k1 r^2 + k2 r^4)), then the projection's ray, as
-    :meth:`startrack.camera.Camera.unproject`."""
+    :meth:`startrack.camera.model.Camera.unproject`."""
     focal, cx, cy, k1, k2 = camera_params[0], camera_params[1], camera_params[2], camera_params[5], camera_params[6]
     x, y = (u - cx) / focal, (v - cy) / focal
     if k1 != 0.0 or k2 != 0.0:

@@ -23,19 +23,20 @@ search alone (no look-ups) ~50 us.
 ``solve(uv, flux, prior)`` takes centroids [px]; ``solve_vectors(obs_S, flux, prior)`` takes unit
 vectors in the sensor frame.  Both return an :class:`~startrack.identify.result.IdentificationResult`
 and never raise for the content of a frame (NaN, too few or off-sensor centroids give a status and a
-reason); a wrong configuration raises :class:`startrack.errors.InputError` at construction.
+reason); a wrong configuration raises :class:`startrack.base.errors.InputError` at construction.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import argsort
+from startrack.geometry.rotation_kernels import quat_from_matrix
 from startrack.identify.context import SearchContext
 from startrack.identify.features import (
     ALL_OUTSIDE,
@@ -47,77 +48,16 @@ from startrack.identify.features import (
     centroid_directions,
     separated,
 )
+from startrack.identify.kernel_loading import load_kernels
 from startrack.identify.lost_in_space import LostInSpace
+from startrack.identify.prior import Prior
 from startrack.identify.result import IdentificationResult
 from startrack.identify.subcatalog import SubCatalog
-from startrack.identify.tracking import Tracking, propagate
+from startrack.identify.tracking import Tracking
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, FieldStars
-from startrack.identify.warmup import load_kernels
-from startrack.jit import njit
-from startrack.rotation_jit import quat_from_matrix
-from startrack.sort_jit import argsort
-from startrack.sphere import radec_to_vector
 
 #: Strategy names in the order they are tried.
 METHODS = ("tracking", "subcatalog", "lost_in_space")
-
-
-@dataclass(frozen=True)
-class Prior:
-    """What is known before the frame: an attitude estimate and rate, or only a boresight.
-
-    q_IS: (4,) attitude estimate at the prior's time (scalar-last, S -> I); rate_S: (3,) body rate
-    [rad/s] in sensor axes; dt: time from the prior to the frame [s]; boresight: (ra, dec) [rad],
-    used when q_IS is None; tracked_hip: HIP numbers tracked in the previous frame (for the lost and
-    entering stars of tracking).
-    """
-
-    q_IS: np.ndarray | None = None
-    rate_S: np.ndarray | None = None
-    dt: float = 0.0
-    boresight: tuple[float, float] | None = None
-    tracked_hip: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.q_IS is not None:
-            q = np.asarray(self.q_IS, dtype=float)
-            if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 0.0:
-                raise InputError(f"prior q_IS must be 4 finite numbers, not all zero; got {self.q_IS!r}.")
-            object.__setattr__(self, "q_IS", q / np.linalg.norm(q))
-        if self.rate_S is not None:
-            rate = np.asarray(self.rate_S, dtype=float)
-            if rate.shape != (3,) or not np.all(np.isfinite(rate)):
-                raise InputError(f"prior rate_S must be 3 finite numbers [rad/s]; got {self.rate_S!r}.")
-            object.__setattr__(self, "rate_S", rate)
-        if not math.isfinite(self.dt):
-            raise InputError(f"prior dt must be a finite number of seconds; got {self.dt!r}.")
-        if self.boresight is not None and (len(self.boresight) != 2 or not all(math.isfinite(x) for x in self.boresight)
-                                           or abs(self.boresight[1]) > math.pi / 2):
-            raise InputError(f"prior boresight must be (ra, dec) in rad with |dec| <= pi/2; got {self.boresight!r}.")
-
-    @functools.cached_property
-    def predicted_R_IS(self):
-        """R_IS (3, 3) predicted at the frame (the prior propagated by ``rate_S`` over ``dt``), or None."""
-        if self.q_IS is None:
-            return None
-        return propagate(self.q_IS, _NO_RATE if self.rate_S is None else self.rate_S, float(self.dt))
-
-    def boresight_vector(self):
-        """Unit vector (3,) in I of the predicted boresight, or None."""
-        if self.q_IS is not None:
-            return np.ascontiguousarray(self.predicted_R_IS[:, 2])
-        if self.boresight is not None:
-            return radec_to_vector(*self.boresight)
-        return None
-
-    def boresight_radec(self):
-        """(ra, dec) [rad] of the predicted boresight, or None."""
-        if self.q_IS is not None:
-            x, y, z = self.predicted_R_IS[:, 2].tolist()
-            return math.atan2(y, x) % (2.0 * math.pi), math.asin(max(-1.0, min(1.0, z)))
-        if self.boresight is not None:
-            return float(self.boresight[0]), float(self.boresight[1])
-        return None
 
 
 def _positive(name, value, upper=math.inf):
@@ -130,7 +70,7 @@ def _positive(name, value, upper=math.inf):
 class StarIdentifier:
     """Star identification over a navigation catalog for one camera.
 
-    catalog: :class:`startrack.navigation_catalog.NavigationCatalog`; camera: :class:`startrack.camera.Camera`;
+    catalog: :class:`startrack.catalog.navigation.NavigationCatalog`; camera: :class:`startrack.camera.model.Camera`;
     centroid_sigma_px: centroid noise per axis [px] (covariance and gates); delta_sigmas: the error
     bound delta of 001 §4.3.1 in units of it (3); gate_sigmas: verification match radius in units of it
     (5); pattern_stars: brightest centroids searched first (16, at most 31; then twice as many); max_stars:
@@ -167,7 +107,7 @@ class StarIdentifier:
         if unknown or not methods:
             raise InputError(f"star identifier methods {tuple(methods)!r} must be a non-empty subset of {METHODS}.")
         if field_stars is None:
-            from startrack.star_catalog import load_star_catalog
+            from startrack.catalog.hipparcos import load_star_catalog
 
             field_stars = FieldStars.from_star_catalog(
                 catalog, camera, load_star_catalog(catalog.params.epoch).in_band(catalog.params.band),
@@ -291,7 +231,6 @@ def matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma:
 
 _NO_STARS = np.zeros(0, np.int64)
 _NO_FLUX = np.zeros(0)
-_NO_RATE = np.zeros(3)
 
 
 def _float_array(value):

@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from startrack.compiled.numba_setup import njit
 from startrack.identify.features import fill_features
 from startrack.identify.pattern_hash import hash_search
 from startrack.identify.pyramid import TRIANGLE_BUFFER, gate_cosines, no_result, search, verify_triangles
 from startrack.identify.zones import SKY
-from startrack.jit import njit
 
 
 @njit

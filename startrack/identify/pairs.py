@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from startrack.catalog.kvector import KVector
+from startrack.catalog.navigation import pattern_pairs
+from startrack.compiled.numba_setup import njit
 from startrack.identify.zones import bisect
-from startrack.jit import njit
-from startrack.kvector import KVector
-from startrack.navigation_catalog import pattern_pairs
 
 #: Distance bins of the cumulative pair counts of a k-vector table.
 COUNT_BINS = 4096

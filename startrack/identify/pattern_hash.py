@@ -33,7 +33,9 @@ import math
 
 import numpy as np
 
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.compiled.numba_setup import njit
+from startrack.geometry.rotation_kernels import wahba_svd, worst_cosine
 from startrack.identify.features import apart, fill_features
 from startrack.identify.pattern_catalog import (
     SEPARATION_PER_FOV,
@@ -54,8 +56,6 @@ from startrack.identify.scale_free import (
     correspondence,
 )
 from startrack.identify.verify import PATTERN_SEEDS, verify_near
-from startrack.jit import njit
-from startrack.rotation_jit import wahba_svd, worst_cosine
 
 #: Brightest thinned centroids whose four-star combinations are looked up (7: 35 combinations).  Median
 #: solve [us] on the benchmark frames (16 deg, 300 per set, solved in turn in one process) with 6 / 7 / 8:

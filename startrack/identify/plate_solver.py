@@ -4,9 +4,9 @@ from the stars (a plate solver).
 :class:`PlateSolver` holds the pattern catalog (:mod:`startrack.identify.pattern_catalog`) and the
 verification stars (the same stars, V <= its magnitude limit, at the frames' epoch, in a
 declination-zone index): the Hipparcos-2 stars to V 8, or when the fields searched reach below 5 deg
-the Gaia DR3 stars to V 10 (:mod:`startrack.gaia_catalog`; a 2 deg field holds a median 28 of them, 6
+the Gaia DR3 stars to V 10 (:mod:`startrack.catalog.gaia`; a 2 deg field holds a median 28 of them, 6
 Hipparcos-2 stars to V 9), as the default range, 2-160 deg (:data:`DEFAULT_FOV_RANGE`), does.  The answer
-names each star by its id (:attr:`startrack.star_catalog.StarCatalog.ids`: the HIP number, else the Gaia
+names each star by its id (:attr:`startrack.catalog.hipparcos.StarCatalog.ids`: the HIP number, else the Gaia
 DR3 source_id).
 ``solve`` orders the detections brightest first, thins them into pattern candidates, measures the local
 density of the detections (a grid of the frame, the false-match model of
@@ -14,7 +14,7 @@ density of the detections (a grid of the frame, the false-match model of
 (:func:`startrack.identify.scale_free.search`) in chunks of combinations (one at first, growing while
 the budget holds them) until a hypothesis is
 accepted, the combinations are exhausted or the time budget is spent.  The answer carries the
-calibrated camera (:class:`startrack.camera_fit.CameraCalibration`) with its sigma.
+calibrated camera (:class:`startrack.camera.fit.CameraCalibration`) with its sigma.
 
 Verification depth: the ``n_predicted`` brightest catalog stars imaged in the frame, twice the
 number of detections within [30, 1000]; the faintest of them is the frame's catalog depth
@@ -34,9 +34,10 @@ import time
 
 import numpy as np
 
-from startrack.camera import PROJECTIONS, Camera, radius_of_angle
-from startrack.camera_fit import CameraCalibration
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.base.units import DEG
+from startrack.camera.fit import CameraCalibration
+from startrack.camera.model import PROJECTIONS, Camera, radius_of_angle
 from startrack.identify.pattern_catalog import (
     RECTILINEAR_TO,
     PatternCatalogParams,
@@ -47,7 +48,6 @@ from startrack.identify.pattern_catalog import (
 from startrack.identify.result import IdentificationResult
 from startrack.identify.scale_free import COMBINATIONS_BELOW, pattern_candidates, search
 from startrack.identify.zones import SKY, cap, zone_index
-from startrack.units import DEG
 
 #: Default acceptance threshold of the false-match probability.
 DEFAULT_THRESHOLD = 1e-6
@@ -181,7 +181,7 @@ class PlateSolver:
         (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3, with
         :data:`SIGMA_FLOOR_PX` added in quadrature);
         ``fov_hint`` [rad] searches the levels nearest it first; ``camera`` a
-        :class:`startrack.camera_file.CameraFile` known before, refined: the intrinsics named in ``refit``
+        :class:`startrack.camera.file.CameraFile` known before, refined: the intrinsics named in ``refit``
         (a subset of :data:`REFIT`) are fitted -- the focal length within 1 % or 3 sigma, the principal
         point and distortion with priors about the camera's, 3 times its sigma where the file gives one
         (else the solver's own prior; k2 that of k1 when the solver holds it) -- the others held at the
@@ -249,10 +249,10 @@ class PlateSolver:
 
     # ------------------------------------------------------------------ internals
     def _start(self, width, height, known, refit):
-        """(camera parameters the hypotheses start from (:func:`startrack.camera_fit.camera_array`), the priors
+        """(camera parameters the hypotheses start from (:func:`startrack.camera.projection_kernels.camera_array`), the priors
         per projection code (mean (5,), sigma (5,): inf free without a prior, 0 held) of (f, cx, cy, k1, k2),
         focal-length ranges (2, 2) [px] per projection code) for a frame, with or without a known camera (a
-        :class:`startrack.camera_file.CameraFile`) and the intrinsics of it ``refit``."""
+        :class:`startrack.camera.file.CameraFile`) and the intrinsics of it ``refit``."""
         params = np.array([1.0, (width - 1) / 2.0, (height - 1) / 2.0, float(width), float(height), 0.0, 0.0, 0.0, 0.0])
         sigma = self.prior_sigma.copy()
         sigma[1:3] *= max(width, height)
@@ -330,7 +330,7 @@ class PlateSolver:
         rms = float(np.sqrt(np.mean(residual**2)))
         calibration = CameraCalibration(camera, covariance, float(reduced), rms, int(obs_index.size), int(n_predicted),
                                         float(self.v_mag[star_index].max()))
-        from startrack.rotation import from_matrix
+        from startrack.geometry.rotation import from_matrix
 
         return IdentificationResult(
             status="ok", q_IS=from_matrix(R_IS), matches=np.column_stack([index[obs_index], self.ids[star_index]]),
@@ -340,7 +340,7 @@ class PlateSolver:
 
     def _warm_up(self):
         """Load (or compile) the kernels: an identifiable frame of catalog stars and an unidentifiable one."""
-        from startrack.rotation import from_rotation_vector
+        from startrack.geometry.rotation import from_rotation_vector
 
         fov = math.sqrt(self.fov_range[0] * self.fov_range[1])
         camera = Camera.from_fov(fov, 1024, 768)

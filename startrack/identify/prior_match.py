@@ -13,7 +13,7 @@ direction o (covariance C_o) of that star has the tangent-plane residual r = T (
 
 T the 2x3 tangent basis at s. The gate is d² <= χ²₂(p_gate) = −2 ln(1 − p_gate) (the true star falls outside
 it with probability 1 − p_gate), and the magnitudes must agree: |m_obs − m_cat| <= k_m √(σ_obs² + σ_cat²), σ_cat
-the band magnitudes' own error (:mod:`startrack.colours`: 0.10-0.14 mag RMS in J and H).
+the band magnitudes' own error (:mod:`startrack.photometry.colours`: 0.10-0.14 mag RMS in J and H).
 
 Uniqueness. A detection is matched to a star only when that star is the only one in its gate and the detection
 the only one in the star's gate.
@@ -41,9 +41,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import norm
 
-from startrack import rotation as rot
-from startrack.errors import InputError
-from startrack.sphere import tangent_basis
+from startrack.base.errors import InputError
+from startrack.geometry import rotation as rot
+from startrack.geometry.sphere import tangent_basis
 
 #: Radius [rad] of the cap around the predicted boresight in which ρ_m of eq. (2) is counted (at least).
 DENSITY_RADIUS = np.radians(10.0)

@@ -32,11 +32,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from startrack.compiled.numba_setup import njit
+from startrack.geometry.rotation_kernels import wahba_svd
 from startrack.identify.pairs import pair_count, pair_range
 from startrack.identify.verify import TRIANGLE_SEEDS, verify_near
 from startrack.identify.zones import stars_near
-from startrack.jit import njit
-from startrack.rotation_jit import wahba_svd
 
 #: Catalog triangles kept per observed triangle, and unextended triangles kept per search.
 TRIANGLE_BUFFER = 64

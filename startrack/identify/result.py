@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from startrack.attitude import cramer_rao_covariance
-from startrack.attitude_angles import radec_roll_from_quaternion
-from startrack.rotation import to_matrix
-from startrack.units import ARCSEC
+from startrack.attitude.solvers import cramer_rao_covariance
+from startrack.base.units import ARCSEC
+from startrack.geometry.attitude_angles import radec_roll_from_quaternion
+from startrack.geometry.rotation import to_matrix
 
 #: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
 #: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
@@ -34,7 +34,7 @@ class IdentificationResult:
         :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
     matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number -- or, from a plate
         solver using the Gaia DR3 stars, the Gaia source_id of a star Hipparcos-2 lacks: an id above
-        :data:`startrack.star_catalog.HIP_MAX`), by centroid index.
+        :data:`startrack.catalog.hipparcos.HIP_MAX`), by centroid index.
     obs_S, ref_I: (M, 3) the matched centroid directions in S and their catalog directions in I (the
         measurements a filter uses); sigma: their per-axis angular noise [rad], scalar or (M,).
         :attr:`residuals` and :attr:`covariance` are derived from them when asked.
@@ -45,10 +45,10 @@ class IdentificationResult:
     solve_ms: wall-clock time of the whole call [ms].
     lost_hip / entered_hip: tracking only -- previously tracked stars predicted inside the field but not
         found, and stars identified now that were not tracked before (HIP numbers).
-    calibration: the camera the frame calibrated (:class:`startrack.camera_fit.CameraCalibration`), when
+    calibration: the camera the frame calibrated (:class:`startrack.camera.fit.CameraCalibration`), when
         the camera was fitted or refined (:class:`startrack.identify.plate_solver.PlateSolver`); then
         :attr:`covariance` is the fit's, which includes the intrinsics' uncertainty.
-    camera: the :class:`startrack.camera.Camera` whose frame S ``q_IS`` is the attitude of (None when not
+    camera: the :class:`startrack.camera.model.Camera` whose frame S ``q_IS`` is the attitude of (None when not
         ok); camera_source: where it came from, one of :data:`CAMERA_SOURCES` ("" when not ok).
     """
 
@@ -111,7 +111,7 @@ class IdentificationResult:
         """(3, 3) attitude-error covariance in sensor axes [rad^2] (x, y cross-boresight, z roll).
 
         The Cramer-Rao bound of the matched stars, which the SVD solution of Wahba's problem attains
-        (:func:`startrack.attitude.cramer_rao_covariance`), or the calibration fit's; NaN unless ok.
+        (:func:`startrack.attitude.solvers.cramer_rao_covariance`), or the calibration fit's; NaN unless ok.
         """
         if not self.ok:
             return np.full((3, 3), np.nan)

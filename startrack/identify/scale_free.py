@@ -39,13 +39,13 @@ import math
 
 import numpy as np
 
-from startrack.camera_fit import ray_one
+from startrack.camera.projection_kernels import ray_one
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import argsort
+from startrack.geometry.rotation_kernels import wahba_svd, worst_cosine
 from startrack.identify.pattern_catalog import bin_ranges, edge_ratios, next_bins, pack_key, run_start
 from startrack.identify.self_calibration import brightest_in_field, verify_calibrate
 from startrack.identify.zones import stars_near
-from startrack.jit import njit
-from startrack.rotation_jit import wahba_svd, worst_cosine
-from startrack.sort_jit import argsort
 
 #: Most detections whose combinations are searched.
 MAX_CANDIDATES = 24
@@ -240,7 +240,7 @@ def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries,
     :attr:`~startrack.identify.pattern_catalog.PatternLevel.arrays`; ``entries`` = (level (e,), projection
     code (e,), focal length (e,) [px], ratio tolerance (e,)): the look-ups of each observed pattern, in
     order; ``vectors`` the pattern stars' unit vectors; f_range (2, 2) [px] the focal lengths allowed
-    per projection code; ``camera`` (:func:`startrack.camera_fit.camera_array`) the start of the
+    per projection code; ``camera`` (:func:`startrack.camera.projection_kernels.camera_array`) the start of the
     calibration (f and the projection replaced); ``region`` for :func:`_gather`; ``settings`` per
     projection code (:func:`verify_calibrate`'s), ``screen`` the same with fewer predicted stars (step 6).
     Returns (verify_calibrate's tuple, hypotheses verified, the combination and candidate to resume at)."""

@@ -4,7 +4,7 @@ A hypothesis of the pattern search (:mod:`startrack.identify.scale_free`) is an 
 length from four stars; the principal point is taken at the image centre and the distortion as zero.
 Its predictions are good near the pattern and drift with the distance from it (focal-length error,
 distortion), so the verification matches in passes with shrinking gates [px], each followed by the
-least-squares fit of the attitude and the intrinsics (:func:`startrack.camera_fit.fit`):
+least-squares fit of the attitude and the intrinsics (:func:`startrack.camera.fit.fit`):
 
 1. the brightest ``first_stars`` detections against the brightest predicted stars, gate g_1 (the
    pattern's tolerance scaled to the image), attitude and focal length free;
@@ -37,11 +37,19 @@ import math
 
 import numpy as np
 
-from startrack.camera_fit import fit, fold_radius_squared_jit, folds_inside, image_point, in_view, off_axis_angle, project
+from startrack.camera.fit import fit
+from startrack.camera.projection_kernels import (
+    fold_radius_squared_jit,
+    folds_inside,
+    image_point,
+    in_view,
+    off_axis_angle,
+    project,
+)
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import argsort, median, unique
 from startrack.identify.chance import chance_match_probability, poisson_tail
 from startrack.identify.zones import stars_near
-from startrack.jit import njit
-from startrack.sort_jit import argsort, median, unique
 
 #: Seed stars of a pattern hypothesis (matched by construction).
 SEEDS = 4
@@ -123,8 +131,8 @@ def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
 @njit
 def predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  (compiled)
     """(star indices, uv (m, 2)) of the first ``limit`` stars of ``around`` (brightest first) imaged inside
-    the frame for R_IS and the camera ``params`` (:func:`startrack.camera_fit.camera_array`): imaged by
-    its projection, within the fold radius of the distortion (:func:`startrack.camera.fold_radius_squared`)."""
+    the frame for R_IS and the camera ``params`` (:func:`startrack.camera.projection_kernels.camera_array`): imaged by
+    its projection, within the fold radius of the distortion (:func:`startrack.camera.model.fold_radius_squared`)."""
     width, height = params[3], params[4]
     fold = fold_radius_squared_jit(params[5], params[6])
     keep = np.empty(min(limit, around.size), np.int64)
@@ -158,7 +166,7 @@ def _residuals(uv, obs_index, model_uv):  # pragma: no cover  (compiled)
 
 @njit
 def _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params, free, prior):  # pragma: no cover
-    """:func:`startrack.camera_fit.fit` of the detections ``obs_index`` to the field stars ``star_index``."""
+    """:func:`startrack.camera.fit.fit` of the detections ``obs_index`` to the field stars ``star_index``."""
     ref = np.empty((obs_index.size, 3))
     seen = np.empty((obs_index.size, 2))
     weight_sigma = np.empty(obs_index.size)
@@ -193,7 +201,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     """Verification of the hypothesis (R_IS, params) of a pattern (module text).
 
     uv (n, 2) detections brightest first [px], sigma (n,) their centroid sigma [px]; ``params`` the
-    camera (:func:`startrack.camera_fit.camera_array`); ``field`` for :func:`stars_around`; ``settings`` =
+    camera (:func:`startrack.camera.projection_kernels.camera_array`); ``field`` for :func:`stars_around`; ``settings`` =
     (final gate r [px], first_stars, n_predicted, free (5,) bool, prior (mean (5,), sigma (5,)), density
     grid, threshold); ``gates`` (3,) [px] g_1, g_2, r.  Returns (ok, R_IS, params, covariance (8, 8), obs
     indices, star indices, P_false, stars predicted, radius reached [px], chi^2 / dof).

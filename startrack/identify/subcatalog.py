@@ -11,7 +11,7 @@ lies in the sub-catalog.
 
 If the predicted sub-catalog gives nothing, the four redundant sub-catalogs at the boresights moved by
 rho_sub east, west, north and south are searched in turn
-(:meth:`startrack.navigation_catalog.NavigationCatalog.redundant_neighbours`); 000 states that this
+(:meth:`startrack.catalog.navigation.NavigationCatalog.redundant_neighbours`); 000 states that this
 tolerates a boresight error up to delta + (sqrt 2 - 1) rho_sub (6.97 deg for 000 §5).
 
 With the dense table (every field star's pairs, ``dense_fallback``, the default) the frame's pattern

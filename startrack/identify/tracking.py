@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import unique
 from startrack.identify.verify import NO_SEEDS, verify_near
-from startrack.jit import njit
-from startrack.sort_jit import unique
 
 
 @njit

@@ -42,12 +42,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from startrack.camera_fit import camera_array, fold_radius_squared_jit, image_point, in_view
+from startrack.camera.projection_kernels import camera_array, fold_radius_squared_jit, image_point, in_view
+from startrack.catalog.navigation import chord
+from startrack.compiled.numba_setup import njit
+from startrack.compiled.sorts import argsort
+from startrack.geometry.rotation_kernels import wahba_svd
 from startrack.identify.zones import stars_near, zone_index
-from startrack.jit import njit
-from startrack.navigation_catalog import chord
-from startrack.rotation_jit import wahba_svd
-from startrack.sort_jit import argsort
 
 #: Default acceptance threshold of the false-match probability.
 DEFAULT_FALSE_MATCH_THRESHOLD = 1e-6
@@ -165,9 +165,9 @@ def match_nearest(obs_S, pred_S, gate):  # pragma: no cover  (compiled)
 def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (compiled)
     """(indices, directions in S (m, 3)) of the stars ``stars_I`` (N, 3) imaged inside the field for R_IS.
 
-    ``camera_params`` (:func:`startrack.camera_fit.camera_array`) [px]; the image (and, if circular, the
+    ``camera_params`` (:func:`startrack.camera.projection_kernels.camera_array`) [px]; the image (and, if circular, the
     inscribed circle of the width) is grown by ``margin_px``; the projection and radial distortion of
-    :class:`startrack.camera.Camera`.
+    :class:`startrack.camera.model.Camera`.
     """
     cx, cy, width, height, circular = camera_params[1], camera_params[2], camera_params[3], camera_params[4], camera_params[7]
     fold = fold_radius_squared_jit(camera_params[5], camera_params[6])
@@ -299,7 +299,7 @@ class FieldStars:
 
     @classmethod
     def from_star_catalog(cls, catalog, camera, stars, mag_limit: float, resolution_px: float = 3.0):
-        """Field stars of ``stars`` (a :class:`startrack.star_catalog.StarCatalog`) to ``mag_limit`` in its band.
+        """Field stars of ``stars`` (a :class:`startrack.catalog.hipparcos.StarCatalog`) to ``mag_limit`` in its band.
 
         Stars closer than ``resolution_px`` [px] to another such star are left out: their images merge
         into one centroid that matches neither, and a match to either would be a guess.

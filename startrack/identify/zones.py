@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from startrack.jit import njit
+from startrack.compiled.numba_setup import njit
 
 #: Height of a zone [rad].
 ZONE_HEIGHT = math.radians(1.0)

@@ -8,7 +8,7 @@ import numpy as np
 from navsim.earth.wander import ned_offset
 from navsim.kinds import load_scenario
 from navsim.truth.segments import Profile
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 

@@ -10,8 +10,8 @@ from navsim.sensors.baro import BaroModel
 from navsim.sensors.inertial import allan_variance, bias_instability_to_sigma
 from navsim.truth import trajectory
 from navsim.truth.segments import Hold, Profile, Start
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
 
 
 def _adev(values, taus, rate_hz):

@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import quad
 
 from navsim.earth import atmosphere
-from startrack.bands import band
+from startrack.photometry.bands import band
 
 # COESA 1976, U.S. Standard Atmosphere, Table I (geometric height [m], temperature [K], pressure [Pa]).
 USSA76 = [(0.0, 288.150, 101325.0), (5000.0, 255.676, 54048.0), (10000.0, 223.252, 26500.0),

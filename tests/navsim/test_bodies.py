@@ -7,8 +7,8 @@ import pytest
 
 from navsim.earth.bodies import SunMoon
 from navsim.earth.orientation import EarthOrientation
-from startrack import units
-from startrack.sphere import angular_distance
+from startrack.base import units
+from startrack.geometry.sphere import angular_distance
 from tests.sky_support import skyfield_vectors
 
 EPOCH = "2025-09-07T18:00:00"  # a total lunar eclipse night: the Moon full, opposite the Sun

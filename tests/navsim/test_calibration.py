@@ -13,8 +13,8 @@ import navsim
 from navsim.campaign.montecarlo import run_campaign
 from navsim.estimation import kernels
 from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 HIGH_DYNAMIC = SCENARIOS / "paper000_high_dynamic.toml"  # 000's 30 deg/s about one axis

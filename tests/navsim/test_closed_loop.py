@@ -14,8 +14,8 @@ from navsim.sensors.faults import AttitudeJumps
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covariance
 from navsim.simulation import prepare, simulate
 from navsim.truth.profiles import TruthRecord
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
 
 
 def image_scenario(base, duration_s=30.0, **faults):

@@ -1,5 +1,5 @@
 """A run compiles nothing after its compile-ahead lanes (each kind's ``lanes``): the tasks call the kernels
-with the argument types of a run, so the run loads them all (``startrack.precompile``)."""
+with the argument types of a run, so the run loads them all (``startrack.compiled.compile_ahead``)."""
 
 import subprocess
 import sys
@@ -22,7 +22,7 @@ import sys
 from numba.core import event
 import navsim
 from navsim.kinds import resolve_scenario, run_kind
-from startrack.precompile import compile_ahead
+from startrack.compiled.compile_ahead import compile_ahead
 
 scenario = resolve_scenario(sys.argv[1], sys.argv[2:])
 compile_ahead(run_kind(scenario, "a run").lanes(scenario))

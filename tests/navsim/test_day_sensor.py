@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from navsim import cli
-from startrack.bands import band
-from startrack.detectors import detector
-from startrack.sensor_photometry import SensorPhotometry
+from startrack.image.sensor_photometry import SensorPhotometry
+from startrack.photometry.bands import band
+from startrack.photometry.detectors import detector
 from tests.support import run_cli
 
 DAY = Path(__file__).parents[2] / "scenarios" / "sins_cns_aircraft_day.toml"
@@ -94,8 +94,7 @@ def test_the_sensor_prior_turns_the_field_by_the_refraction_states_sigma():
     from navsim.estimation.nav_filter import NavFilter
     from navsim.kinds import resolve_scenario
     from navsim.navigation import build
-    from startrack import rotation as rot
-
+    from startrack.geometry import rotation as rot
     scenario = resolve_scenario(str(DAY), [])
     gyro, accel = build.imu(scenario)
     lat, lon, h = np.radians(40.0), np.radians(-10.0), 12000.0

@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 
 from navsim.earth import frames, gravity, orientation, wgs84
-from startrack import aberration, sphere, units
-from startrack import rotation as rot
+from startrack.base import units
+from startrack.catalog import apparent_place as aberration
+from startrack.geometry import rotation as rot
+from startrack.geometry import sphere
 from tests.sky_support import deflected_by_the_sun, random_directions, skyfield_stars, skyfield_vectors
 
 # NIMA TR8350.2 (3rd ed.), Table 3.4: normal gravity on the ellipsoid at the equator and at the poles.
@@ -140,7 +142,7 @@ def test_slow_terms_on_their_grid_equal_erfa_at_every_second():
 
 
 def test_bad_epoch_is_named():
-    from startrack.errors import InputError
+    from startrack.base.errors import InputError
 
     with pytest.raises(InputError, match="epoch_utc: expected"):
         frames.c_ei("yesterday")

@@ -10,7 +10,7 @@ import pytest
 
 from navsim.kinds import resolve_scenario
 from navsim.simulation import covariance, prepare, run_batch
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 
 LEVEL = Path(__file__).resolve().parent / "data" / "sins_cns_level.toml"
 #: Straight and level at 11 km due east over the equator through local noon at the March equinox: the boresight

@@ -14,8 +14,8 @@ from navsim.estimation import kernels, linalg
 from navsim.estimation.analytic import farrenkopf_steady_state
 from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
 from navsim.sensors.star_sensor import isotropic_covariance
-from startrack import rotation as rot
-from startrack import units
+from startrack.base import units
+from startrack.geometry import rotation as rot
 
 RNG = np.random.default_rng(3)
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from navsim.sensors.gyro import GyroModel, allan_variance, bias_instability_to_sigma
-from startrack import units
+from startrack.base import units
 
 RATE_HZ = 10.0
 

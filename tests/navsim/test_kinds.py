@@ -10,7 +10,7 @@ from navsim import kinds
 from navsim.estimation.attitude_filter import AttitudeFilter, AttitudeFilterConfig
 from navsim.estimation.nav_filter import ImuNoise, NavFilterConfig
 from navsim.simulation import prepare, simulate
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"

@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from navsim import kinematics, kinematics_jit
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 RNG = np.random.default_rng(20261122)
 ARCSEC = np.pi / 180 / 3600

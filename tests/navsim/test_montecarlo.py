@@ -12,7 +12,7 @@ import pytest
 
 import navsim.campaign.montecarlo as mc
 from navsim.simulation import run, run_batch
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 from tests.support import HANG_S, finished_runs, wait_for
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ from navsim.earth import wander
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import OMEGA_IE, radii
 from navsim.estimation import nav_kernels
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 LAT, LON, H, ALPHA = 0.7, 0.3, 3000.0, 0.9
 V = np.array([150.0, -80.0, 5.0])
@@ -157,7 +157,7 @@ from navsim.sensors.gyro import GyroModel  # noqa: E402
 from navsim.simulation import prepare, run_batch, simulate  # noqa: E402
 from navsim.truth import trajectory  # noqa: E402
 from navsim.truth.segments import Profile  # noqa: E402
-from startrack.errors import InputError  # noqa: E402
+from startrack.base.errors import InputError  # noqa: E402
 
 TURNS = {"start": {"lat_deg": 40.0, "lon_deg": 10.0, "height_m": 1000.0, "speed_m_per_s": 100.0, "heading_deg": 0.0},
          "segments": [{"kind": "straight", "duration_s": 60.0},

@@ -16,7 +16,7 @@ from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import radii
 from navsim.navigation.records import RunSummary
 from navsim.simulation import run_batch
-from startrack import units
+from startrack.base import units
 from tests.support import HANG_S, pdf_text
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -151,7 +151,7 @@ def test_position_aided_campaign_of_the_shipped_scenario(tmp_path):
 def test_tune_needs_measurements():
     """A free INS without a baro has no NIS to fit: one clear error, not a search on nothing."""
     from navsim.campaign.tuning import tune
-    from startrack.errors import InputError
+    from startrack.base.errors import InputError
 
     short = {**FREE_AT_REST, "trajectory": {**FREE_AT_REST["trajectory"], "segments": [{"kind": "hold", "duration_s": 60.0}]}}
     with pytest.raises(InputError, match="filter tuning needs measurements"):
@@ -163,8 +163,7 @@ def test_along_and_cross_track_errors_resolve_the_horizontal_error_on_the_course
     track: south) is −north; due north they are north and east; any course keeps the horizontal size; at rest the
     course is the body's heading."""
     from navsim.navigation.summary import track_metres
-    from startrack import rotation as rot
-
+    from startrack.geometry import rotation as rot
     error = np.array([[3.0, 4.0], [3.0, 4.0], [-1.0, 2.0], [3.0, 4.0]])
     v_n = np.array([[0.0, 250.0, 0.0], [10.0, 0.0, 1.0], [7.0, -7.0, 0.0], [0.0, 0.0, 0.0]])
     q_nb = rot.from_rotation_vector(np.array([[0.0, 0.0, 0.3]] * 3 + [[0.0, 0.0, np.pi / 2]]))  # the last faces east

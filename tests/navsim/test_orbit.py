@@ -14,7 +14,7 @@ from navsim.orbit.eclipse import PENUMBRA, SUNLIT, UMBRA, crossings, discs, over
 from navsim.orbit.elements import SUN_SYNCHRONOUS_RATE, Elements, j2_node_rate, sun_synchronous_inclination
 from navsim.orbit.numerical import Forces, NumericalOrbit, air_density
 from navsim.orbit.sgp4_orbit import SGP4Orbit, checked_tle
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 
 ISS = ("1 25544U 98067A   08264.51782528 -.00002182  00000-0 -11606-4 0  2927",
        "2 25544  51.6416 247.4627 0006703 130.5360 325.0288 15.72125391563537")

@@ -8,8 +8,8 @@ import pytest
 from navsim.earth.apparent import apparent, fix_rotation
 from navsim.earth.atmosphere import temperature_pressure
 from navsim.earth.refraction import Air, refract, refraction_angle
-from startrack import rotation as rot
-from startrack.units import ARCSEC
+from startrack.base.units import ARCSEC
+from startrack.geometry import rotation as rot
 
 ZENITH = np.array([[0.0, 0.0, 1.0]])
 

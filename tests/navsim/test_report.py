@@ -20,9 +20,9 @@ from navsim.pooling import averaged_nees
 from navsim.report import write_report
 from navsim.typeset import statistics
 from navsim.typeset.inputs import RunData
-from startrack import address
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
+from startrack.base.errors import InputError
+from startrack.catalog import address
+from startrack.catalog.hipparcos import load_star_catalog
 from tests.support import pdf_text
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "paper000_high_dynamic.toml"  # vector fidelity

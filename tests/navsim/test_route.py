@@ -14,7 +14,7 @@ from navsim.ins import strapdown
 from navsim.truth import route as route_module
 from navsim.truth import trajectory
 from navsim.truth.route import MISS, Route, Waypoint
-from startrack import units
+from startrack.base import units
 from tests.navsim.test_bad_input_corpus import BASES, assert_one_clear_line
 from tests.support import run_cli
 

@@ -6,7 +6,7 @@ import pytest
 
 from navsim.kinds import load_scenario, scenario_from_dict
 from navsim.scenario import parse_override
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 
 
 def check(data, overrides=()):

@@ -6,8 +6,8 @@ import pytest
 
 from navsim.build.star_sensor import image_star_sensor
 from navsim.kinds import load_scenario
-from startrack.errors import InputError
-from startrack.star_catalog import load_star_catalog
+from startrack.base.errors import InputError
+from startrack.catalog.hipparcos import load_star_catalog
 
 CAMERA = """[camera]
 width_px = 640

@@ -263,8 +263,7 @@ def test_the_attitude_difference_jacobian_against_finite_errors():
     from navsim.earth.wander import q_ew
     from navsim.estimation.celestial_kernels import attitude_jacobian, inertial_attitude
     from navsim.estimation.nav_kernels import DP
-    from startrack import rotation as rot
-
+    from startrack.geometry import rotation as rot
     rng = np.random.default_rng(11)
     q_ie = rot.from_rotation_vector(rng.normal(size=3))
     for lat in [*rng.uniform(-1.4, 1.4, size=18), 0.5 * np.pi, -0.5 * np.pi]:

@@ -12,7 +12,7 @@ import pytest
 from navsim import cli
 from navsim.kinds import load_scenario
 from navsim.navigation.scenario import boresight_elevation
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 from tests.support import run_cli
 
 BASE = Path(__file__).resolve().parent / "data" / "base_sins_cns.toml"

@@ -15,9 +15,9 @@ from navsim import cli
 from navsim.kinds import resolve_scenario
 from navsim.navigation import run as ins_simulation
 from navsim.truth.sky import SkyTruth
-from startrack import rotation as rot
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
+from startrack.geometry import rotation as rot
 from tests.support import pdf_text, run_cli
 
 #: Straight and level at 100 m/s for one Schuler period (5063 s; the Schuler mean is then the floor

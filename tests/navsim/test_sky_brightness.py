@@ -9,8 +9,8 @@ import pytest
 
 from navsim.earth.atmosphere import Extinction, extinction
 from navsim.earth.sky_brightness import NL_ZERO, Sightline, sky_band, sky_brightness
-from startrack.bands import band
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.photometry.bands import band
 
 BELOW = 180.0  # a Sun or Moon far below the horizon [deg]
 

@@ -14,7 +14,7 @@ from navsim.kinds import scenario_from_dict
 from navsim.navigation import run as navigation_run
 from navsim.navigation.availability import star_availability
 from navsim.truth.sky import SkyTruth
-from startrack import units
+from startrack.base import units
 from tests.support import pdf_text, run_cli
 
 DATA = Path(__file__).parent / "data"
@@ -132,7 +132,7 @@ def test_image_frames_carry_the_sky():
     their sampling errors on 65 536 pixels (0.1 DN and 0.5 %, within 3σ), and the run identifies and fuses stars
     (3 or more in 30 of its 33 frames, measured);
     20 min after sunset the sky fills the pixels (they sit at the well) and no star is detected."""
-    from startrack.render import render
+    from startrack.image.render import render
 
     night = navigation_run.prepare(image_scenario(NIGHT))
     model, budget = night.star_sensor.frame_model(0), night.star_sensor.photometry

@@ -14,7 +14,7 @@ from navsim.scenario import read_scenario_file
 from navsim.sensors.radiation_hits import RadiationHits
 from navsim.sensors.stray_light import SUN_MAGNITUDE, Baffle, StrayLight
 from navsim.simulation import prepare, simulate
-from startrack.bands import band
+from startrack.photometry.bands import band
 
 DATA = Path(__file__).resolve().parent / "data"
 

@@ -10,8 +10,8 @@ from navsim.orbit.elements import Elements, mean_motion
 from navsim.orbit.numerical import NumericalOrbit
 from navsim.truth.pointing import Nadir, SunPointing, Targets, reference_rates, slew_angle
 from navsim.truth.spacecraft import Controller, Spacecraft, Wheels, _derivatives
-from startrack import rotation as rot
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.geometry import rotation as rot
 
 A = 6378137.0 + 550e3
 INERTIA = ((100.0, 0.0, 0.0), (0.0, 120.0, 0.0), (0.0, 0.0, 80.0))

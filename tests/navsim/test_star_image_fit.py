@@ -1,5 +1,5 @@
 """The image-fidelity star sensor fuses each identified star with the covariance of its position fit
-(startrack.psf_fit): at the bound, correlated along the smear trail the body rate draws."""
+(startrack.image.psf_fit): at the bound, correlated along the smear trail the body rate draws."""
 
 from pathlib import Path
 
@@ -8,7 +8,7 @@ import numpy as np
 from navsim.closed_loop import FrameGrid
 from navsim.sensors.star_sensor import FrameRequest
 from navsim.simulation import prepare
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "demo.toml"
 

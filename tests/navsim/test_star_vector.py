@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from navsim.sensors.star_vector import StarVectorSensor
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 FOV = np.radians(12.0)
 

@@ -13,9 +13,9 @@ from navsim.earth.wgs84 import radii
 from navsim.ins import strapdown
 from navsim.truth import trajectory
 from navsim.truth.segments import Hold, Profile, Start
-from startrack import rotation as rot
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
+from startrack.geometry import rotation as rot
 from tests.navsim.ins_helpers import aircraft_first_hour, attitude_errors, position_errors, trajectory_table
 
 

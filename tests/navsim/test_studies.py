@@ -16,7 +16,7 @@ from navsim import studies
 from navsim.kinds import load_scenario, scenario_from_dict
 from navsim.output import write_study
 from navsim.report import write_report
-from startrack.errors import InputError
+from startrack.base.errors import InputError
 from tests.support import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -10,9 +10,9 @@ from navsim.earth.gravity import GravityDisturbance, normal_gravity
 from navsim.earth.wgs84 import radii
 from navsim.truth import trajectory
 from navsim.truth.segments import Climb, Hold, Profile, ShipMotion, Start, Straight, Turn, window
-from startrack import rotation as rot
-from startrack import units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
+from startrack.geometry import rotation as rot
 from tests.navsim.ins_helpers import trajectory_table
 
 MANOEUVRES = {

@@ -5,7 +5,7 @@ import pytest
 
 from navsim import kinematics
 from navsim.truth.profiles import ConstantRate, RateSegments, RigidBody, SinusoidalAxis, interval_mean_rates
-from startrack import rotation as rot
+from startrack.geometry import rotation as rot
 
 PAPER000 = SinusoidalAxis(axis=(np.sqrt(2) / 2, 0.5, 0.5), theta0=np.pi / 3, amplitude=np.pi / 6, angular_frequency=1.0)
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])

@@ -1,4 +1,4 @@
-"""Apparent star directions (startrack.aberration) against skyfield, an independent implementation
+"""Apparent star directions (startrack.catalog.apparent_place) against skyfield, an independent implementation
 (NOVAS's aberration, JPL's DE421 ephemeris from the skyfield-data package: nothing is downloaded),
 and against the closed forms of relativistic aberration and the annual aberration figures."""
 
@@ -6,8 +6,10 @@ import erfa
 import numpy as np
 import pytest
 
-from startrack import aberration, sphere, units
-from startrack.errors import InputError
+from startrack.base import units
+from startrack.base.errors import InputError
+from startrack.catalog import apparent_place as aberration
+from startrack.geometry import sphere
 from tests.sky_support import deflected_by_the_sun, random_directions, skyfield_stars, skyfield_vectors
 
 DATES = [(2000, 1, 1, 12.0), (2015, 3, 20, 0.0), (2019, 7, 15, 3.5), (2026, 3, 1, 12.0), (2045, 9, 1, 0.0)]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.attitude_angles import (
+from startrack.geometry.attitude_angles import (
     euler313_from_matrix,
     matrix_from_euler313,
     matrix_from_radec_roll,

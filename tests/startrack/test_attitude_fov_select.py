@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from startrack.attitude_angles import matrix_from_radec_roll
-from startrack.errors import InputError
-from startrack.fov_select import cone_mask, field_radius, radec_prefilter, radec_window
-from startrack.sphere import radec_to_vector, vector_to_radec
+from startrack.base.errors import InputError
+from startrack.catalog.field_selection import cone_mask, field_radius, radec_prefilter, radec_window
+from startrack.geometry.attitude_angles import matrix_from_radec_roll
+from startrack.geometry.sphere import radec_to_vector, vector_to_radec
 
 
 @pytest.fixture(scope="module")

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.attitude import SOLVERS, cramer_rao_covariance, get_solver
-from startrack.errors import InputError
+from startrack.attitude.solvers import SOLVERS, cramer_rao_covariance, get_solver
+from startrack.base.errors import InputError
 
 ARCSEC = np.pi / 180.0 / 3600.0
 ALL = list(SOLVERS)

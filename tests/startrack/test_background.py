@@ -1,12 +1,12 @@
-"""Mesh background (startrack.background) and the detection of real-frame features: vignetting and
+"""Mesh background (startrack.image.background) and the detection of real-frame features: vignetting and
 nebulosity, hot pixels (single-pixel events), full scale."""
 
 import numpy as np
 import pytest
 
-from startrack.background import estimate_background, mesh_background
-from startrack.detection import detect
-from startrack.render import SensorModel, Sources, render
+from startrack.image.background import estimate_background, mesh_background
+from startrack.image.detection import detect
+from startrack.image.render import SensorModel, Sources, render
 
 
 def _vignetted(rng, shape=(480, 640), sigma=7.0):

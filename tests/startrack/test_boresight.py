@@ -5,8 +5,8 @@ import pytest
 from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
 
-from startrack import boresight as bs
-from startrack.errors import InputError
+from startrack.attitude import boresight as bs
+from startrack.base.errors import InputError
 
 ARCSEC = np.pi / 180.0 / 3600.0
 FOCAL = 256.0 / np.tan(np.radians(6.0))       # 001 2.1.3: f = 256 / tan 6 deg ~ 2435.7 px

@@ -1,11 +1,11 @@
 """Writers that fill the cache at once (a campaign's workers on a fresh machine) each leave a whole table and
-never fail on one another's temporary (startrack.cache.publish_file, publish_folder)."""
+never fail on one another's temporary (startrack.base.cache_dir.publish_file, publish_folder)."""
 
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from startrack.cache import publish_file, publish_folder
+from startrack.base.cache_dir import publish_file, publish_folder
 
 WRITERS, WRITES = 6, 15
 

@@ -7,9 +7,9 @@ import pytest
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-from startrack.attitude_angles import quaternion_from_radec_roll
-from startrack.camera import Camera
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.camera.model import Camera
+from startrack.geometry.attitude_angles import quaternion_from_radec_roll
 
 DEG = np.pi / 180.0
 

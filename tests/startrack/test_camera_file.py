@@ -1,14 +1,14 @@
-"""Camera files (startrack.camera_file): written from a calibration, read back, bad files refused."""
+"""Camera files (startrack.camera.file): written from a calibration, read back, bad files refused."""
 
 import math
 
 import numpy as np
 import pytest
 
-from startrack.camera import Camera
-from startrack.camera_file import read_camera_file, write_camera_file
-from startrack.camera_fit import CameraCalibration
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.camera.file import read_camera_file, write_camera_file
+from startrack.camera.fit import CameraCalibration
+from startrack.camera.model import Camera
 
 
 def test_written_camera_is_read_back_with_its_sigma(tmp_path):
@@ -17,7 +17,7 @@ def test_written_camera_is_read_back_with_its_sigma(tmp_path):
     path = write_camera_file(tmp_path / "cam.toml", CameraCalibration(camera, covariance, 1.2, 0.15, 150, 160, 8.0),
                              'frame "a".tiff')
     content = read_camera_file(path)
-    assert content.camera == camera and Camera.from_file(path) == camera
+    assert content.camera == camera and read_camera_file(path).camera == camera
     # rounding level: square roots of the diagonal written above
     assert content.sigma == pytest.approx({"focal_px": 0.4, "cx": 2.0, "cy": 2.5, "k1": 0.01, "k2": 0.0})
     assert content.fit["source"] == 'frame "a".tiff' and content.fit["matched"] == 150
@@ -44,4 +44,4 @@ def test_bad_camera_files_are_one_input_error(tmp_path, text, message):
 
 def test_missing_camera_file(tmp_path):
     with pytest.raises(InputError, match="does not exist"):
-        Camera.from_file(tmp_path / "none.toml")
+        read_camera_file(tmp_path / "none.toml").camera

@@ -9,15 +9,16 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from startrack.camera import Camera
-from startrack.camera_file import read_camera_file, write_camera_file
-from startrack.camera_fit import CameraCalibration, _jacobian_rows, camera_array, fit, project_one
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.base.units import ARCSEC, DEG
+from startrack.camera.file import read_camera_file, write_camera_file
+from startrack.camera.fit import CameraCalibration, _jacobian_rows, fit
+from startrack.camera.model import Camera
+from startrack.camera.projection_kernels import camera_array, project_one
+from startrack.geometry.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
+from startrack.geometry.sphere import vector_to_radec
 from startrack.identify.verify import field_solid_angle
-from startrack.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
-from startrack.sphere import vector_to_radec
-from startrack.synthetic import random_attitude
-from startrack.units import ARCSEC, DEG
+from startrack.image.synthetic import random_attitude
 
 #: A 140 deg fisheye (f = 420 px over 1024 px) with an off-centre principal point.
 FISHEYE = Camera(1024, 768, 420.0, cx=520.0, cy=380.0, k1=-0.04, k2=0.002, projection="fisheye")
@@ -144,7 +145,7 @@ def test_zpn_wcs_reproduces_the_fisheye():
     from astropy.io import fits
     from astropy.wcs import WCS
 
-    from startrack.wcs import frame_wcs
+    from startrack.camera.wcs import frame_wcs
 
     camera = Camera(1600, 1200, 1600.0 / (150.0 * DEG), cx=790.3, cy=610.2, k1=1.0 / 12.0, k2=1.0 / 120.0,
                     projection="fisheye")

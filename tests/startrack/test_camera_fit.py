@@ -1,15 +1,16 @@
-"""The least-squares fit of attitude and intrinsics (startrack.camera_fit) against independent references:
+"""The least-squares fit of attitude and intrinsics (startrack.camera.fit) against independent references:
 the exact camera (noise-free), scipy's least_squares on the same data with the model written through
-startrack.camera.Camera, and the scatter of seeded Monte Carlo fits against the covariance it reports."""
+startrack.camera.model.Camera, and the scatter of seeded Monte Carlo fits against the covariance it reports."""
 
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from startrack.camera import Camera
-from startrack.camera_fit import CameraCalibration, camera_array, fit
-from startrack.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
-from startrack.synthetic import random_attitude
+from startrack.camera.fit import CameraCalibration, fit
+from startrack.camera.model import Camera
+from startrack.camera.projection_kernels import camera_array
+from startrack.geometry.rotation import from_matrix, from_rotation_vector, to_matrix, to_rotation_vector
+from startrack.image.synthetic import random_attitude
 
 TRUE = Camera(1024, 768, 2100.0, cx=520.0, cy=380.0, k1=-0.12, k2=0.03)
 FREE_ALL = np.array([True, True, True, True, True])

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from startrack import address as addr
-from startrack.errors import InputError
-from startrack.sphere import angular_distance, radec_to_vector, vector_to_radec
+from startrack.base.errors import InputError
+from startrack.catalog import address as addr
+from startrack.geometry.sphere import angular_distance, radec_to_vector, vector_to_radec
 
 DEG = math.pi / 180.0
 RHO_SUB = 12.0 * DEG  # eq. 6 for n_d = 53, 16 deg, max(delta) = 2 deg

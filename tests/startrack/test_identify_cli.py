@@ -13,11 +13,11 @@ import re
 import numpy as np
 import pytest
 
-from startrack.attitude_angles import matrix_from_radec_roll
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
 from startrack.cli import main
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame, random_attitude
+from startrack.geometry.attitude_angles import matrix_from_radec_roll
+from startrack.image.synthetic import centroid_frame, random_attitude
 
 SIZE = ["--width", "1024", "--height", "1024"]
 GEOMETRY = ["--fov-deg", "16", *SIZE]
@@ -197,9 +197,9 @@ def test_malformed_csv(tmp_path, capsys, text, message):
     (["--fov-hint-deg", "3"], None),                     # inside it (2-160 deg): the default range
     (["--fov-range-deg", "2,20", "--fov-hint-deg", "3"], (2.0, 20.0))])
 def test_a_narrow_hint_extends_the_search(argv, expected_deg):
-    from startrack.cli import build_parser
+    from startrack.base.units import DEG
+    from startrack.commands import build_parser
     from startrack.commands.solve import _fov_range
-    from startrack.units import DEG
 
     found = _fov_range(build_parser().parse_args(["solve", "frame.png", *argv]))
     assert found == expected_deg if expected_deg is None else np.allclose(np.array(found) / DEG, expected_deg)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
 from startrack.identify.features import FrameFeatures, pair_features
 
 FOCAL_PX = 512.0 / np.tan(np.radians(8.0))  # 16 deg over 1024 px

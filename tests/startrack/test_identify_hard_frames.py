@@ -17,10 +17,10 @@ answers (1 of these 200 frames).
 import numpy as np
 import pytest
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.navigation import NavigationCatalogParams, load_navigation_catalog
 from startrack.identify import StarIdentifier
-from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-from startrack.synthetic import random_attitude
+from startrack.image.synthetic import random_attitude
 
 FOV = np.radians(12.0)
 SIGMA_PX = 0.05

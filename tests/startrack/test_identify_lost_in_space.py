@@ -1,7 +1,7 @@
 """Full-sky lost-in-space identification on random sky frames from the real catalog.
 
 Frames: every Hipparcos star with V <= 6 in a 16 deg, 1024 x 1024 pinhole field at a uniformly random
-attitude, 0.1 px centroid noise, missing and false stars (startrack.synthetic).  Truth is the
+attitude, 0.1 px centroid noise, missing and false stars (startrack.image.synthetic).  Truth is the
 star each centroid came from and the attitude drawn.
 """
 
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import NavigationCatalogParams, load_navigation_catalog
 from startrack.identify import StarIdentifier
-from startrack.navigation_catalog import NavigationCatalogParams, load_navigation_catalog
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame, random_attitude
+from startrack.image.synthetic import centroid_frame, random_attitude
 
 SIGMA_PX = 0.1
 

@@ -1,7 +1,7 @@
 """Pattern look-ups of a calibrated camera (startrack.identify.pattern_hash) on random frames of the real sky.
 
 Frames: every Hipparcos star with V <= 6 in a 16 deg, 1024 x 1024 pinhole field at a uniformly random
-attitude, 0.1 px centroid noise (startrack.synthetic).  The look-ups alone (no pyramid after
+attitude, 0.1 px centroid noise (startrack.image.synthetic).  The look-ups alone (no pyramid after
 them) are checked against the truth, against mirror images and random points, and against the
 pyramid search of the same frames.
 """
@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import load_navigation_catalog
 from startrack.identify import StarIdentifier
 from startrack.identify.pattern_catalog import PatternCatalog, PatternCatalogParams, build_level, candidates_per_lookup
 from startrack.identify.pattern_hash import HASH_STARS, NO_PATTERNS, hash_search, pattern_arrays
 from startrack.identify.scale_free import COMBINATIONS_BELOW
 from startrack.identify.zones import SKY, cap
-from startrack.navigation_catalog import load_navigation_catalog
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame, random_attitude
+from startrack.image.synthetic import centroid_frame, random_attitude
 
 SIGMA_PX = 0.1
 ARCSEC = math.pi / 180.0 / 3600.0

@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import load_navigation_catalog
+from startrack.geometry.sphere import vector_to_radec
 from startrack.identify import Prior, StarIdentifier
 from startrack.identify.pairs import SubCatalogPairs
-from startrack.navigation_catalog import load_navigation_catalog
-from startrack.sphere import vector_to_radec
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame, random_attitude
+from startrack.image.synthetic import centroid_frame, random_attitude
 
 DEG = np.pi / 180.0
 

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack.camera import Camera
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import load_navigation_catalog
 from startrack.identify import Prior, StarIdentifier
-from startrack.navigation_catalog import load_navigation_catalog
-from startrack.star_catalog import load_star_catalog
-from startrack.synthetic import centroid_frame
+from startrack.image.synthetic import centroid_frame
 
 DEG = np.pi / 180.0
 
@@ -86,7 +86,7 @@ def test_a_prior_beyond_the_window_hands_over_to_the_sub_catalog(setup):
 @pytest.mark.parametrize("kwargs", [{"q_IS": [0.0, 0.0, 0.0, 0.0]}, {"q_IS": [np.nan, 0, 0, 1]}, {"q_IS": [0, 0, 1]},
                                     {"rate_S": [0.0, 1.0]}, {"dt": float("inf")}, {"boresight": (0.0, 2.0)}])
 def test_bad_priors_are_refused(kwargs):
-    from startrack.errors import InputError
+    from startrack.base.errors import InputError
 
     with pytest.raises(InputError):
         Prior(**kwargs)

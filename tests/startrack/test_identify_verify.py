@@ -7,12 +7,12 @@ import pytest
 from scipy.spatial.transform import Rotation
 from scipy.stats import binom
 
-from startrack.attitude import SvdWahba
-from startrack.camera import Camera
+from startrack.attitude.solvers import SvdWahba
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.catalog.navigation import load_navigation_catalog
 from startrack.identify.pairs import PairTable, kvector_range, pair_range
 from startrack.identify.verify import FieldStars, binomial_tail, false_match_probability, match_nearest, wahba_svd
-from startrack.navigation_catalog import load_navigation_catalog
-from startrack.star_catalog import load_star_catalog
 
 
 @pytest.mark.parametrize("n, k, p", [(30, 3, 1e-4), (30, 0, 0.3), (10, 10, 0.5), (50, 7, 2e-3), (5, 6, 0.1),

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from startrack.detection import (
+from startrack.base.errors import InputError
+from startrack.image.detection import (
     CENTROIDERS,
     GreyCentroid,
     SquareWeightedCentroid,
@@ -13,9 +14,8 @@ from startrack.detection import (
     detect_windows,
     estimate_background,
 )
-from startrack.errors import InputError
-from startrack.render import SensorModel, Sources, Windows, expected_charge, render
-from startrack.stacking import grey_centroid
+from startrack.image.render import SensorModel, Sources, Windows, expected_charge, render
+from startrack.image.stacking import grey_centroid
 
 GAUSS = SensorModel(shot_noise=False, gain_e_per_dn=1.0, read_noise_e=10.0, dark_e_per_px_s=0.0, bias_dn=100.0)
 

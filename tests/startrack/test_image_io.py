@@ -7,9 +7,9 @@ import pytest
 from PIL import Image
 from scipy.spatial import cKDTree
 
+from startrack.base.errors import InputError
 from startrack.cli import main
-from startrack.errors import InputError
-from startrack.image_io import full_scale, read_frame, read_image, write_image
+from startrack.image.files import full_scale, read_frame, read_image, write_image
 
 
 def _frame():

@@ -6,15 +6,9 @@ from scipy.spatial.transform import Rotation
 from scipy.special import erf
 from scipy.stats import norm
 
-from startrack.camera import Camera
-from startrack.errors import InputError
-from startrack.photometry import (
-    centred_peak_fraction,
-    magnitude_for_electrons,
-    pixel_fraction,
-    star_electrons,
-)
-from startrack.render import (
+from startrack.base.errors import InputError
+from startrack.camera.model import Camera
+from startrack.image.render import (
     SMEAR_STEP_SIGMA,
     SensorModel,
     Sources,
@@ -26,6 +20,12 @@ from startrack.render import (
     render_star_field,
     star_sources,
     stray_light,
+)
+from startrack.photometry.star_signal import (
+    centred_peak_fraction,
+    magnitude_for_electrons,
+    pixel_fraction,
+    star_electrons,
 )
 
 DEG = np.pi / 180.0

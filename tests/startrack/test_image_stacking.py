@@ -3,18 +3,10 @@
 import numpy as np
 import pytest
 
-from startrack.detection import detect
-from startrack.errors import InputError
-from startrack.photometry import (
-    detection_threshold,
-    snr,
-    stackable_snr_range,
-    stacked_snr,
-    stacked_threshold,
-    static_stacking_gain,
-)
-from startrack.render import SensorModel, Sources, expected_charge, render
-from startrack.stacking import (
+from startrack.base.errors import InputError
+from startrack.image.detection import detect
+from startrack.image.render import SensorModel, Sources, expected_charge, render
+from startrack.image.stacking import (
     DimStarCache,
     cut_window,
     grey_centroid,
@@ -23,6 +15,14 @@ from startrack.stacking import (
     stacked_centroid_from_frames,
     window_centre,
     window_shifts,
+)
+from startrack.photometry.star_signal import (
+    detection_threshold,
+    snr,
+    stackable_snr_range,
+    stacked_snr,
+    stacked_threshold,
+    static_stacking_gain,
 )
 
 GAUSS = SensorModel(shot_noise=False, gain_e_per_dn=1.0, read_noise_e=10.0, dark_e_per_px_s=0.0, bias_dn=100.0)

@@ -1,5 +1,5 @@
 """Compiled kernels cannot load stale machine code: the cache folder is keyed by every source file of
-startrack and navsim (``startrack.jit``), so editing a module a kernel calls -- which numba's own per-file
+startrack and navsim (``startrack.compiled.numba_setup``), so editing a module a kernel calls -- which numba's own per-file
 cache key misses -- compiles that kernel again."""
 
 import os
@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 
 import startrack
-from startrack.jit import source_key
+from startrack.compiled.numba_setup import source_key
 
 PACKAGE = Path(startrack.__file__).resolve().parent
-CALLEE = "from startrack.jit import njit\n\n\n@njit\ndef value():\n    return {}\n"
-CALLER = "from startrack._probe_callee import value\nfrom startrack.jit import njit\n\n\n@njit\ndef twice():\n    return 2.0 * value()\n"
+CALLEE = "from startrack.compiled.numba_setup import njit\n\n\n@njit\ndef value():\n    return {}\n"
+CALLER = "from startrack._probe_callee import value\nfrom startrack.compiled.numba_setup import njit\n\n\n@njit\ndef twice():\n    return 2.0 * value()\n"
 
 
 def test_the_key_follows_every_source_file(tmp_path):
@@ -56,7 +56,7 @@ def test_kernels_defined_after_a_compilation_still_go_to_the_keyed_folder(tmp_pa
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env.update(STARTRACK_CACHE_DIR=str(tmp_path / "cache"))
     script = tmp_path / "probe.py"
-    script.write_text("import numba\nfrom startrack.jit import njit, kernel_cache_dir\n\n\n@njit\ndef first():\n"
+    script.write_text("import numba\nfrom startrack.compiled.numba_setup import njit, kernel_cache_dir\n\n\n@njit\ndef first():\n"
                       "    return 1.0\n\n\nfirst()\n\n\ndef second():\n    return 2.0\n\n\nsecond = njit(second)\n"
                       "second()\nprint(numba.config.CACHE_DIR == str(kernel_cache_dir()), len(list(kernel_cache_dir().rglob('*.nbi'))))\n")
     done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, cwd=tmp_path)

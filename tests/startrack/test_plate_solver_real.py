@@ -17,14 +17,15 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from startrack.attitude_angles import matrix_from_radec_roll, quaternion_from_radec_roll
-from startrack.camera import Camera
+from startrack.base.units import ARCSEC
+from startrack.camera.file import read_camera_file
+from startrack.camera.model import Camera
 from startrack.cli import main
 from startrack.commands.detect import detect_frame
+from startrack.geometry.attitude_angles import matrix_from_radec_roll, quaternion_from_radec_roll
+from startrack.geometry.sphere import angular_distance, radec_to_vector
 from startrack.identify.plate_solver import PlateSolver
-from startrack.image_io import read_frame
-from startrack.sphere import angular_distance, radec_to_vector
-from startrack.units import ARCSEC
+from startrack.image.files import read_frame
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "realsky"
 REFERENCE = json.loads((DATA / "reference.json").read_text())
@@ -100,7 +101,7 @@ def test_camera_file_round_trip_solves_the_frame_again(tmp_path, capsys):
     camera_file = tmp_path / "camera.toml"
     assert main(["solve", str(frame), "--json", "--write-camera", str(camera_file)]) == 0
     first = json.loads(capsys.readouterr().out)
-    written = Camera.from_file(camera_file)  # rounding level: the same number, printed and read back
+    written = read_camera_file(camera_file).camera  # rounding level: the same number, printed and read back
     assert written.focal_px == pytest.approx(first["camera"]["focal_px"]) and (written.width, written.height) == (1024, 768)
     assert main(["solve", str(frame), "--json", "--camera", str(camera_file)]) == 0
     again = json.loads(capsys.readouterr().out)

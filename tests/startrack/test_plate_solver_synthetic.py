@@ -19,16 +19,16 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from startrack.attitude_angles import matrix_from_radec_roll
-from startrack.camera import Camera
-from startrack.detection import detect
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.base.units import ARCSEC, DEG
+from startrack.camera.model import Camera
+from startrack.catalog.hipparcos import HIP_MAX, load_star_catalog
+from startrack.geometry.attitude_angles import matrix_from_radec_roll
 from startrack.identify import plate_solver
 from startrack.identify.pattern_catalog import PatternCatalogParams
 from startrack.identify.plate_solver import PlateSolver
-from startrack.star_catalog import HIP_MAX, load_star_catalog
-from startrack.synthetic import as_jpeg, centroid_frame, noise_crowd, random_attitude, rendered_sky
-from startrack.units import ARCSEC, DEG
+from startrack.image.detection import detect
+from startrack.image.synthetic import as_jpeg, centroid_frame, noise_crowd, random_attitude, rendered_sky
 from tests.support import SteppedClock
 
 WIDTH, HEIGHT = 1024, 768
@@ -108,7 +108,7 @@ def test_rendered_frames_with_distortion(solver, stars, fov_deg, k1):
 
 
 #: The fisheye lenses in the equidistant model with radial terms: (k1, k2) of the equidistant, equisolid and
-#: stereographic projections (their Taylor series, :mod:`startrack.camera`).
+#: stereographic projections (their Taylor series, :mod:`startrack.camera.model`).
 FISHEYES = {"equidistant": (0.0, 0.0), "equisolid": (-1.0 / 24.0, 1.0 / 1920.0), "stereographic": (1.0 / 12.0, 1.0 / 120.0)}
 
 
@@ -154,8 +154,8 @@ def test_pattern_levels_deepen_below_five_degrees():
 def test_rendered_narrow_frames(solver):
     """Frames of 2-5 deg rendered from the Gaia DR3 sky (2 s exposure: V ~ 10.5), solved by the default search
     (down to 2 deg, with the Gaia stars): right, and named by HIP or Gaia source_id."""
-    from startrack.gaia_catalog import load_gaia_catalog
-    from startrack.render import SensorModel
+    from startrack.catalog.gaia import load_gaia_catalog
+    from startrack.image.render import SensorModel
 
     sky_stars = load_gaia_catalog(2000.0)
     for fov_deg, seed in ((2.2, 1), (3.3, 2), (4.7, 3)):

@@ -1,4 +1,4 @@
-"""Kernels compiled ahead (``startrack.precompile``): lanes run at once, finished tasks are marked and
+"""Kernels compiled ahead (``startrack.compiled.compile_ahead``): lanes run at once, finished tasks are marked and
 skipped afterwards, a failing task is one line and no failure of the run."""
 
 import io
@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numba
 
-from startrack.precompile import compile_ahead, marker
+from startrack.compiled.compile_ahead import compile_ahead, marker
 
 TWICE, THRICE, FAILS = "tests.compile_tasks:twice", "tests.compile_tasks:thrice", "tests.compile_tasks:fails"
 

@@ -4,12 +4,12 @@ daytime field: 1, 2 or 3 stars and 0-2 false detections, the prior's σ from 5" 
 import numpy as np
 import pytest
 
-from startrack import rotation as rot
-from startrack.errors import InputError
+from startrack.base.errors import InputError
+from startrack.base.units import ARCSEC
+from startrack.catalog.hipparcos import load_star_catalog
+from startrack.geometry import rotation as rot
+from startrack.geometry.sphere import tangent_basis
 from startrack.identify.prior_match import PriorMatch
-from startrack.sphere import tangent_basis
-from startrack.star_catalog import load_star_catalog
-from startrack.units import ARCSEC
 
 #: A 2-deg SWIR field in H: the catalog to H = 6, detections of the stars to H = 4, 2" centroids, 0.1 mag photometry;
 #: the band magnitudes from the colours err by 0.12 mag RMS (tests/startrack/test_colours.py: 0.10 J, 0.14 H).

@@ -1,4 +1,4 @@
-"""Star positions at the Cramér-Rao bound (startrack.psf_fit): the bound against its closed forms, the fit
+"""Star positions at the Cramér-Rao bound (startrack.image.psf_fit): the bound against its closed forms, the fit
 against the bound on frames rendered without the project's renderer (tests/star_images.py), its
 covariance against the errors, and the flags of what the model cannot explain."""
 
@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from startrack.errors import InputError
-from startrack.psf_fit import PixelNoise, centroid_bound, fit_stars
+from startrack.base.errors import InputError
+from startrack.image.psf_fit import PixelNoise, centroid_bound, fit_stars
 from tests.star_images import noisy_frame
 
 

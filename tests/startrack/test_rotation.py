@@ -1,4 +1,4 @@
-"""The rotation floor of both packages (startrack.rotation and its compiled twin) against scipy's Rotation.
+"""The rotation floor of both packages (startrack.geometry.rotation and its compiled twin) against scipy's Rotation.
 
 Every tolerance here is at the rounding level: exact identities of well-conditioned closed forms (round
 trips, conversions) and compiled twins of the same operations."""
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from startrack import rotation as rot
-from startrack import rotation_jit
+from startrack.geometry import rotation as rot
+from startrack.geometry import rotation_kernels as rotation_jit
 
 RNG = np.random.default_rng(20261122)
 

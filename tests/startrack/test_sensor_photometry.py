@@ -11,15 +11,15 @@ import pytest
 from scipy.special import erf
 from scipy.stats import chi2
 
-from startrack.bands import BANDS, LIGHT_SPEED, PLANCK, band, sky_rate, zero_point
-from startrack.camera import Camera
-from startrack.detection import detect
-from startrack.detectors import DETECTORS, detector
-from startrack.errors import InputError
-from startrack.photometry import peak_fraction, trail_peak_fraction
-from startrack.psf_fit import PixelNoise, centroid_bound, centroid_variance, fit_stars
-from startrack.render import SensorModel, render_star_field
-from startrack.sensor_photometry import SensorPhotometry, detection_threshold
+from startrack.base.errors import InputError
+from startrack.camera.model import Camera
+from startrack.image.detection import detect
+from startrack.image.psf_fit import PixelNoise, centroid_bound, centroid_variance, fit_stars
+from startrack.image.render import SensorModel, render_star_field
+from startrack.image.sensor_photometry import SensorPhotometry, detection_threshold
+from startrack.photometry.bands import BANDS, LIGHT_SPEED, PLANCK, band, sky_rate, zero_point
+from startrack.photometry.detectors import DETECTORS, detector
+from startrack.photometry.star_signal import peak_fraction, trail_peak_fraction
 
 UM = 1e-6
 #: photons cm⁻² s⁻¹ Å⁻¹ -> photons m⁻² s⁻¹ m⁻¹.

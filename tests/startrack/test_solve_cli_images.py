@@ -13,7 +13,7 @@ from PIL import Image
 
 from startrack.cli import main
 from startrack.identify import plate_solver
-from startrack.image_io import read_image
+from startrack.image.files import read_image
 from tests.support import SteppedClock
 
 FRAMES = sorted((Path(__file__).resolve().parents[1] / "data" / "realsky").glob("*.tiff"))
@@ -135,12 +135,12 @@ def test_a_fisheye_image_is_solved_as_one_and_its_wcs_is_zpn(tmp_path, capsys):
     from astropy.io import fits
     from astropy.wcs import WCS
 
-    from startrack.camera import Camera
-    from startrack.camera_file import read_camera_file
-    from startrack.image_io import write_image
-    from startrack.star_catalog import load_star_catalog
-    from startrack.synthetic import rendered_sky
-    from startrack.units import DEG
+    from startrack.base.units import DEG
+    from startrack.camera.file import read_camera_file
+    from startrack.camera.model import Camera
+    from startrack.catalog.hipparcos import load_star_catalog
+    from startrack.image.files import write_image
+    from startrack.image.synthetic import rendered_sky
 
     focal = Camera.from_fov(100.0 * DEG, 1024, 768, projection="fisheye").focal_px
     camera = Camera(1024, 768, focal, k1=-1.0 / 24.0, k2=1.0 / 1920.0, projection="fisheye")

@@ -23,9 +23,9 @@ import json
 import numpy as np
 import pytest
 
+from startrack.base.units import ARCSEC
+from startrack.catalog.hipparcos import load_star_catalog
 from startrack.cli import main
-from startrack.star_catalog import load_star_catalog
-from startrack.units import ARCSEC
 from tests.pinhole_frames import Pinhole, attitude_error, efficient_attitude, make_frame, pixel_crb
 
 #: name: (camera, centroid sigma [px], frames, seed).

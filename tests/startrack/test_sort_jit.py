@@ -1,4 +1,4 @@
-"""The kernels' sorts (``startrack.sort_jit``) give numpy's answers: the stable argsort, unique and median,
+"""The kernels' sorts (``startrack.compiled.sorts``) give numpy's answers: the stable argsort, unique and median,
 on keys with many ties and every length around the insertion runs and the merge widths."""
 
 import numpy as np
@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from startrack.sort_jit import argsort, median, unique
+from startrack.compiled.sorts import argsort, median, unique
 
 LENGTHS = [0, 1, 2, 15, 16, 17, 31, 32, 33, 48, 64, 65, 1000, 4097]
 

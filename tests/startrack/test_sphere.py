@@ -1,9 +1,9 @@
-"""The azimuthal equidistant map (startrack.sphere.azimuthal_equidistant) against its defining properties
+"""The azimuthal equidistant map (startrack.geometry.sphere.azimuthal_equidistant) against its defining properties
 (Snyder 1987, ch. 25) and its closed form at a pole."""
 
 import numpy as np
 
-from startrack.sphere import angular_distance, azimuthal_equidistant, radec_to_vector
+from startrack.geometry.sphere import angular_distance, azimuthal_equidistant, radec_to_vector
 
 
 def test_every_point_lies_at_its_distance_from_the_centre_in_its_bearing():

@@ -19,7 +19,7 @@ sys.path.insert(0, str(BENCHMARKS))
 import star_id  # noqa: E402
 import star_id_frames as sif  # noqa: E402
 
-from startrack.attitude import cramer_rao_covariance  # noqa: E402
+from startrack.attitude.solvers import cramer_rao_covariance  # noqa: E402
 
 ARCSEC = np.pi / (180.0 * 3600.0)
 

@@ -1,0 +1,1 @@
+"""Attitude from matched directions: the solvers and the boresight solves."""

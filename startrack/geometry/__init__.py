@@ -1,0 +1,1 @@
+"""Rotations (one convention, numpy and compiled), the sphere, attitude angles."""

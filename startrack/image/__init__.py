@@ -1,0 +1,1 @@
+"""The image chain: rendering, background, detection, the position fit, stacking, image files, synthetic frames and a sensor's light budget."""
