@@ -23,11 +23,20 @@ def divergence_sigmas(samples):
     return max(DIVERGENCE_SIGMAS, float(norm.isf(0.5 * FALSE_DIVERGENCE / max(int(samples), 1))))
 
 
-def diverged(summary, errors, sigmas):
-    """True when the steady ``errors`` (F, m) exceed :func:`divergence_sigmas` of their filter's ``sigmas``
-    (F, m) anywhere or the run's NEES mean is above 5 times its dof."""
-    limit = divergence_sigmas(np.size(errors))
-    return bool(np.any(np.abs(errors) > limit * sigmas)) or summary["nees"]["mean"] > DIVERGENCE_SIGMAS * summary["nees"]["dof"]
+def divergence(errors, sigmas):
+    """A run's divergence test on every steady frame (its summary's ``divergence``): the largest normalised error
+    |e|/σ of ``errors`` (F, m) against their filter's ``sigmas`` (F, m), the ``samples`` F·m and the family-wise
+    ``threshold`` (:func:`divergence_sigmas`) for them."""
+    z = np.abs(np.asarray(errors, dtype=float)) / np.asarray(sigmas, dtype=float)
+    return {"max_normalised_error": float(np.max(z, initial=0.0)), "samples": int(z.size),
+            "threshold": divergence_sigmas(z.size)}
+
+
+def diverged(summary):
+    """True when a run's largest normalised error passed its threshold (:func:`divergence`, tested when the run was
+    summarised, on every frame: a campaign keeps fewer) or its NEES mean is above 5 times its dof."""
+    test = summary["divergence"]
+    return test["max_normalised_error"] > test["threshold"] or summary["nees"]["mean"] > DIVERGENCE_SIGMAS * summary["nees"]["dof"]
 
 
 def run_averaged_nees(series):

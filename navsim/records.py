@@ -27,7 +27,7 @@ from typing import ClassVar
 
 from startrack import InputError
 
-RUN_FORMAT = "navsim.run-summary/1"
+RUN_FORMAT = "navsim.run-summary/2"
 CAMPAIGN_FORMAT = "navsim.campaign-summary/1"
 
 
@@ -115,6 +115,7 @@ class RunSummary(Record):
     frames: int
     settle_s: float
     nees: dict
+    divergence: dict
     nis: dict
     updates: dict
     identification: dict | None = None

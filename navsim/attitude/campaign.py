@@ -16,7 +16,7 @@ def pool(finished, settle):
         steady = series["t"] >= settle
         errors.append(series["attitude_error"][steady])
         sigmas.append(np.sqrt(series["P_diag"][steady, :3]))
-        if diverged(summary, errors[-1], sigmas[-1]):
+        if diverged(summary):
             divergent.append(k)
     stacked, sigma = np.concatenate(errors), np.concatenate(sigmas)
     arcsec = units.rad_to_arcsec

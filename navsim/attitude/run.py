@@ -21,6 +21,7 @@ from navsim.build.star_sensor import observers, star_sensor
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.estimation.attitude_filter import AttitudeFilter
 from navsim.estimation.consistency import nees, nees_statistics
+from navsim.pooling import divergence
 from navsim.records import RunResult
 from navsim.scenario.star_sensor_fields import mounting
 from navsim.sensors.faults import apply_bias_steps
@@ -170,6 +171,7 @@ def summarize(scenario, seed, series, R_BS):
         attitude_sigma_final_arcsec=[float(v) for v in units.rad_to_arcsec(sigma_att)],
         bias_error_final_deg_per_h=[float(v) for v in units.rad_per_s_to_deg_per_h(series["bias_true"][-1] - series["bias_est"][-1])],
         nees=nees_statistics(series["nees"][steady], NEES_DOF),
+        divergence=divergence(err_B[steady], np.sqrt(np.diagonal(series["P"][steady], axis1=1, axis2=2)[:, 0:3])),
         nis={"mean_per_dof": float(np.sum(series["nis"][nis_frames]) / max(int(np.sum(series["nis_dof"][nis_frames])), 1))},
         updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])),
                  "measurements": measurements, "accepted": accepted, "rejected": measurements - accepted},

@@ -13,11 +13,7 @@ def pool(finished, settle):
     [(index, summary, series), ...]: CEP50/CEP95 are the median and 95th percentile over the runs
     of the final horizontal position error (its radial distance from the truth)."""
     summaries = [summary for _, summary, _ in finished]
-    divergent = []
-    for k, summary, series in finished:
-        steady = series["t"] >= settle
-        if diverged(summary, series["error_state"][steady], series["error_sigma"][steady]):
-            divergent.append(k)
+    divergent = [k for k, summary, _ in finished if diverged(summary)]
     horizontal = np.array([s["position_error_m"]["horizontal"]["final"] for s in summaries])
     vertical = np.array([s["position_error_m"]["vertical"]["final"] for s in summaries])
 

@@ -15,6 +15,7 @@ from navsim.earth.wander import ned_offset
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.estimation.nav_filter import error_state, mounting_error, state_names
 from navsim.navigation.records import RunSummary
+from navsim.pooling import divergence
 from startrack import rotation as rot
 from startrack import units
 
@@ -129,6 +130,7 @@ def summarize(scenario, seed, series, grid):
         accel_bias_error_final_micro_g=[float(v) for v in e[-1, ACCEL_BIAS] / MICRO_G],
         imu_calibration=imu_calibration(series),
         nees=nees_statistics(series["nees"][steady], e.shape[1]),
+        divergence=divergence(e[steady], sigma[steady]),
         nis={"mean_per_dof": float(np.sum(series["nis"][nis_frames]) / max(int(np.sum(series["nis_dof"][nis_frames])), 1))},
         updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])),
                  "measurements": measurements, "accepted": accepted, "rejected": measurements - accepted},

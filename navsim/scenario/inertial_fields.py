@@ -8,9 +8,12 @@ MAX_RATE, MAX_ARCSEC, MAX_ARW, MAX_RRW, MAX_BIAS = 1e4, 36000.0, 1e3, 1e4, 1e6
 #: Upper bounds of the accelerometer: bias [µg], bias random walk [µg/√h], VRW [m/s/√h], specific force [m/s²].
 MAX_MICRO_G, MAX_MICRO_G_PER_SQRT_H, MAX_VRW, MAX_FORCE = 1e6, 1e6, 1e3, 1e4
 
+#: The inertial sensors' preset grades (their tables: ``navsim.sensors.gyro.PRESETS`` and the accelerometer's).
+PRESETS = ("navigation", "tactical", "mems")
+
 #: The gyro's datasheet errors beside its preset (None: the preset's value, or 0 without a preset).
 GYRO_ERRORS = {
-    "preset": Value("str", default=None, choices=("navigation", "tactical", "mems")),
+    "preset": Value("str", default=None, choices=PRESETS),
     "arw_deg_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_ARW),
     "rrw_deg_per_h_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_RRW),
     "bias_turn_on_deg_per_h": Value("float", default=None, minimum=0.0, maximum=MAX_BIAS),
@@ -27,7 +30,7 @@ GYRO_ERRORS = {
 
 #: The accelerometer's datasheet errors beside its preset, the twin of :data:`GYRO_ERRORS`.
 ACCELEROMETER_ERRORS = {
-    "preset": Value("str", default=None, choices=("navigation", "tactical", "mems")),
+    "preset": Value("str", default=None, choices=PRESETS),
     "vrw_m_per_s_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_VRW),
     "bias_rw_micro_g_per_sqrt_h": Value("float", default=None, minimum=0.0, maximum=MAX_MICRO_G_PER_SQRT_H),
     "bias_turn_on_micro_g": Value("float", default=None, minimum=0.0, maximum=MAX_MICRO_G),

@@ -23,6 +23,14 @@ import numpy as np
 from navsim.sensors import inertial
 from startrack import units
 
+#: The datasheet presets: VRW [m/s/√h], bias [µg], bias random walk [µg/√h], τ [s], scale factor [ppm], misalignment
+#: [arcsec]; bias random walk, scale factor and misalignment typical of each grade.
+PRESETS = {
+    "navigation": inertial.Grade(0.002, 25.0, 2.0, 3600.0, 20.0, 5.0),
+    "tactical": inertial.Grade(0.05, 1000.0, 50.0, 300.0, 300.0, 60.0),
+    "mems": inertial.Grade(0.06, 500.0, 100.0, 100.0, 1000.0, 300.0),
+}
+
 
 @dataclass(frozen=True)
 class AccelerometerRecord:
@@ -64,29 +72,9 @@ class AccelerometerModel:
 
     @classmethod
     def preset(cls, name, rate_hz):
-        """Datasheet presets beside the gyro's: 'navigation' (VRW 0.002 m/s/√h, bias 25 µg),
-        'tactical' (0.05, 1000) and 'mems' (0.06, 500). The bias figure is the turn-on 1σ and the
-        bias-instability floor B (σ_g = 0.664 B / 0.6174); bias random walk, scale factor and
-        misalignment are typical of each grade."""
-        table = {
-            # vrw m/s/√h, bias µg, bias rw µg/√h, τ s, scale ppm, misalignment arcsec
-            "navigation": (0.002, 25.0, 2.0, 3600.0, 20.0, 5.0),
-            "tactical": (0.05, 1000.0, 50.0, 300.0, 300.0, 60.0),
-            "mems": (0.06, 500.0, 100.0, 100.0, 1000.0, 300.0),
-        }
-        if name not in table:
-            raise ValueError(f"unknown accelerometer preset {name!r}; choose one of {', '.join(table)}")
-        vrw, bias, bias_rw, tau, scale_ppm, misalignment_arcsec = table[name]
-        return cls(
-            rate_hz=rate_hz,
-            vrw=float(units.vrw_to_si(vrw)),
-            bias_rw=float(units.micro_g_per_sqrt_h_to_si(bias_rw)),
-            bias_turn_on_sigma=float(units.micro_g_to_si(bias)),
-            bias_instability_sigma=float(inertial.bias_instability_to_sigma(units.micro_g_to_si(bias))),
-            bias_correlation_time=tau,
-            scale_factor_sigma=scale_ppm * units.PPM,
-            misalignment_sigma=float(units.arcsec_to_rad(misalignment_arcsec)),
-        )
+        """A datasheet preset of :data:`PRESETS`, beside the gyro's (:func:`navsim.sensors.inertial.preset_fields`)."""
+        return cls(rate_hz=rate_hz, **inertial.preset_fields("accelerometer", PRESETS, name, ("vrw", units.vrw_to_si),
+                                                             ("bias_rw", units.micro_g_per_sqrt_h_to_si), units.micro_g_to_si))
 
     @property
     def filter_bias_rw(self):

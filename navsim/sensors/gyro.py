@@ -28,6 +28,14 @@ from navsim.sensors import inertial
 from navsim.sensors.inertial import allan_variance, bias_instability_to_sigma  # noqa: F401  (the gyro's API)
 from startrack import units
 
+#: The datasheet presets: ARW [deg/√h], bias [deg/h], RRW [deg/h/√h], τ [s], scale factor [ppm], misalignment
+#: [arcsec]; RRW, scale factor and misalignment typical of each grade.
+PRESETS = {
+    "navigation": inertial.Grade(0.002, 0.0035, 0.0003, 3600.0, 5.0, 5.0),
+    "tactical": inertial.Grade(0.125, 1.0, 0.05, 300.0, 100.0, 60.0),
+    "mems": inertial.Grade(0.15, 0.5, 0.3, 100.0, 500.0, 300.0),
+}
+
 
 @dataclass(frozen=True)
 class GyroRecord:
@@ -62,29 +70,9 @@ class GyroModel:
 
     @classmethod
     def preset(cls, name, rate_hz):
-        """Datasheet presets: 'navigation' (ARW 0.002 deg/√h, bias 0.0035 deg/h), 'tactical'
-        (0.125, 1) and 'mems' (0.15, 0.5). The bias figure is used both as the turn-on 1σ
-        and as the bias-instability floor B (σ_g = 0.664 B / 0.6174); RRW, scale factor
-        and misalignment are typical of each grade."""
-        table = {
-            # arw deg/√h, bias deg/h, rrw deg/h/√h, τ s, scale ppm, misalignment arcsec
-            "navigation": (0.002, 0.0035, 0.0003, 3600.0, 5.0, 5.0),
-            "tactical": (0.125, 1.0, 0.05, 300.0, 100.0, 60.0),
-            "mems": (0.15, 0.5, 0.3, 100.0, 500.0, 300.0),
-        }
-        if name not in table:
-            raise ValueError(f"unknown gyro preset {name!r}; choose one of {', '.join(table)}")
-        arw, bias, rrw, tau, scale_ppm, misalignment_arcsec = table[name]
-        return cls(
-            rate_hz=rate_hz,
-            arw=units.arw_to_si(arw),
-            rrw=units.rrw_to_si(rrw),
-            bias_turn_on_sigma=units.deg_per_h_to_rad_per_s(bias),
-            bias_instability_sigma=bias_instability_to_sigma(units.deg_per_h_to_rad_per_s(bias)),
-            bias_correlation_time=tau,
-            scale_factor_sigma=scale_ppm * 1e-6,
-            misalignment_sigma=units.arcsec_to_rad(misalignment_arcsec),
-        )
+        """A datasheet preset of :data:`PRESETS` (:func:`navsim.sensors.inertial.preset_fields`)."""
+        return cls(rate_hz=rate_hz, **inertial.preset_fields("gyro", PRESETS, name, ("arw", units.arw_to_si),
+                                                             ("rrw", units.rrw_to_si), units.deg_per_h_to_rad_per_s))
 
     @property
     def white_noise(self):

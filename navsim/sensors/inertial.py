@@ -13,9 +13,11 @@ A model is a frozen dataclass with ``rate_hz`` and the error fields ``bias_turn_
 quantisation of the accumulated increment.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from startrack import njit
+from startrack import njit, units
 
 #: Ratio of the flicker-floor definition of bias instability B (ADEV floor = 0.664 B, IEEE 952)
 #: to the peak Allan deviation of a first-order Gauss-Markov process of unit σ (0.6174 at τ ≈ 1.893 T,
@@ -84,6 +86,36 @@ def gauss_markov(g0, phi, drive):
         for i in range(drive.shape[1]):
             g[k + 1, i] = drive[k, i] + phi * g[k, i]
     return g
+
+
+@dataclass(frozen=True)
+class Grade:
+    """One grade of an inertial sensor's datasheet (a preset) in the datasheet's units: the ``white`` noise and
+    ``random_walk`` (the sensor's units, e.g. deg/√h and deg/h/√h), the ``bias`` figure (the turn-on 1σ and the
+    bias-instability floor B), the Gauss-Markov ``correlation_time`` [s], ``scale_factor_ppm`` and
+    ``misalignment_arcsec``."""
+
+    white: float
+    bias: float
+    random_walk: float
+    correlation_time: float
+    scale_factor_ppm: float
+    misalignment_arcsec: float
+
+
+def preset_fields(sensor, grades, name, white, random_walk, bias):
+    """The SI fields of the preset ``name`` of ``grades`` ({name: :class:`Grade`}) of a ``sensor`` (its name in the
+    message): ``white`` and ``random_walk`` each (the model's field, the datasheet-to-SI conversion), ``bias`` the
+    bias figure's conversion, used both as the turn-on 1σ and as the bias-instability floor B
+    (σ_g = 0.664 B / 0.6174, :func:`bias_instability_to_sigma`)."""
+    if name not in grades:
+        raise ValueError(f"unknown {sensor} preset {name!r}; choose one of {', '.join(grades)}")
+    grade = grades[name]
+    b = bias(grade.bias)
+    return {white[0]: float(white[1](grade.white)), random_walk[0]: float(random_walk[1](grade.random_walk)),
+            "bias_turn_on_sigma": float(b), "bias_instability_sigma": float(bias_instability_to_sigma(b)),
+            "bias_correlation_time": grade.correlation_time, "scale_factor_sigma": grade.scale_factor_ppm * units.PPM,
+            "misalignment_sigma": float(units.arcsec_to_rad(grade.misalignment_arcsec))}
 
 
 def filter_random_walk(model):

@@ -117,6 +117,13 @@ def test_presets_carry_their_datasheet_figures(name, arw, bias):
     assert floor == pytest.approx(0.664 * units.deg_per_h_to_rad_per_s(bias), rel=1e-3)
 
 
+def test_the_schema_offers_every_preset_both_sensors_have():
+    from navsim.scenario.inertial_fields import PRESETS
+    from navsim.sensors import accelerometer, gyro
+
+    assert tuple(gyro.PRESETS) == tuple(accelerometer.PRESETS) == PRESETS
+
+
 def test_unknown_preset_is_named():
     with pytest.raises(ValueError, match="unknown gyro preset 'fog'"):
         GyroModel.preset("fog", 100.0)

@@ -196,3 +196,18 @@ def test_ctrl_c_cancels_the_pending_runs_and_keeps_the_finished(tmp_path, base_s
     assert not (out / "campaign.lock").exists()
     resumed = mc.run_campaign(scenario, runs, out, workers=1, progress=False)
     assert resumed["runs_finished"] == runs and not list(out.glob("runs/*.partial"))
+
+
+def test_a_run_is_tested_for_divergence_on_every_frame():
+    """The run's test sees the one frame a campaign's 2000 kept frames would miss, at the threshold of all its samples."""
+    from navsim.pooling import diverged, divergence, divergence_sigmas
+
+    rng = np.random.default_rng(5)
+    errors, sigmas = 0.5 * rng.standard_normal((6000, 3)), np.full((6000, 3), 1.0)
+    errors[4001, 1] = 6.0
+    test = divergence(errors, sigmas)
+    assert test["samples"] == 18000 and test["threshold"] == divergence_sigmas(18000) > 5.0
+    assert test["max_normalised_error"] == 6.0
+    nees = {"mean": 6.0, "dof": 6}
+    assert diverged({"divergence": test, "nees": nees})
+    assert not diverged({"divergence": divergence(errors[::3], sigmas[::3]), "nees": nees})
