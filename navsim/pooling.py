@@ -26,9 +26,10 @@ def divergence_sigmas(samples):
 def divergence(errors, sigmas):
     """A run's divergence test on every steady frame (its summary's ``divergence``): the largest normalised error
     |e|/σ of ``errors`` (F, m) against their filter's ``sigmas`` (F, m), the ``samples`` F·m and the family-wise
-    ``threshold`` (:func:`divergence_sigmas`) for them."""
-    z = np.abs(np.asarray(errors, dtype=float)) / np.asarray(sigmas, dtype=float)
-    return {"max_normalised_error": float(np.max(z, initial=0.0)), "samples": int(z.size),
+    ``threshold`` (:func:`divergence_sigmas`) for them; a NaN error or σ is passed over, as a comparison with it is."""
+    e, s = np.abs(np.asarray(errors, dtype=float)), np.asarray(sigmas, dtype=float)
+    z = np.divide(e, s, out=np.where(e > 0.0, np.inf, 0.0), where=s > 0.0)  # σ = 0: any error passes, none does not
+    return {"max_normalised_error": float(np.fmax.reduce(z, axis=None, initial=0.0)), "samples": int(z.size),
             "threshold": divergence_sigmas(z.size)}
 
 

@@ -171,11 +171,18 @@ def summarize(scenario, seed, series, R_BS):
         attitude_sigma_final_arcsec=[float(v) for v in units.rad_to_arcsec(sigma_att)],
         bias_error_final_deg_per_h=[float(v) for v in units.rad_per_s_to_deg_per_h(series["bias_true"][-1] - series["bias_est"][-1])],
         nees=nees_statistics(series["nees"][steady], NEES_DOF),
-        divergence=divergence(err_B[steady], np.sqrt(np.diagonal(series["P"][steady], axis1=1, axis2=2)[:, 0:3])),
+        divergence=attitude_divergence(series, steady),
         nis={"mean_per_dof": float(np.sum(series["nis"][nis_frames]) / max(int(np.sum(series["nis_dof"][nis_frames])), 1))},
         updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])),
                  "measurements": measurements, "accepted": accepted, "rejected": measurements - accepted},
     )
+
+
+def attitude_divergence(series, steady):
+    """The run's divergence test (:func:`navsim.pooling.divergence`) on the attitude errors of the ``steady`` frames
+    against the filter's σ."""
+    sigma = np.sqrt(np.diagonal(series["P"], axis1=1, axis2=2)[steady, 0:3])
+    return divergence(series["attitude_error"][steady], sigma)
 
 
 def star_availability(scenario, star_catalog=None):

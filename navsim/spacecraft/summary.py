@@ -3,10 +3,9 @@ kind's figures, each head's availability and the fused accuracy about its boresi
 
 import numpy as np
 
-from navsim.attitude.run import NEES_DOF
+from navsim.attitude.run import NEES_DOF, attitude_divergence
 from navsim.estimation.consistency import nees_statistics
 from navsim.orbit.eclipse import PENUMBRA, UMBRA
-from navsim.pooling import divergence
 from navsim.sensors.star_sensor import MODES
 from navsim.spacecraft.exclusion import REASONS
 from navsim.spacecraft.records import RunSummary
@@ -112,7 +111,7 @@ def summarize(prepared, seed, series, sensor_run, filt):
         attitude_sigma_final_arcsec=[float(v) for v in sigma_att / ARCSEC],
         bias_error_final_deg_per_h=[float(v) for v in units.rad_per_s_to_deg_per_h(series["bias_true"][-1] - series["bias_est"][-1])],
         nees=nees_statistics(series["nees"][steady], NEES_DOF),
-        divergence=divergence(err_B[steady], np.sqrt(np.diagonal(series["P"][steady], axis1=1, axis2=2)[:, 0:3])),
+        divergence=attitude_divergence(series, steady),
         nis={"mean_per_dof": float(np.sum(series["nis"][nis_frames]) / max(int(np.sum(series["nis_dof"][nis_frames])), 1))},
         updates={"frames_with_measurements": int(np.count_nonzero(series["n_measurements"])), "measurements": measurements,
                  "accepted": accepted, "rejected": measurements - accepted},
