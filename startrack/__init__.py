@@ -7,7 +7,8 @@ predicted sub-catalog, tracking; and the plate solver for images of an unknown c
 directions (aberration). Knows nothing of vehicles or filters (never imports ``navsim``). Units: radians
 inside; degrees only at the command line. The layers below (docs/design.md, tests/startrack/test_layering.py):
 ``base``, ``compiled``, ``geometry`` and ``photometry``, ``attitude`` and ``catalog``, ``camera``, ``image``,
-``identify``, then the application (``commands``, ``cli``). Names are imported on first use (PEP 562).
+``identify``, then the application (``commands``, ``cli``). Names are imported on first use (PEP 562). What is
+exported here, and the namespaces below, is the API; a module's own helpers and constants carry a leading underscore.
 """
 
 from startrack.base.lazy_exports import lazy_exports
@@ -29,8 +30,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.photometry.bands": ("BANDS", "band"),
     "startrack.photometry.detectors": ("DETECTORS", "detector"),
     # attitude
-    "startrack.attitude.solvers": ("SOLVERS", "AttitudeSolution", "SvdWahba", "ThreeStarOptimal", "Triad",
-                                   "cramer_rao_covariance", "get_solver"),
+    "startrack.attitude.solvers": ("SOLVERS", "AttitudeSolution", "AttitudeSolver", "MultiVector", "QMethod", "Quest",
+                                   "SvdWahba", "ThreeStarOptimal", "Triad", "cramer_rao_covariance", "get_solver"),
     "startrack.attitude.boresight": ("BoresightSolution",),
     # catalogs
     "startrack.catalog.apparent_place": ("aberrate", "earth_barycentric_velocity", "unaberrate"),
@@ -47,15 +48,15 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.image.background": ("Background", "estimate_background", "mesh_background"),
     "startrack.image.detection": ("Detections", "detect", "detect_windows"),
     "startrack.image.files": ("read_frame", "read_image", "write_image"),
-    "startrack.image.psf_fit": ("PixelNoise", "concatenate_fits", "fit_stars", "neighbour_reach"),
-    "startrack.image.render": ("SensorModel", "Sources", "Windows", "cosmic_ray", "expected_charge", "render",
-                               "render_star_field"),
+    "startrack.image.psf_fit": ("PixelNoise", "StarFits", "concatenate_fits", "fit_stars", "neighbour_reach"),
+    "startrack.image.render": ("RenderedFrame", "SensorModel", "Sources", "Windows", "cosmic_ray", "expected_charge",
+                               "render", "render_star_field"),
     "startrack.image.sensor_photometry": ("SensorPhotometry",),
-    "startrack.image.stacking": ("DimStarCache", "stack"),
-    "startrack.image.synthetic": ("centroid_frame", "random_attitude"),
+    "startrack.image.stacking": ("DimStarCache", "StackedStar", "stack"),
+    "startrack.image.synthetic": ("SyntheticFrame", "centroid_frame", "random_attitude"),
     # identification
     "startrack.identify": ("IdentificationResult", "PlateSolver", "Prior", "StarIdentifier"),
-    "startrack.identify.prior_match": ("PriorMatch",),
+    "startrack.identify.prior_match": ("PriorMatch", "PriorMatches"),
 }, modules={
     # namespaces: the rotation convention (numpy, and its compiled twin), units, the address index of 000,
     # the boresight solves of 001

@@ -24,7 +24,7 @@ SOCKET_ENV = "STARTRACK_SERVE_SOCKET"
 #: Setting it to 0 makes ``startrack solve`` solve in its own process even with a server running.
 USE_ENV = "STARTRACK_USE_SERVER"
 #: Seconds to wait for a server that does not accept (a stale socket of a killed server: refused at once).
-CONNECT_TIMEOUT_S = 1.0
+_CONNECT_TIMEOUT_S = 1.0
 
 
 def socket_path() -> Path:
@@ -78,7 +78,7 @@ def forward(argv):
     connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     answered = False
     try:
-        connection.settimeout(CONNECT_TIMEOUT_S)
+        connection.settimeout(_CONNECT_TIMEOUT_S)
         connection.connect(str(path))
         connection.settimeout(None)
         request = {"version": code_version(), "argv": argv, "cwd": os.getcwd()}

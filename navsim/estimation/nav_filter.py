@@ -27,10 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navsim.earth.apparent import fix_rotation
+from navsim.earth.apparent import ApparentPlace
 from navsim.earth.frames import c_en, local_up
 from navsim.earth.orientation import observer_velocity
-from navsim.earth.refraction import refract
 from navsim.earth.wander import ned_offset, normal, normal_turn, to_ned
 from navsim.estimation import celestial_kernels, nav_kernels
 from navsim.estimation.consistency import chi2_quantile
@@ -40,7 +39,7 @@ from navsim.estimation.updates import UpdateResult, star_covariances
 from navsim.ins import strapdown
 from navsim.ins.strapdown import HEIGHT, Q_EW, Q_WB, V_W
 from navsim.sensors.star_sensor import SensorPrior
-from startrack import InputError, aberrate
+from startrack import InputError
 from startrack import rotation as rot
 
 #: Which states a baro height updates: the vertical channel (:data:`nav_kernels.BARO_STATES`), or every
@@ -240,8 +239,9 @@ class NavFilter:
         rotation of its boresight when the processing corrects aberration."""
         j = self._frame()
         q_IS = np.asarray(q_IS, dtype=float)
-        rho = self._refraction_rotation(j, q_IS) if self.layout.refraction >= 0 else np.zeros(3)
-        q_IS = self._corrected_fix(q_IS, j)
+        place = self._apparent_place(j)
+        rho = self._refraction_rotation(place, q_IS) if self.layout.refraction >= 0 else np.zeros(3)
+        q_IS = place.turn_back(q_IS)
         R = self.sigma_scale**2 * np.asarray(R_S, dtype=float)
         z, nis, accepted = celestial_kernels.fix_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                         self.star_sensor.orientation.q_ie[j], q_IS, R, self.gates[0],
@@ -255,7 +255,7 @@ class NavFilter:
         apparent with the filter's own velocity and the ephemeris when the processing corrects aberration, and
         refracted by its model air at the INS's position when it corrects refraction."""
         j = self._frame()
-        aberrated, ref_I = self._seen(j)(np.asarray(ref_I, dtype=float))
+        aberrated, ref_I = self._apparent_place(j).directions(np.asarray(ref_I, dtype=float))
         z, nis, accepted = celestial_kernels.stars_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                           self.star_sensor.orientation.q_ie[j], ref_I,
                                                           np.ascontiguousarray(obs_S, dtype=float),
@@ -277,7 +277,7 @@ class NavFilter:
         q_IS ⊗ q̂_BS⁻¹ (the fix corrected like an update's), the attitude block of P back to its
         initial value and its correlations cleared."""
         j = self._frame()
-        q_IS = self._corrected_fix(np.asarray(q_IS, dtype=float), j)
+        q_IS = self._apparent_place(j).turn_back(np.asarray(q_IS, dtype=float))
         q_wi = rot.conjugate(rot.multiply(self.star_sensor.orientation.q_ie[j], self._nav[Q_EW]))
         self._nav[Q_WB] = rot.normalize(rot.multiply(rot.multiply(q_wi, q_IS), rot.conjugate(self._calib[MOUNTING])))
         self._P[0:3, :] = 0.0
@@ -315,35 +315,24 @@ class NavFilter:
             G[:, self.layout.mounting:self.layout.mounting + 3] += np.eye(3)
         q_IB = celestial_kernels.inertial_attitude(self._nav, self.star_sensor.orientation.q_ie[j])
         q_IS = rot.multiply(q_IB, self._calib[MOUNTING])
+        place = self._apparent_place(j)
         if self.layout.refraction >= 0:  # the field turned by ε_r ρ: an attitude error −ε_r R_SI ρ (fix_terms)
-            G[:, self.layout.refraction] = -(rot.to_matrix(q_IS).T @ self._refraction_rotation(j, q_IS))
-        return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=self._apparent(j))
+            G[:, self.layout.refraction] = -(rot.to_matrix(q_IS).T @ self._refraction_rotation(place, q_IS))
+        return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=place.apparent)
 
-    def _refraction_rotation(self, j, q_IS):
+    @staticmethod
+    def _refraction_rotation(place, q_IS):
         """ρ (3,) [rad, ICRS axes]: the rotation vector by which the processing's model air raises the (aberrated)
-        boresight of the sensor attitude ``q_IS`` at frame ``j``, b × refract(b) (eq. 3 of :mod:`navsim.earth.refraction`)."""
-        aberrated, refracted = self._seen(j)(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))[None, :])
-        return np.cross(aberrated[0], refracted[0])
+        boresight of the sensor attitude ``q_IS`` (:meth:`ApparentPlace.refraction_rotation`)."""
+        return place.refraction_rotation(rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))[None, :])[0]
 
-    def _apparent(self, j):
-        """The processing's map of catalog unit vectors (N, 3) to their apparent directions at frame ``j`` (contiguous):
-        aberrated with the INS's velocity when it corrects aberration, refracted by its model air at the INS's
-        position when it corrects refraction (the state of now, held)."""
-        seen = self._seen(j)
-        return lambda u: seen(u)[1]
-
-    def _seen(self, j):
-        """The processing's map of catalog unit vectors (N, 3) to (aberrated, apparent) directions at frame ``j``
-        (:meth:`_apparent`; their difference is the refraction it corrects)."""
+    def _apparent_place(self, j):
+        """The processing's :class:`~navsim.earth.apparent.ApparentPlace` at frame ``j`` (the state of now, held):
+        aberration with the INS's velocity when it corrects aberration, refraction by its model air at the INS's
+        position when it corrects refraction."""
         ned = self._ned()
         v = self._observer_velocity(j, ned) if self.star_sensor.correct_aberration else None
-        air = self._air(j, ned)
-
-        def seen(u):
-            aberrated = np.ascontiguousarray(u if v is None else aberrate(u, v))
-            return aberrated, aberrated if air is None else np.ascontiguousarray(refract(aberrated, *air))
-
-        return seen
+        return ApparentPlace(v, self._air(j, ned))
 
     def _air(self, j, ned):
         """(up_I (3,), A, B) of the processing's refraction correction at frame ``j`` and the INS's position (of its NED
@@ -354,17 +343,6 @@ class NavFilter:
         lat, lon, _, _ = ned
         a, b = air.coefficients(self._nav[HEIGHT])
         return local_up(self.star_sensor.orientation.c_ie[j], lat, lon), a, b
-
-    def _corrected_fix(self, q_IS, j):
-        """The fix turned back by the rotation of its boresight to its apparent direction, as far as the processing
-        corrects it (aberration with the INS's velocity, refraction with its model air)."""
-        ned = self._ned()
-        correct, air = self.star_sensor.correct_aberration, self._air(j, ned)
-        if not correct and air is None:
-            return q_IS
-        boresight = rot.rotate(q_IS, np.array([0.0, 0.0, 1.0]))
-        v = self._observer_velocity(j, ned) if correct else np.zeros(3)
-        return rot.normalize(rot.multiply(fix_rotation(boresight, v, air), q_IS))
 
     def process_record(self, samples, ratio, dt, record):
         """The compiled fast path: the whole :class:`~navsim.sensors.aiding.AidingRecord` at once

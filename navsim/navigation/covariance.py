@@ -30,7 +30,7 @@ import numpy as np
 from navsim.analysis import Analysis, Quantity
 from navsim.build.faults import bias_steps
 from navsim.build.star_sensor import vector_equivalent
-from navsim.earth.apparent import apparent, fix_rotation
+from navsim.earth.apparent import ApparentPlace
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.orientation import EarthOrientation
 from navsim.estimation.nav_filter import NavFilter, state_names
@@ -248,25 +248,25 @@ def measurements(scenario, nom, filt, star_catalog, src):
         sensor = sky_background.seeing(exclusion.excluding(sensor, geometry, nom.frame_k * dt), scenario, geometry,
                                        nom.trajectory, nom.frame_k)
         available = sensor.faults.available(nom.frame_k * dt)
-        real, modelled = nom.sky.air(slice(None)), processed_air(scenario, nom)
+        real = nom.sky.air(slice(None))
+        place, place_real = (_apparent_place(scenario, nom, air) for air in (processed_air(scenario, nom), real))
         if isinstance(sensor, AttitudeFixSensor):
             fix_R = sensor.R_S
             seen = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
-            fix_q, fix_q_real = (_processed_fixes(scenario, nom, seen, air) for air in (modelled, real))
+            fix_q, fix_q_real = place.turn_back(seen), place_real.turn_back(seen)
             fix_mask = available
             if filt.layout.refraction >= 0:
-                boresight = rot.rotate(seen, np.array([0.0, 0.0, 1.0]))
-                aberrated = _processed_stars(scenario, nom, boresight, np.arange(F), None)
-                fix_rho = np.cross(aberrated, _processed_stars(scenario, nom, boresight, np.arange(F), modelled))
+                fix_rho = place.refraction_rotation(rot.rotate(seen, np.array([0.0, 0.0, 1.0])))
         else:
             stars = sensor.observe_frames(nom.sky.q_IB, np.random.default_rng(0), nom.sky.v_I, noise=False, air=real)
             frame = np.repeat(np.arange(F), np.diff(stars.offsets))
             keep = available[frame]
             frame, catalog, obs = frame[keep], stars.ref_I[keep], stars.obs_S[keep]
             offsets = np.concatenate([[0], np.cumsum(np.bincount(frame, minlength=F))])
-            ref, ref_real = (_processed_stars(scenario, nom, catalog, frame, air) for air in (modelled, real))
+            aberrated, ref = place.rows(frame).directions(catalog)
+            ref_real = place_real.rows(frame).apparent(catalog)
             cov = isotropic_covariance(obs, stars.sigma[keep])
-            shift = ref - _processed_stars(scenario, nom, catalog, frame, None) if filt.layout.refraction >= 0 else np.zeros_like(ref)
+            shift = ref - aberrated if filt.layout.refraction >= 0 else np.zeros_like(ref)
     position, baro = build.position_sensor(scenario, 1.0 / (nom.ratio * dt)), build.baro(scenario)
     position_mask, position_sigma = np.zeros(F, np.bool_), np.zeros(3)
     if position is not None:
@@ -304,21 +304,11 @@ def processed_air(scenario, nom):
     return nom.sky.up_I, a, b
 
 
-def _processed_stars(scenario, nom, catalog, frame, air):
-    """The catalog directions ``catalog`` (M, 3) of the frames ``frame`` (M,) as the processing makes them apparent
-    along the nominal: aberrated when it corrects aberration, refracted by ``air`` (the frames' (up_I, A, B); None:
-    not)."""
-    v = nom.sky.v_I[frame] if scenario["star_sensor"]["aberration_correction"] else np.zeros((frame.size, 3))
-    return apparent(catalog, v, None if air is None else tuple(x[frame] for x in air))
-
-
-def _processed_fixes(scenario, nom, fixes, air):
-    """The noise-free fixes (F, 4) as the processing turns them back along the nominal (:func:`_processed_stars`)."""
-    correct = scenario["star_sensor"]["aberration_correction"]
-    if not correct and air is None:
-        return fixes
-    v = nom.sky.v_I if correct else np.zeros_like(nom.sky.v_I)
-    return rot.multiply(fix_rotation(rot.rotate(fixes, np.array([0.0, 0.0, 1.0])), v, air), fixes)
+def _apparent_place(scenario, nom, air):
+    """The processing's :class:`~navsim.earth.apparent.ApparentPlace` along the nominal, a row per frame: aberration
+    with the nominal's velocity when it corrects aberration, refraction by ``air`` (the frames' (up_I, A, B); None:
+    none)."""
+    return ApparentPlace(nom.sky.v_I if scenario["star_sensor"]["aberration_correction"] else None, air)
 
 
 def covariance_analysis(scenario, split=False, star_catalog=None):

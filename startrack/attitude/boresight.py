@@ -30,9 +30,9 @@ from scipy.optimize import brentq
 from startrack.base.errors import InputError
 from startrack.geometry.rotation import from_matrix, nearest_rotation
 
-RANK_TOLERANCE = 1e-9          # relative singular value below which ^0P counts as rank deficient
-COLLINEAR_TOLERANCE = 1e-4     # 1 - |P^+ b|^2 down to -this counts as tangent (noise in b), not a miss
-FOCAL_GRID_POINTS = 256        # grid that brackets the roots of |P^-1 b(f)|^2 = 1 before bisection
+_RANK_TOLERANCE = 1e-9          # relative singular value below which ^0P counts as rank deficient
+_COLLINEAR_TOLERANCE = 1e-4     # 1 - |P^+ b|^2 down to -this counts as tangent (noise in b), not a miss
+_FOCAL_GRID_POINTS = 256        # grid that brackets the roots of |P^-1 b(f)|^2 = 1 before bisection
 
 
 @dataclass(frozen=True)
@@ -118,7 +118,7 @@ def _scalar_known_f(P_rows, radii, f, what):
     """One triple: rank test of ^0P (001 2.1.2) and eq. 2-3 (rank 3) or the collinear line (rank 2)."""
     U, s, Vt = np.linalg.svd(P_rows)
     b = cos_gamma(radii, f)
-    rank = int(np.sum(s > RANK_TOLERANCE * s[0]))
+    rank = int(np.sum(s > _RANK_TOLERANCE * s[0]))
     if rank == 3:
         return scalar_known_f_batch(P_rows[None], b[None])
     if rank == 1:
@@ -128,7 +128,7 @@ def _scalar_known_f(P_rows, radii, f, what):
     w0 = Vt[:2].T @ ((U[:, :2].T @ b) / s[:2])
     t = Vt[2]
     k2 = 1.0 - w0 @ w0
-    if k2 < -COLLINEAR_TOLERANCE:
+    if k2 < -_COLLINEAR_TOLERANCE:
         raise InputError(f"{what}: collinear stars and the measured radii give a line that misses the "
                          f"unit sphere (1 - |P^+ b|^2 = {k2:.3g}); no boresight satisfies eq. 2-1.")
     if k2 <= 0.0:
@@ -193,7 +193,7 @@ def solve_scalar_known_f(ref_I, radii_px, focal_px, method="normalised"):
     if method == "normalised":
         candidates = _scalar_known_f(ref, radii, f, what)
     elif method == "linearised":
-        if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+        if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
             raise InputError(f"{what}: the linearised variant needs three non-collinear stars (rank ^0P = 3).")
         candidates = _linearised_error_term(ref, radii, f, what)[None]
     else:
@@ -204,7 +204,7 @@ def solve_scalar_known_f(ref_I, radii_px, focal_px, method="normalised"):
 # ---------------------------------------------------------------------- scalar model, unknown f
 
 def _focal_grid(bounds):
-    return np.geomspace(bounds[0], bounds[1], FOCAL_GRID_POINTS)
+    return np.geomspace(bounds[0], bounds[1], _FOCAL_GRID_POINTS)
 
 
 def scalar_unknown_f_batch(P_rows, radii, bounds):
@@ -254,7 +254,7 @@ def solve_scalar_unknown_f(ref_I, radii_px, focal_bounds_px):
     _one_triple(ref, what)
     radii = _as_radii(radii_px, 3, what)
     bounds = _as_bounds(focal_bounds_px, what)
-    if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+    if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
         raise InputError(f"{what}: needs three non-collinear stars (rank ^0P = 3, 001 2.2.1).")
     f, w = scalar_unknown_f_batch(ref[None], radii[None], bounds)
     if not np.isfinite(f[0]):
@@ -294,7 +294,7 @@ def solve_vector_known_f(ref_I, xy_px, focal_px):
     _one_triple(ref, what)
     xy = _as_xy(xy_px, 3, what)
     f = _as_focal(focal_px, what)
-    if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+    if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
         raise InputError(f"{what}: needs three non-collinear stars (rank ^0P = 3, 001 3.1.1).")
     R, _ = vector_known_f_batch(ref, sensor_directions(xy, f))
     return _solution_from_R(R, f, "vector_known_f_svd")
@@ -372,7 +372,7 @@ def solve_vector_unknown_f(ref_I, xy_px, method="analytic", focal_bounds_px=None
     ref = _as_unit_vectors(ref_I, 3, what)
     _one_triple(ref, what)
     xy = _as_xy(xy_px, 3, what)
-    if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+    if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
         raise InputError(f"{what}: needs three non-collinear stars (rank ^0P = 3, 001 3.2.1).")
     if method == "analytic":
         f, _ = focal_from_angular_distances(ref, xy)
@@ -431,7 +431,7 @@ def error_bound_norms(ref_I, focal_px, radii_px=None, xy_px=None):
     triples = all_triples(ref.shape[0])
     P_rows = ref[triples]
     singular = np.linalg.svd(P_rows, compute_uv=False)
-    ok = singular[:, 2] > RANK_TOLERANCE * singular[:, 0]
+    ok = singular[:, 2] > _RANK_TOLERANCE * singular[:, 0]
     norms = np.full(len(triples), np.inf)
     if (radii_px is None) == (xy_px is None):
         raise InputError(f"{what}: give exactly one of radii_px (scalar model) or xy_px (vector model).")
@@ -511,7 +511,7 @@ def solve_scalar_all_stars(ref_I, radii_px, focal_px, method="ols"):
     ref = _as_unit_vectors(ref_I, 3, what)
     radii = _as_radii(radii_px, ref.shape[0], what)
     f = _as_focal(focal_px, what)
-    if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+    if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
         raise InputError(f"{what}: ^0P' must have full column rank (stars not all on one great circle).")
     b = cos_gamma(radii, f)
     if method == "ols":
@@ -538,7 +538,7 @@ def solve_vector_all_stars(ref_I, xy_px, focal_px=None):
     what = "solve_vector_all_stars"
     ref = _as_unit_vectors(ref_I, 3, what)
     xy = _as_xy(xy_px, ref.shape[0], what)
-    if np.linalg.matrix_rank(ref, tol=RANK_TOLERANCE) < 3:
+    if np.linalg.matrix_rank(ref, tol=_RANK_TOLERANCE) < 3:
         raise InputError(f"{what}: ^0P' must have full column rank (stars not all on one great circle).")
     f = focal_from_angular_distances(ref, xy)[0] if focal_px is None else _as_focal(focal_px, what)
     R = _vector_ols(ref, sensor_directions(xy, f))

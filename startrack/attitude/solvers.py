@@ -38,7 +38,7 @@ import numpy as np
 from startrack.base.errors import InputError
 from startrack.geometry.rotation import from_matrix, nearest_rotation, skew, to_matrix
 
-UNIT_NORM_TOLERANCE = 1e-6
+_UNIT_NORM_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ def _validated(ref_I, obs_S, sigma, min_stars, name):
         raise InputError(f"{name}: needs at least {min_stars} stars, got {n}.")
     for label, vectors in (("ref_I", ref), ("obs_S", obs)):
         norm_error = np.abs(np.einsum("ij,ij->i", vectors, vectors) - 1.0).max()
-        if not norm_error <= 2.0 * UNIT_NORM_TOLERANCE:                # also catches NaN and inf
+        if not norm_error <= 2.0 * _UNIT_NORM_TOLERANCE:                # also catches NaN and inf
             raise InputError(f"{name}: {label} must hold finite unit vectors; a squared norm is off by "
                              f"{norm_error:.3g}.")
     sig = np.asarray(sigma, dtype=float)

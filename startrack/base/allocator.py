@@ -18,12 +18,12 @@ import sys
 #: mallopt's parameter numbers (glibc malloc.h).
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 #: Largest allocation served from the heap [bytes] (glibc's limit on 64-bit) and the free heap top kept.
-MMAP_THRESHOLD = 32 << 20
-TRIM_THRESHOLD = 2 * MMAP_THRESHOLD
+_MMAP_THRESHOLD = 32 << 20
+_TRIM_THRESHOLD = 2 * _MMAP_THRESHOLD
 
 
 def reuse_freed_memory() -> bool:
-    """Have glibc serve allocations up to :data:`MMAP_THRESHOLD` from the heap and keep freed memory for the
+    """Have glibc serve allocations up to :data:`_MMAP_THRESHOLD` from the heap and keep freed memory for the
     next frame (module text); whether it applied (glibc on Linux only)."""
     if not sys.platform.startswith("linux"):
         return False
@@ -32,4 +32,4 @@ def reuse_freed_memory() -> bool:
     except (OSError, AttributeError):
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
-    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+    return bool(mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD))

@@ -25,7 +25,7 @@ def cache_dir() -> Path:
 
 
 #: How many times :func:`publish_folder` renames its folder into place while other writers do the same.
-PUBLISH_ATTEMPTS = 100
+_PUBLISH_ATTEMPTS = 100
 
 
 def _temporary(path: Path) -> Path:
@@ -54,7 +54,7 @@ def publish_folder(folder, write) -> Path:
     temporary.mkdir(parents=True)
     try:
         write(temporary)
-        for _ in range(PUBLISH_ATTEMPTS):
+        for _ in range(_PUBLISH_ATTEMPTS):
             _discard(folder)
             try:
                 os.replace(temporary, folder)
@@ -62,7 +62,7 @@ def publish_folder(folder, write) -> Path:
             except OSError:
                 if folder.is_dir():
                     return folder
-        raise OSError(f"{folder}: could not be replaced ({PUBLISH_ATTEMPTS} attempts against other writers)")
+        raise OSError(f"{folder}: could not be replaced ({_PUBLISH_ATTEMPTS} attempts against other writers)")
     finally:
         shutil.rmtree(temporary, ignore_errors=True)
 

@@ -52,12 +52,12 @@ def radius_of_angle(theta, projection="pinhole"):
     return np.tan(theta) if projection == "pinhole" else np.asarray(theta, dtype=float)
 
 
-def angle_of_radius(radius, projection="pinhole"):
+def _angle_of_radius(radius, projection="pinhole"):
     """Angle off the axis [rad] of ideal normalised radii (the inverse of :func:`radius_of_angle`)."""
     return np.arctan(radius) if projection == "pinhole" else np.asarray(radius, dtype=float)
 
 
-def ideal_coordinates(v_S, projection="pinhole"):
+def _ideal_coordinates(v_S, projection="pinhole"):
     """(x_n, y_n) (..., 2) of directions ``v_S`` (..., 3) in S and the mask of those the projection images
     (pinhole: z > 0; fisheye: all but the -z axis); NaN where it does not (module text)."""
     v_S = np.asarray(v_S, dtype=float)
@@ -73,7 +73,7 @@ def ideal_coordinates(v_S, projection="pinhole"):
 
 
 def ray(xy_n, projection="pinhole"):
-    """Unit vectors (..., 3) in S of normalised ideal coordinates (..., 2) (inverse of :func:`ideal_coordinates`)."""
+    """Unit vectors (..., 3) in S of normalised ideal coordinates (..., 2) (inverse of :func:`_ideal_coordinates`)."""
     xy_n = np.asarray(xy_n, dtype=float)
     if projection == "pinhole":
         v = np.concatenate([xy_n, np.ones(xy_n.shape[:-1] + (1,))], axis=-1)
@@ -99,7 +99,7 @@ def fold_radius_squared(k1, k2):
     return best
 
 
-def ideal_radius(rd, k1, k2):
+def _ideal_radius(rd, k1, k2):
     """Ideal normalised radius r of distorted radii ``rd``: r (1 + k1 r^2 + k2 r^4) = rd by Newton's method
     to machine precision (Brown 1971; broadcasts over rd, k1, k2)."""
     rd = np.asarray(rd, dtype=float)
@@ -115,7 +115,7 @@ def ideal_radius(rd, k1, k2):
 
 def _ideal_scale(rd, k1, k2):
     """r / r_d of distorted radii ``rd`` (1 at the centre)."""
-    r = ideal_radius(rd, k1, k2)
+    r = _ideal_radius(rd, k1, k2)
     return np.where(rd > 0.0, r / np.where(rd > 0.0, rd, 1.0), 1.0)
 
 
@@ -190,12 +190,12 @@ class Camera:
     @property
     def fov_x(self):
         """Full field angle across the width [rad] (undistorted)."""
-        return 2.0 * float(angle_of_radius(self.width / (2.0 * self.focal_px), self.projection))
+        return 2.0 * float(_angle_of_radius(self.width / (2.0 * self.focal_px), self.projection))
 
     @property
     def fov_y(self):
         """Full field angle across the height [rad]."""
-        return 2.0 * float(angle_of_radius(self.height / (2.0 * self.focal_px), self.projection))
+        return 2.0 * float(_angle_of_radius(self.height / (2.0 * self.focal_px), self.projection))
 
     @functools.cached_property
     def angular_width(self):
@@ -208,7 +208,7 @@ class Camera:
     @property
     def fov_diagonal(self):
         """Full field angle across the diagonal [rad]."""
-        return 2.0 * float(angle_of_radius(np.hypot(self.width, self.height) / (2.0 * self.focal_px), self.projection))
+        return 2.0 * float(_angle_of_radius(np.hypot(self.width, self.height) / (2.0 * self.focal_px), self.projection))
 
     # ----------------------------------------------------------------- distortion
     def _radial_factor(self, r2):
@@ -242,7 +242,7 @@ class Camera:
 
     def undistort(self, xy_d):
         """Distorted normalised (x_d, y_d) -> ideal (x_n, y_n): each point scaled by r / r_d
-        (:func:`ideal_radius`)."""
+        (:func:`_ideal_radius`)."""
         xy_d = np.asarray(xy_d, dtype=float)
         if self.k1 == 0.0 and self.k2 == 0.0:
             return xy_d.copy()
@@ -251,7 +251,7 @@ class Camera:
     # ----------------------------------------------------------------- projection
     def _project(self, v_S):
         """(uv, normalised ideal x_n y_n, imaged mask) of directions (N,3) in S; NaN where not imaged."""
-        xy_n, front = ideal_coordinates(v_S, self.projection)
+        xy_n, front = _ideal_coordinates(v_S, self.projection)
         return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy]), xy_n, front
 
     def project_body(self, vectors_S):
@@ -343,5 +343,5 @@ class Camera:
         rotvecs = np.asarray(times_s, dtype=float)[:, None] * np.asarray(omega_S, dtype=float)[None, :]
         mats = to_matrix(from_rotation_vector(rotvecs))  # (K,3,3) S(t) -> S(0)
         v_S = np.einsum("nj,kji->nki", v_S0, mats)  # R^T v
-        xy_n, _ = ideal_coordinates(v_S, self.projection)
+        xy_n, _ = _ideal_coordinates(v_S, self.projection)
         return self.focal_px * self.distort(xy_n) + np.array([self.cx, self.cy])

@@ -37,7 +37,7 @@ fold_radius_squared_jit = njit(fold_radius_squared)
 
 
 @njit(_nrt=False)
-def ideal_xy(vx, vy, vz, projection):  # pragma: no cover  (compiled)
+def _ideal_xy(vx, vy, vz, projection):  # pragma: no cover  (compiled)
     """(imaged, x, y): the normalised ideal coordinates of the direction (vx, vy, vz) in S under the
     projection code (module text); imaged is False behind a pinhole and on the fisheye's -z axis."""
     if projection != FISHEYE:
@@ -54,7 +54,7 @@ def ideal_xy(vx, vy, vz, projection):  # pragma: no cover  (compiled)
 @njit(_nrt=False)
 def in_view(vx, vy, vz, camera_params, fold):  # pragma: no cover  (compiled)
     """(imaged within the fold radius^2 ``fold`` of the distortion, x, y) of a direction in S."""
-    imaged, x, y = ideal_xy(vx, vy, vz, camera_params[8])
+    imaged, x, y = _ideal_xy(vx, vy, vz, camera_params[8])
     return imaged and x * x + y * y < fold, x, y
 
 
@@ -82,7 +82,7 @@ def image_point(x, y, camera_params):  # pragma: no cover  (compiled)
 @njit(_nrt=False)
 def project_one(vx, vy, vz, camera_params):  # pragma: no cover  (compiled)
     """(u, v) [px] of the direction (vx, vy, vz) in S (one the projection images): the module's model."""
-    _, x, y = ideal_xy(vx, vy, vz, camera_params[8])
+    _, x, y = _ideal_xy(vx, vy, vz, camera_params[8])
     return image_point(x, y, camera_params)
 
 
@@ -94,7 +94,7 @@ def off_axis_angle(radius, projection):  # pragma: no cover  (compiled)
 
 @njit(_nrt=False)
 def ray_one(x, y, projection):  # pragma: no cover  (compiled)
-    """Unit vector in S of the normalised ideal coordinates (x, y) (the inverse of :func:`ideal_xy`)."""
+    """Unit vector in S of the normalised ideal coordinates (x, y) (the inverse of :func:`_ideal_xy`)."""
     if projection != FISHEYE:
         norm = math.sqrt(x * x + y * y + 1.0)
         return x / norm, y / norm, 1.0 / norm

@@ -15,7 +15,7 @@ and the reference pixel CRPIX at the principal point (cx + 1, cy + 1):
   undistorted coordinate (:meth:`startrack.camera.model.Camera.undistort`), fitted by least squares on a grid
   over the image; AP, BP the inverse, U = U' + AP(U', V') on the undistorted offsets U' = f x_n.
 
-The order N is the smallest (0 for a pinhole, else 2..:data:`MAX_ORDER`) whose fit misses the camera model
+The order N is the smallest (0 for a pinhole, else 2..:data:`_MAX_ORDER`) whose fit misses the camera model
 by at most ``tolerance_arcsec`` (0.02") everywhere on the grid, the inverse likewise; the header states what it
 reached (``max_error_px``).
 
@@ -38,7 +38,7 @@ from startrack.base.units import ARCSEC
 from startrack.geometry.rotation import to_matrix
 
 #: Highest SIP order tried (the distortion of a fisheye's corners needs the most terms).
-MAX_ORDER = 9
+_MAX_ORDER = 9
 #: Grid points per image side on which the polynomials are fitted and checked.
 GRID = 41
 
@@ -93,18 +93,18 @@ class FrameWcs:
 
 #: CRVAL1 [deg] of a reference point at a celestial pole, where the RA is undefined: the orientation
 #: astrometry.net's TAN assumes there whatever CRVAL1 says, and wcslib's (astropy's) for this CRVAL1.
-POLE_RA_DEG = 270.0
+_POLE_RA_DEG = 270.0
 
 
 def reference(boresight):
     """(RA, Dec) [deg] of the unit vector ``boresight`` and the (east, north) unit vectors (2, 3) of the tangent
-    plane there; at a pole the limit along the meridian of :data:`POLE_RA_DEG` (east along +x)."""
+    plane there; at a pole the limit along the meridian of :data:`_POLE_RA_DEG` (east along +x)."""
     z = np.asarray(boresight, dtype=float)
     east = np.cross([0.0, 0.0, 1.0], z)
     norm = np.linalg.norm(east)
     at_pole = norm <= 1e-15
     east = np.array([1.0, 0.0, 0.0]) if at_pole else east / norm
-    ra = POLE_RA_DEG if at_pole else math.degrees(math.atan2(z[1], z[0])) % 360.0
+    ra = _POLE_RA_DEG if at_pole else math.degrees(math.atan2(z[1], z[0])) % 360.0
     return np.array([ra, math.degrees(math.asin(np.clip(z[2], -1.0, 1.0)))]), np.array([east, np.cross(z, east)])
 
 
@@ -131,7 +131,7 @@ def frame_wcs(camera, q_IS, tolerance_arcsec=0.02):
     """The :class:`FrameWcs` of ``camera`` (:class:`startrack.camera.model.Camera`) at attitude ``q_IS`` (S -> I,
     scalar last): CD exact; a fisheye's ZPN exact, a pinhole's SIP polynomials of the lowest order that
     reproduces the camera model within ``tolerance_arcsec`` (as pixels at the focal length) on a grid over
-    the image (module text); raises InputError if no order up to :data:`MAX_ORDER` does."""
+    the image (module text); raises InputError if no order up to :data:`_MAX_ORDER` does."""
     tolerance_px = tolerance_arcsec * ARCSEC * camera.focal_px
     R = to_matrix(np.asarray(q_IS, dtype=float))
     crval, axes = reference(R[:, 2])
@@ -145,11 +145,11 @@ def frame_wcs(camera, q_IS, tolerance_arcsec=0.02):
     ideal = camera.focal_px * camera.undistort(np.stack([U, V], axis=1) / camera.focal_px)  # f x_n, f y_n
     scale = max(np.abs(U).max(), np.abs(V).max())
     pinhole = camera.k1 == 0.0 and camera.k2 == 0.0
-    for order in [0] if pinhole else range(2, MAX_ORDER + 1):
+    for order in [0] if pinhole else range(2, _MAX_ORDER + 1):
         a, b, forward = _fit(U, V, ideal - np.stack([U, V], axis=1), order, scale)
         ap, bp, inverse = _fit(ideal[:, 0], ideal[:, 1], np.stack([U, V], axis=1) - ideal, order, scale)
         if max(forward, inverse) <= tolerance_px:
             return FrameWcs(crpix, crval, cd, a, b, ap, bp, order, max(forward, inverse), camera.width, camera.height)
     raise InputError(f"the camera's distortion (k1 {camera.k1:+.4g}, k2 {camera.k2:+.4g}) is not reproduced by SIP "
-                     f"polynomials up to order {MAX_ORDER} within {tolerance_arcsec:g} arcsec (largest miss "
+                     f"polynomials up to order {_MAX_ORDER} within {tolerance_arcsec:g} arcsec (largest miss "
                      f"{max(forward, inverse):.3g} px)")

@@ -24,9 +24,9 @@ SPEED_OF_LIGHT = erfa.CMPS
 #: Earth's 30 km/s; 1 au instead of the Earth's 0.983-1.017 au changes it by < 0.01 µas.
 SUN_DISTANCE_AU = 1.0
 #: Directions whose norm differs from 1 by more than this are refused (they are not directions).
-UNIT_TOLERANCE = 1e-6
+_UNIT_TOLERANCE = 1e-6
 #: The span of erfa.epv00's series, Julian dates of 1900-01-01 and 2100-12-31 (TDB).
-EPV00_SPAN_JD = (2415020.5, 2488069.5)
+_EPV00_SPAN_JD = (2415020.5, 2488069.5)
 
 
 def aberrate(u, v):
@@ -68,9 +68,9 @@ def earth_barycentric_velocity(jd1, jd2):
     """
     jd1, jd2 = np.broadcast_arrays(np.asarray(jd1, dtype=float), np.asarray(jd2, dtype=float))
     jd = jd1 + jd2
-    _require((jd >= EPV00_SPAN_JD[0]) & (jd <= EPV00_SPAN_JD[1]), jd,
+    _require((jd >= _EPV00_SPAN_JD[0]) & (jd <= _EPV00_SPAN_JD[1]), jd,
              "earth_barycentric_velocity: Julian date {} is outside 1900-2100 "
-             f"(JD {EPV00_SPAN_JD[0]}-{EPV00_SPAN_JD[1]}), the span of erfa.epv00's series.")
+             f"(JD {_EPV00_SPAN_JD[0]}-{_EPV00_SPAN_JD[1]}), the span of erfa.epv00's series.")
     _, barycentric = erfa.epv00(jd1, jd2)
     return barycentric["v"] * (erfa.DAU / erfa.DAYSEC)
 
@@ -89,8 +89,8 @@ def _checked(name, u, v):
         raise InputError(f"{name}: directions and velocities need 3 components on their last axis, "
                          f"got shapes {u.shape} and {v.shape}.")
     norm = np.linalg.norm(u, axis=-1)
-    _require(np.abs(norm - 1.0) <= UNIT_TOLERANCE, norm,  # NaN and inf fail the comparison
-             f"{name}: directions must be finite unit vectors (|u| within {UNIT_TOLERANCE:g} of 1), got |u| = {{}}.")
+    _require(np.abs(norm - 1.0) <= _UNIT_TOLERANCE, norm,  # NaN and inf fail the comparison
+             f"{name}: directions must be finite unit vectors (|u| within {_UNIT_TOLERANCE:g} of 1), got |u| = {{}}.")
     speed = np.linalg.norm(v, axis=-1)
     _require(speed < SPEED_OF_LIGHT, speed, f"{name}: the observer's velocity must be finite and below "
              f"the speed of light ({SPEED_OF_LIGHT:.0f} m/s), got |v| = {{}} m/s.")

@@ -22,7 +22,7 @@ import numpy as np
 from startrack.base.errors import InputError
 
 #: added to the cap radius in the RA/Dec tests so stars on the boundary survive rounding [rad]
-BOUNDARY_MARGIN = 1e-9
+_BOUNDARY_MARGIN = 1e-9
 
 
 def field_radius(fov_x, fov_y=None):
@@ -63,11 +63,11 @@ def radec_prefilter(ra, dec, ra0, dec0, radius):
     dec_min, dec_max, half_span = radec_window(ra0, dec0, radius)
     ra = np.asarray(ra, dtype=float)
     dec = np.asarray(dec, dtype=float)
-    in_dec = (dec >= dec_min - BOUNDARY_MARGIN) & (dec <= dec_max + BOUNDARY_MARGIN)
+    in_dec = (dec >= dec_min - _BOUNDARY_MARGIN) & (dec <= dec_max + _BOUNDARY_MARGIN)
     if half_span >= np.pi:
         return in_dec
     delta_ra = np.mod(ra - ra0 + np.pi, 2.0 * np.pi) - np.pi            # eq. 5 without the case split
-    return in_dec & (np.abs(delta_ra) <= half_span + BOUNDARY_MARGIN)
+    return in_dec & (np.abs(delta_ra) <= half_span + _BOUNDARY_MARGIN)
 
 
 def cone_mask(vectors, boresight, radius):

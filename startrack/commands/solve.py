@@ -106,7 +106,7 @@ def register(subparsers):
 
 #: A given camera's refit, or the diagnosis of a frame it cannot identify, searches fields of view within
 #: this factor of its own.
-GIVEN_FOV_SPREAD = 1.3
+_GIVEN_FOV_SPREAD = 1.3
 
 
 def _pair(option, text):
@@ -129,13 +129,13 @@ def _parse_boresight(text, error_deg):
 
 def _fov_range(args):
     """(low, high) [rad] of the field of view searched, or None for the default range; a hint narrower than
-    the default range's low end extends it down to the hint over :data:`GIVEN_FOV_SPREAD`."""
+    the default range's low end extends it down to the hint over :data:`_GIVEN_FOV_SPREAD`."""
     if args.fov_range_deg is None:
         from startrack.identify.plate_solver import DEFAULT_FOV_RANGE
 
         low = DEFAULT_FOV_RANGE[0] / DEG
         if args.fov_hint_deg is not None and args.fov_hint_deg < low:
-            return args.fov_hint_deg / GIVEN_FOV_SPREAD * DEG, _widest_deg() * DEG
+            return args.fov_hint_deg / _GIVEN_FOV_SPREAD * DEG, _widest_deg() * DEG
         return None
     low, high = _pair("--fov-range-deg", args.fov_range_deg)
     widest = _widest_deg()
@@ -189,7 +189,7 @@ def frame_solver(args):
     camera_file = None if args.camera is None else read_camera_file(args.camera)
     if camera_file is not None or args.fov_deg is not None:  # a refit or a diagnosis searches near the given field
         given = camera_file.camera.angular_width if camera_file is not None else args.fov_deg * DEG
-        fov_range = (max(0.5 * DEG, given / GIVEN_FOV_SPREAD), min(_widest_deg() * DEG, given * GIVEN_FOV_SPREAD))
+        fov_range = (max(0.5 * DEG, given / _GIVEN_FOV_SPREAD), min(_widest_deg() * DEG, given * _GIVEN_FOV_SPREAD))
     plate = {"fov_range": fov_range, "threshold": args.max_false_match,
              "time_budget_s": args.time_budget_s, "mag_limit": args.mag, "progress": True}
     return FrameSolver(camera_file, None if args.fov_deg is None else args.fov_deg * DEG, refit,

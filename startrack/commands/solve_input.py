@@ -51,7 +51,7 @@ class SolveFrame:
     hdu: int | None = None
 
 
-def read_centroid_csv(path):
+def _read_centroid_csv(path):
     """(uv (n, 2), flux (n,) or None) from a CSV of u,v[,flux] rows; a first non-numeric line is a header."""
     path = Path(path)
     try:
@@ -95,7 +95,7 @@ def _centroid_rows(rows):
     return array[:, :2], (array[:, 2] if array.shape[1] == 3 else None)
 
 
-def batch_jsonl(path, width, height):
+def _batch_jsonl(path, width, height):
     """SolveFrame records of a JSON Lines file (one per non-empty line)."""
     try:
         handle = path.open("rb")
@@ -132,7 +132,7 @@ def _json_frame(raw, number, width, height, source):
         return SolveFrame(frame_id, reason=f"{source} line {number}: {error}")
 
 
-def stream_frames(lines, options, width, height, hdu=None):
+def _stream_frames(lines, options, width, height, hdu=None):
     """SolveFrame records of a stream read as it comes (``--batch -``: standard input, a camera pipeline's
     frames): per non-empty line a JSON centroid record (a line starting with "{") or an image path."""
     for number, line in enumerate(lines, 1):
@@ -184,9 +184,9 @@ def _listed_images(path):
 
 def batch_frames(path, options, width, height, hdu=None):
     """SolveFrame records of ``--batch PATH``: JSON Lines, a folder of images, a list of images, or ``-``:
-    standard input as a stream (:func:`stream_frames`)."""
+    standard input as a stream (:func:`_stream_frames`)."""
     if path == "-":
-        yield from stream_frames(sys.stdin, options, width, height, hdu)
+        yield from _stream_frames(sys.stdin, options, width, height, hdu)
         return
     path = Path(path)
     if not path.exists():
@@ -194,7 +194,7 @@ def batch_frames(path, options, width, height, hdu=None):
     if path.is_file() and path.suffix.lower() == ".jsonl":
         if hdu is not None:
             raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is a JSON Lines batch of centroids.")
-        yield from batch_jsonl(path, width, height)
+        yield from _batch_jsonl(path, width, height)
         return
     for image in _listed_images(path):
         try:
@@ -214,5 +214,5 @@ def input_frame(path, options, width, height, hdu=None):
         return image_frame(path, options, width, height, hdu)
     if hdu is not None:
         raise InputError(f"--hdu {hdu} selects an HDU of a FITS file; {path} is a centroid list.")
-    uv, flux = read_centroid_csv(path)
+    uv, flux = _read_centroid_csv(path)
     return SolveFrame(str(path), uv, flux, None, width, height)

@@ -25,10 +25,10 @@ from startrack.base.errors import InputError
 
 #: Centroid sigma [px] of centroid lists and of a given camera's gates when neither the option nor the
 #: camera file's fit gives one.
-DEFAULT_CENTROID_SIGMA_PX = 0.3
+_DEFAULT_CENTROID_SIGMA_PX = 0.3
 #: A frame's own epoch is rounded to this step [Julian years] (8.8 h: 0.005" of the fastest proper motion,
 #: 10"/yr), so that the frames of a night share one solver.
-EPOCH_STEP_YEARS = 0.001
+_EPOCH_STEP_YEARS = 0.001
 
 
 def parse_refit(text):
@@ -49,7 +49,7 @@ def centroid_sigma(option, camera_file):
     rms = None if camera_file is None else camera_file.fit.get("rms_px")
     if isinstance(rms, (int, float)) and not isinstance(rms, bool) and 0.0 < rms <= 100.0:
         return float(rms)
-    return DEFAULT_CENTROID_SIGMA_PX
+    return _DEFAULT_CENTROID_SIGMA_PX
 
 
 class FrameSolver:
@@ -85,12 +85,12 @@ class FrameSolver:
 
     def epoch_of(self, frame):
         """The epoch of a frame's star positions [Julian year]: the given one, else the frame's observation's
-        to :data:`EPOCH_STEP_YEARS` (one solver per step), else J2000."""
+        to :data:`_EPOCH_STEP_YEARS` (one solver per step), else J2000."""
         if self.epoch is not None:
             return self.epoch
         if frame.epoch is None:
             return 2000.0
-        return round(frame.epoch / EPOCH_STEP_YEARS) * EPOCH_STEP_YEARS
+        return round(frame.epoch / _EPOCH_STEP_YEARS) * _EPOCH_STEP_YEARS
 
     def solve(self, frame, boresight):
         """The :class:`startrack.identify.result.IdentificationResult` of a readable ``SolveFrame``."""

@@ -25,7 +25,7 @@ from startrack.base.output_paths import check_file
 from startrack.image.fits import FITS_SUFFIXES, WCS_KEYWORDS, fits_stem, is_fits, write_hdus
 
 #: The options, and the file suffixes each takes (astrometry.net's .wcs, .new and .corr are FITS files too).
-OUTPUTS = {"wcs": ("--wcs", FITS_SUFFIXES + (".wcs",)), "new_fits": ("--new-fits", FITS_SUFFIXES + (".new",)),
+_OUTPUTS = {"wcs": ("--wcs", FITS_SUFFIXES + (".wcs",)), "new_fits": ("--new-fits", FITS_SUFFIXES + (".new",)),
            "corr": ("--corr", FITS_SUFFIXES + (".corr",))}
 
 
@@ -41,7 +41,7 @@ def check_output_options(args, frames):
     """Refuse, before any work, a FILE without ``{stem}`` for several frames (``frames``: the number of
     INPUTs, or None for a batch), with another suffix, or where it cannot be written
     (:func:`startrack.base.output_paths.check_file`)."""
-    for name, (option, suffixes) in OUTPUTS.items():
+    for name, (option, suffixes) in _OUTPUTS.items():
         template = getattr(args, name)
         if template is None:
             continue
@@ -52,7 +52,7 @@ def check_output_options(args, frames):
 
 def write_outputs(args, frame, result, epoch):
     """Write the files of the options for the identified ``frame`` (a SolveFrame) and its ``result``."""
-    if not result.ok or not any(getattr(args, name) for name in OUTPUTS):
+    if not result.ok or not any(getattr(args, name) for name in _OUTPUTS):
         return
     from astropy.io import fits
 
@@ -61,7 +61,7 @@ def write_outputs(args, frame, result, epoch):
     solution = frame_wcs(result.camera, result.q_IS)
     stem = _stem(frame.frame_id)
     header = fits.Header(solution.cards())
-    model = "ZPN, exact" if solution.projection == "ZPN" else \
+    model = "ZPN, exact" if solution.projection == "ZPN" else\
         f"SIP order {solution.order} within {solution.max_error_px:.1e} px of the camera model"
     header.add_comment(f"startrack solve: {len(result.matches)} catalog stars at epoch J{epoch:.3f}, {model}")
     if args.wcs:

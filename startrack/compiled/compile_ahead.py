@@ -45,7 +45,7 @@ def compile_ahead(lanes, stream=None) -> None:
     children = [_spawn(lane) for lane in lanes[1:]] if parallel else []
     try:
         for lane in lanes[:1] if parallel else lanes:
-            run_lane(lane, stream)
+            _run_lane(lane, stream)
         for child in children:
             child.join()
             if child.exitcode:
@@ -64,7 +64,7 @@ def marker(task: str) -> Path:
     return Path(numba.config.CACHE_DIR) / "ahead" / task.replace(":", ".")
 
 
-def run_lane(lane, stream=None) -> None:
+def _run_lane(lane, stream=None) -> None:
     """Run the tasks of ``lane`` in order, marking each that finishes; a failure is one line on ``stream``."""
     stream = sys.stderr if stream is None else stream
     for task in lane:
@@ -82,7 +82,7 @@ def run_lane(lane, stream=None) -> None:
 
 def _child(lane):
     try:
-        run_lane(lane)
+        _run_lane(lane)
     except KeyboardInterrupt:  # the parent stops too
         sys.exit(130)
 

@@ -6,7 +6,7 @@ kernel that calls a kernel of another module would load stale machine code after
 The cache folder is therefore ``<cache>/numba/<key>``, the key a hash of every ``.py`` file of the
 ``startrack`` and ``navsim`` packages and of numba's and Python's versions: any edit of either package
 starts a new folder (a kernel that cannot have changed is compiled again once).  ``$NUMBA_CACHE_DIR`` set
-by the user replaces ``<cache>/numba``.  Folders of other keys unused for :data:`PRUNE_DAYS` are removed.
+by the user replaces ``<cache>/numba``.  Folders of other keys unused for :data:`_PRUNE_DAYS` are removed.
 """
 
 import functools
@@ -22,9 +22,9 @@ import numba
 from startrack.base.cache_dir import cache_dir
 
 #: Cache folders of other keys not used for this many days are removed.
-PRUNE_DAYS = 14
+_PRUNE_DAYS = 14
 #: The packages whose sources key the cache (siblings of startrack in the installation).
-PACKAGES = ("startrack", "navsim")
+_PACKAGES = ("startrack", "navsim")
 
 
 def source_key(roots) -> str:
@@ -43,7 +43,7 @@ def kernel_cache_dir() -> Path:
     Its root goes to ``$NUMBA_CACHE_DIR`` for child processes, which so share the folder."""
     base = Path(os.environ.setdefault("NUMBA_CACHE_DIR", str(cache_dir() / "numba")))
     here = Path(__file__).resolve().parents[2]
-    folder = base / source_key([here / name for name in PACKAGES if (here / name).is_dir()])
+    folder = base / source_key([here / name for name in _PACKAGES if (here / name).is_dir()])
     folder.mkdir(parents=True, exist_ok=True)
     os.utime(folder)
     _prune(base, folder)
@@ -51,7 +51,7 @@ def kernel_cache_dir() -> Path:
 
 
 def _prune(base, keep):
-    old = time.time() - PRUNE_DAYS * 86400.0
+    old = time.time() - _PRUNE_DAYS * 86400.0
     for folder in base.iterdir():
         if folder != keep and folder.is_dir() and len(folder.name) == 16 and folder.stat().st_mtime < old:
             shutil.rmtree(folder, ignore_errors=True)

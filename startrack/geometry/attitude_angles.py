@@ -35,7 +35,7 @@ import numpy as np
 from startrack.geometry.rotation import from_matrix, to_matrix
 from startrack.geometry.sphere import local_frame
 
-TWO_PI = 2.0 * np.pi
+_TWO_PI = 2.0 * np.pi
 
 
 def matrix_from_radec_roll(ra, dec, roll):
@@ -61,12 +61,12 @@ def radec_roll_from_matrix(R_IS):
     """
     R_IS = np.asarray(R_IS, dtype=float)
     b = R_IS[..., :, 2]
-    ra = np.mod(np.arctan2(b[..., 1], b[..., 0]), TWO_PI)
+    ra = np.mod(np.arctan2(b[..., 1], b[..., 0]), _TWO_PI)
     dec = np.arctan2(b[..., 2], np.hypot(b[..., 0], b[..., 1]))
     _, east, north = local_frame(ra, dec)
     x_s = R_IS[..., :, 0]
     roll = np.arctan2(np.sum(x_s * north, axis=-1), np.sum(x_s * east, axis=-1))
-    roll = np.mod(roll + np.pi, TWO_PI) - np.pi
+    roll = np.mod(roll + np.pi, _TWO_PI) - np.pi
     return ra, dec, roll
 
 
@@ -106,10 +106,10 @@ def euler313_from_matrix(M_st):
     so it inherits its robustness at theta = 0 and pi (gimbal lock: only phi +- psi is defined there).
     """
     ra, dec, roll = radec_roll_from_matrix(np.swapaxes(np.asarray(M_st, dtype=float), -1, -2))
-    return np.mod(0.5 * np.pi + ra, TWO_PI), 0.5 * np.pi - dec, np.mod(roll, TWO_PI)
+    return np.mod(0.5 * np.pi + ra, _TWO_PI), 0.5 * np.pi - dec, np.mod(roll, _TWO_PI)
 
 
 def radec_gamma_from_quaternion(q_IS):
     """(ra, dec, gamma) [rad] of 004: as the 003 angles but with gamma = roll wrapped to [0, 2 pi)."""
     ra, dec, roll = radec_roll_from_quaternion(q_IS)
-    return ra, dec, np.mod(roll, TWO_PI)
+    return ra, dec, np.mod(roll, _TWO_PI)

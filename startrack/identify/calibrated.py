@@ -11,8 +11,8 @@ it; when a frame's stars come with sigmas estimated from the image (its detectio
 refitted with those weights and the covariance is the bound for them, scaled by max(1, chi^2 / dof) of
 the residuals (estimated sigmas are a lower bound of a real camera's errors).
 
-Catalog depth: ``mag_limit``, or by default the shallowest of :data:`DEPTHS` at which the camera's field
-holds :data:`FIELD_STARS` catalog stars on average, N(V <= m) Omega / (4 pi) (16 deg: V 6; 5 deg: V 7.5).
+Catalog depth: ``mag_limit``, or by default the shallowest of :data:`_DEPTHS` at which the camera's field
+holds :data:`_FIELD_STARS` catalog stars on average, N(V <= m) Omega / (4 pi) (16 deg: V 6; 5 deg: V 7.5).
 """
 
 from __future__ import annotations
@@ -31,25 +31,25 @@ from startrack.identify.result import IdentificationResult
 from startrack.identify.verify import DEFAULT_FALSE_MATCH_THRESHOLD, field_solid_angle
 
 #: Catalog stars the field holds on average at the default depth.
-FIELD_STARS = 15.0
+_FIELD_STARS = 15.0
 #: Catalog depths [V mag] the default is chosen from.
-DEPTHS = (6.0, 6.5, 7.0, 7.5, 8.0)
+_DEPTHS = (6.0, 6.5, 7.0, 7.5, 8.0)
 
 
-def default_mag_limit(camera, v_mag) -> float:
-    """The shallowest of :data:`DEPTHS` at which ``camera``'s field holds :data:`FIELD_STARS` of the stars
+def _default_mag_limit(camera, v_mag) -> float:
+    """The shallowest of :data:`_DEPTHS` at which ``camera``'s field holds :data:`_FIELD_STARS` of the stars
     of magnitudes ``v_mag`` on average (the deepest when none does)."""
     fraction = field_solid_angle(camera) / (4.0 * math.pi)
-    for depth in DEPTHS:
-        if np.count_nonzero(np.asarray(v_mag) <= depth) * fraction >= FIELD_STARS:
+    for depth in _DEPTHS:
+        if np.count_nonzero(np.asarray(v_mag) <= depth) * fraction >= _FIELD_STARS:
             return depth
-    return DEPTHS[-1]
+    return _DEPTHS[-1]
 
 
 class CalibratedSolver:
     """Star identification of frames from one calibrated ``camera`` (:class:`startrack.camera.model.Camera`).
 
-    mag_limit: depth of the navigation catalog [V mag] (default :func:`default_mag_limit`); epoch: of the
+    mag_limit: depth of the navigation catalog [V mag] (default :func:`_default_mag_limit`); epoch: of the
     star positions [Julian year]; centroid_sigma_px: the centroid noise the identifier's gates assume
     [px]; threshold: largest accepted false-match probability.
     """
@@ -60,7 +60,7 @@ class CalibratedSolver:
         from startrack.catalog.navigation import NavigationCatalogParams, load_navigation_catalog
 
         stars = load_star_catalog(epoch)
-        self.mag_limit = default_mag_limit(camera, stars.v_mag) if mag_limit is None else float(mag_limit)
+        self.mag_limit = _default_mag_limit(camera, stars.v_mag) if mag_limit is None else float(mag_limit)
         params = NavigationCatalogParams(mag_limit=self.mag_limit, fov=camera.angular_width, epoch=epoch)
         self.camera = camera
         self.identifier = StarIdentifier(load_navigation_catalog(params, progress=progress), camera,

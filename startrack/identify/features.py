@@ -104,7 +104,7 @@ def _unproject(u, v, camera_params):  # pragma: no cover  (compiled)
 
 
 @njit
-def feature_arrays(n_stars, n_pattern):  # pragma: no cover  (compiled)
+def _feature_arrays(n_stars, n_pattern):  # pragma: no cover  (compiled)
     """Empty features of a frame: (beta (m, m) zeros, gate (m, m) +inf, filled (1,) zero), m = min(n_stars,
     n_pattern)."""
     m = min(n_stars, n_pattern)
@@ -117,10 +117,10 @@ def centroid_directions(uv, flux, camera_params, max_stars, n_pattern, cos_merge
     (n, 2) [px] that lie on the sensor (pixel edges included), brightest first by ``flux`` (n,) (empty:
     given order), a centroid within the merge radius (cosine ``cos_merge``) of a brighter one left out
     (:func:`separated`), at most ``max_stars`` (< 0: all); ``index`` their positions in ``uv``; empty
-    features for ``n_pattern`` stars (:func:`feature_arrays`).  status: DIRECTIONS_OK, BAD_COORDINATE
+    features for ``n_pattern`` stars (:func:`_feature_arrays`).  status: DIRECTIONS_OK, BAD_COORDINATE
     (NaN or infinite), BAD_FLUX (NaN or infinite) or ALL_OUTSIDE."""
     n = uv.shape[0]
-    beta, gate, filled = feature_arrays(0, n_pattern)
+    beta, gate, filled = _feature_arrays(0, n_pattern)
     width, height = camera_params[3], camera_params[4]
     inside = np.empty(n, np.int64)
     count = 0
@@ -143,7 +143,7 @@ def centroid_directions(uv, flux, camera_params, max_stars, n_pattern, cos_merge
     for m in range(index.size):
         obs[m, 0], obs[m, 1], obs[m, 2] = _unproject(uv[index[m], 0], uv[index[m], 1], camera_params)
     obs, index = separated(obs, index, cos_merge, max_stars)
-    beta, gate, filled = feature_arrays(index.size, n_pattern)
+    beta, gate, filled = _feature_arrays(index.size, n_pattern)
     return DIRECTIONS_OK, obs, index, beta, gate, filled
 
 
@@ -201,7 +201,7 @@ class FrameFeatures:
         """Features of ``obs_S`` (already brightest first) for at most ``n_pattern`` pattern stars, the
         pairs of the first ``n_filled`` (default: all of them) computed now."""
         obs_S = np.ascontiguousarray(obs_S, dtype=float)
-        beta, gate, filled = feature_arrays(len(obs_S), n_pattern)
+        beta, gate, filled = _feature_arrays(len(obs_S), n_pattern)
         fill_features(obs_S, n_pattern if n_filled is None else n_filled, float(focal_px), float(delta_px), beta, gate,
                       filled)
         return cls(obs_S, index, beta, gate, filled, float(focal_px), float(delta_px), verify_gate)

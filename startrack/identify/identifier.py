@@ -61,7 +61,7 @@ METHODS = ("tracking", "subcatalog", "lost_in_space")
 
 
 def _positive(name, value, upper=math.inf):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))\
             or not math.isfinite(value) or not 0.0 < value <= upper:
         raise InputError(f"star identifier option {name} = {value!r} must be a number in (0, {upper:g}].")
     return float(value)
@@ -94,7 +94,7 @@ class StarIdentifier:
         self.centroid_sigma_px = _positive("centroid_sigma_px", centroid_sigma_px, 100.0)
         self.delta_px = _positive("delta_sigmas", delta_sigmas, 100.0) * self.centroid_sigma_px
         self.verify_gate = _positive("gate_sigmas", gate_sigmas, 100.0) * self.centroid_sigma_px / camera.focal_px
-        if isinstance(pattern_stars, bool) or not isinstance(pattern_stars, (int, np.integer)) \
+        if isinstance(pattern_stars, bool) or not isinstance(pattern_stars, (int, np.integer))\
                 or not 4 <= pattern_stars <= 31:
             raise InputError(f"star identifier option pattern_stars = {pattern_stars!r} must be an integer in [4, 31].")
         if max_stars is not None and (isinstance(max_stars, bool) or not isinstance(max_stars, (int, np.integer))
@@ -202,7 +202,7 @@ class StarIdentifier:
         return _failed("no_match", f"no star pattern was verified ({tried or 'no method applicable'})", start)
 
     def _result(self, frame, verified, strategy, prior, start):
-        matches, obs_S, ref_I = matched_stars(frame.index, frame.obs_S, verified.obs_index, verified.star_index,
+        matches, obs_S, ref_I = _matched_stars(frame.index, frame.obs_S, verified.obs_index, verified.star_index,
                                               self.field.hip, self.field.vectors)
         lost = entered = _NO_STARS
         if strategy.name == "tracking":
@@ -215,7 +215,7 @@ class StarIdentifier:
 
 
 @njit
-def matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma: no cover  (compiled)
+def _matched_stars(index, obs_S, obs_index, star_index, hip, vectors):  # pragma: no cover  (compiled)
     """(matches (M, 2) rows (centroid index, HIP), obs_S (M, 3), ref_I (M, 3)) ordered by centroid index."""
     centroid = index[obs_index]
     order = argsort(centroid.astype(np.float64))

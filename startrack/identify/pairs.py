@@ -27,7 +27,7 @@ from startrack.compiled.numba_setup import njit
 from startrack.identify.zones import bisect
 
 #: Distance bins of the cumulative pair counts of a k-vector table.
-COUNT_BINS = 4096
+_COUNT_BINS = 4096
 
 
 def _frozen(array, dtype):
@@ -38,7 +38,7 @@ def _frozen(array, dtype):
 
 #: Angular distances of a table [rad] in single precision (2e-8 rad at 0.3 rad, far inside any gate):
 #: half the memory a search reads.
-THETA = np.float32
+_THETA = np.float32
 
 _NO_INDEX = _frozen(np.zeros(0), np.int32)
 _NO_COUNTS = _frozen(np.zeros(0), np.int64)
@@ -60,7 +60,7 @@ class PairTable:
     intercept: float = 0.0
 
     def __post_init__(self):
-        for name, dtype in (("theta", THETA), ("first", np.int32), ("second", np.int32), ("k", np.int32)):
+        for name, dtype in (("theta", _THETA), ("first", np.int32), ("second", np.int32), ("k", np.int32)):
             object.__setattr__(self, name, _frozen(getattr(self, name), dtype))
 
     @classmethod
@@ -84,8 +84,8 @@ class PairTable:
         if self.k.size == 0:
             return self.theta, self.first, self.second, self.k, self.slope, self.intercept, _NO_COUNTS, 0.0, 1.0
         low, high = float(self.theta[0]), float(self.theta[-1])
-        step = max(high - low, 1e-12) / COUNT_BINS
-        counts = _frozen(np.searchsorted(self.theta, low + step * np.arange(COUNT_BINS + 1)), np.int64)
+        step = max(high - low, 1e-12) / _COUNT_BINS
+        counts = _frozen(np.searchsorted(self.theta, low + step * np.arange(_COUNT_BINS + 1)), np.int64)
         return self.theta, self.first, self.second, self.k, self.slope, self.intercept, counts, low, step
 
 
@@ -96,7 +96,7 @@ class SubCatalogPairs:
     def __init__(self, catalog):
         index = catalog.sub_pair_index
         self.offsets = np.asarray(catalog.sub_pair_offsets, dtype=np.int64)
-        self.theta = _frozen(catalog.pair_theta[index], THETA)
+        self.theta = _frozen(catalog.pair_theta[index], _THETA)
         self.first = _frozen(catalog.pair_i[index], np.int32)
         self.second = _frozen(catalog.pair_j[index], np.int32)
 

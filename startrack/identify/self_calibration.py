@@ -11,14 +11,14 @@ least-squares fit of the attitude and the intrinsics (:func:`startrack.camera.fi
 2. every detection against the ``n_predicted`` brightest stars predicted in the image, gate g_2,
    every intrinsic of ``free`` with its prior; repeated (up to ``WIDE_PASSES`` times) while it matches
    ``GROWTH`` times the stars of the pass before;
-3. the same at the final gate r, repeated (up to ``EXTRA_PASSES`` times) while it adds stars; a
+3. the same at the final gate r, repeated (up to ``_EXTRA_PASSES`` times) while it adds stars; a
    hypothesis whose first pass there matches no more stars than chance would (:data:`HOPELESS`) is
    dropped at once (a wrong one: its last passes cost a crowded frame a third of its verification);
-4. the depth of the catalog the frame shows (:func:`detected_depth`: where the matched fraction of the
+4. the depth of the catalog the frame shows (:func:`_detected_depth`: where the matched fraction of the
    predicted stars, brightest first, falls to the level of chance): matches of fainter stars are
    dropped (in a crowd of false detections they are chance neighbours); then matches the fit puts
-   outside r, or beyond OUTLIER (4) times their sigma scaled by the fit's sqrt(chi^2 / dof) (a
-   compression artefact next to a star), are dropped and the fit repeated (up to OUTLIER_ROUNDS times;
+   outside r, or beyond _OUTLIER (4) times their sigma scaled by the fit's sqrt(chi^2 / dof) (a
+   compression artefact next to a star), are dropped and the fit repeated (up to _OUTLIER_ROUNDS times;
    the answer is always the fit of the matches it reports: a wrong match at a wide field's corner bends
    the distortion terms until it is dropped).
 
@@ -54,7 +54,7 @@ from startrack.identify.zones import stars_near
 #: Seed stars of a pattern hypothesis (matched by construction).
 SEEDS = 4
 #: Passes at the final gate beyond the first, made while they add stars.
-EXTRA_PASSES = 2
+_EXTRA_PASSES = 2
 #: Passes at the second gate beyond the first, made while each matches GROWTH times the stars of the last: the
 #: fit spreads from the pattern outwards over a strongly distorted field (a fisheye's corners).
 WIDE_PASSES, GROWTH = 3, 1.1
@@ -62,16 +62,16 @@ WIDE_PASSES, GROWTH = 3, 1.1
 #: is dropped before its last passes: it matched about as many stars as a wrong one does.
 HOPELESS = 0.5
 #: A match whose residual exceeds this many of its sigma (scaled by the fit's sqrt(chi^2 / dof)) is dropped.
-OUTLIER = 4.0
+_OUTLIER = 4.0
 #: Rounds of dropping outliers, each followed by the fit of the matches left.
-OUTLIER_ROUNDS = 3
+_OUTLIER_ROUNDS = 3
 #: Predicted stars this close to a detection [px] are one blend to it: the brightest of them is its match
 #: (a double that Hipparcos-2 lists as one star and Gaia DR3 resolves, e.g. HIP 8544, G 5.9 and 7.2 at 2.9").
 BLEND_PX = 1.0
 
 
 @njit
-def match_pixels(obs_uv, n_obs, pred_uv, gate):  # pragma: no cover  (compiled)
+def _match_pixels(obs_uv, n_obs, pred_uv, gate):  # pragma: no cover  (compiled)
     """One-to-one matches (obs index, pred index) of mutual nearest neighbours within ``gate`` [px] among
     the first ``n_obs`` observed points, the predictions brightest first: a point's neighbour is the
     brightest prediction within :data:`BLEND_PX` of it, else the nearest.  Predictions sorted by u, each
@@ -114,7 +114,7 @@ def brightest_in_field(expected, params, n_stars):  # pragma: no cover  (compile
 
 
 @njit
-def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
+def _stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
     """Indices below ``max_star`` of the field stars within 1.2 times the image's corner angle of the
     boresight of R_IS for the camera ``params``, brightest first (ascending: the field stars are ordered
     brightest first); ``field`` = (vectors, v_mag, zones, number of stars within the magnitude cap).
@@ -129,7 +129,7 @@ def stars_around(R_IS, params, field, max_star):  # pragma: no cover  (compiled)
 
 
 @njit
-def predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  (compiled)
+def _predicted_stars(R_IS, params, vectors, around, limit):  # pragma: no cover  (compiled)
     """(star indices, uv (m, 2)) of the first ``limit`` stars of ``around`` (brightest first) imaged inside
     the frame for R_IS and the camera ``params`` (:func:`startrack.camera.projection_kernels.camera_array`): imaged by
     its projection, within the fold radius of the distortion (:func:`startrack.camera.model.fold_radius_squared`)."""
@@ -184,7 +184,7 @@ def _fit_matches(uv, sigma, vectors, stars, obs_index, pred_index, R_IS, params,
 
 
 @njit
-def local_density(uv_points, grid):  # pragma: no cover  (compiled)
+def _local_density(uv_points, grid):  # pragma: no cover  (compiled)
     """Detections per px^2 at each point (m, 2) from ``grid`` = (density map (gy, gx), cell width, cell
     height) [px^-2]."""
     density, cell_w, cell_h = grid
@@ -201,26 +201,26 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
     """Verification of the hypothesis (R_IS, params) of a pattern (module text).
 
     uv (n, 2) detections brightest first [px], sigma (n,) their centroid sigma [px]; ``params`` the
-    camera (:func:`startrack.camera.projection_kernels.camera_array`); ``field`` for :func:`stars_around`; ``settings`` =
+    camera (:func:`startrack.camera.projection_kernels.camera_array`); ``field`` for :func:`_stars_around`; ``settings`` =
     (final gate r [px], first_stars, n_predicted, free (5,) bool, prior (mean (5,), sigma (5,)), density
     grid, threshold); ``gates`` (3,) [px] g_1, g_2, r.  Returns (ok, R_IS, params, covariance (8, 8), obs
     indices, star indices, P_false, stars predicted, radius reached [px], chi^2 / dof).
     """
     _, first_stars, n_predicted, free, prior, _, _ = settings
     vectors = field[0]
-    around = stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, field[3]))
+    around = _stars_around(R_IS, params, field, brightest_in_field(4.0 * first_stars, params, field[3]))
     empty = np.zeros(0, np.int64)
     covariance = np.zeros((8, 8))
     reduced = 0.0
     first_free = np.zeros(5, np.bool_)
     first_free[0] = free[0]
     stage, runs, previous = 0, 0, 0  # the gate's index, the passes made at it, the stars the last pass matched
-    for p in range(3 + WIDE_PASSES + EXTRA_PASSES):
+    for p in range(3 + WIDE_PASSES + _EXTRA_PASSES):
         gate = gates[stage]
         if p == 1:  # as deep as needed for about 4 n_predicted stars in the field, at most the magnitude cap
-            around = stars_around(R_IS, params, field, brightest_in_field(4.0 * n_predicted, params, field[3]))
-        stars, pred_uv = predicted_stars(R_IS, params, vectors, around, first_stars if p == 0 else n_predicted)
-        obs_index, pred_index = match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
+            around = _stars_around(R_IS, params, field, brightest_in_field(4.0 * n_predicted, params, field[3]))
+        stars, pred_uv = _predicted_stars(R_IS, params, vectors, around, first_stars if p == 0 else n_predicted)
+        obs_index, pred_index = _match_pixels(uv, min(first_stars, uv.shape[0]) if p == 0 else uv.shape[0], pred_uv, gate)
         if stage == 2 and runs > 0 and obs_index.size <= previous:
             break  # the final gate adds no more stars
         if obs_index.size < SEEDS + 1 or (stage == 2 and runs == 0 and _hopeless(pred_uv, settings[5], gate, obs_index.size)):
@@ -232,7 +232,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
         runs, grew, previous = runs + 1, obs_index.size > GROWTH * previous, obs_index.size
         if stage == 0 or (stage == 1 and (runs > WIDE_PASSES or not grew)):
             stage, runs = stage + 1, 0
-        elif stage == 2 and runs > EXTRA_PASSES:
+        elif stage == 2 and runs > _EXTRA_PASSES:
             break
     return _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypotheses, covariance, reduced)
 
@@ -241,7 +241,7 @@ def verify_calibrate(uv, sigma, R_IS, params, field, settings, gates, n_hypothes
 def _hopeless(pred_uv, grid, gate, n_matches):  # pragma: no cover  (compiled)
     """Whether the first pass at the final gate matched no more stars than chance would (the Poisson tail of
     its matches beyond the seeds above HOPELESS): a wrong hypothesis, not worth the passes left."""
-    expected = -np.expm1(-local_density(pred_uv, grid) * math.pi * gate * gate)
+    expected = -np.expm1(-_local_density(pred_uv, grid) * math.pi * gate * gate)
     return poisson_tail(np.sum(expected), n_matches - SEEDS) > HOPELESS
 
 
@@ -252,22 +252,22 @@ def _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypot
     returns verify_calibrate's tuple."""
     _, _, n_predicted, free, prior, grid, threshold = settings
     empty = np.zeros(0, np.int64)
-    stars, pred_uv = predicted_stars(R_IS, params, vectors, around, n_predicted)
-    obs_index, pred_index = match_pixels(uv, uv.shape[0], pred_uv, gates[2])
-    chance = -np.expm1(-local_density(pred_uv, grid) * math.pi * gates[2] ** 2)
-    deep = pred_index < detected_depth(pred_index, stars.size, chance)
+    stars, pred_uv = _predicted_stars(R_IS, params, vectors, around, n_predicted)
+    obs_index, pred_index = _match_pixels(uv, uv.shape[0], pred_uv, gates[2])
+    chance = -np.expm1(-_local_density(pred_uv, grid) * math.pi * gates[2] ** 2)
+    deep = pred_index < _detected_depth(pred_index, stars.size, chance)
     obs_index, star_index = obs_index[deep], stars[pred_index[deep]]
-    for rounds in range(OUTLIER_ROUNDS + 1):
+    for rounds in range(_OUTLIER_ROUNDS + 1):
         if obs_index.size < SEEDS + 1:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
         ok, R_IS, params, covariance, reduced = _fit_stars(uv, sigma, vectors, obs_index, star_index, R_IS, params,
                                                            free, prior)
         if not ok:
             return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
-        if rounds == OUTLIER_ROUNDS:
+        if rounds == _OUTLIER_ROUNDS:
             break  # the answer is the fit of the matches it reports
         residual = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params))
-        keep = (residual <= gates[2]) & (residual <= OUTLIER * math.sqrt(max(reduced, 1.0)) * sigma[obs_index])
+        keep = (residual <= gates[2]) & (residual <= _OUTLIER * math.sqrt(max(reduced, 1.0)) * sigma[obs_index])
         if keep.all():
             break
         obs_index, star_index = obs_index[keep], star_index[keep]
@@ -275,36 +275,36 @@ def _conclude(uv, sigma, R_IS, params, vectors, around, settings, gates, n_hypot
         return False, R_IS, params, covariance, empty, empty, 1.0, stars.size, gates[2], reduced
     reached = _residuals(uv, obs_index, project(_sensor(vectors, star_index, R_IS), params)).max()
     reached = min(max(reached, median(sigma)), gates[2])
-    q = local_density(pred_uv, grid) * math.pi * reached * reached
+    q = _local_density(pred_uv, grid) * math.pi * reached * reached
     bonferroni = n_hypotheses * (gates[0] / reached) ** (3 + int(np.sum(free)))
     probability = chance_match_probability(q, obs_index.size - SEEDS, bonferroni)
     return (probability <= threshold, R_IS, params, covariance, obs_index, star_index, probability, stars.size,
             reached, reduced)
 
 
-#: Predicted stars per window of :func:`detected_depth`.
-DEPTH_WINDOW = 20
+#: Predicted stars per window of :func:`_detected_depth`.
+_DEPTH_WINDOW = 20
 
 
 @njit
-def detected_depth(pred_index, n_predicted, chance):  # pragma: no cover  (compiled)
+def _detected_depth(pred_index, n_predicted, chance):  # pragma: no cover  (compiled)
     """How many of the ``n_predicted`` stars (brightest first) the frame shows: the end of the last
-    window of DEPTH_WINDOW consecutive stars of which at least max(1/4, 4 x the mean chance of a
+    window of _DEPTH_WINDOW consecutive stars of which at least max(1/4, 4 x the mean chance of a
     detection within the gate) are matched (``pred_index`` the matched ones); all of them for fewer
-    than DEPTH_WINDOW.  Fainter stars than that are not in the image (its catalog depth): their
+    than _DEPTH_WINDOW.  Fainter stars than that are not in the image (its catalog depth): their
     matches are detections near them by chance."""
-    if n_predicted <= DEPTH_WINDOW:
+    if n_predicted <= _DEPTH_WINDOW:
         return n_predicted
     matched = np.zeros(n_predicted, np.int64)
     matched[pred_index] = 1
-    floor = max(0.25, 4.0 * chance.mean()) * DEPTH_WINDOW
-    running = matched[:DEPTH_WINDOW].sum()
-    depth = DEPTH_WINDOW if running >= floor else 0
-    for end in range(DEPTH_WINDOW, n_predicted):
-        running += matched[end] - matched[end - DEPTH_WINDOW]
+    floor = max(0.25, 4.0 * chance.mean()) * _DEPTH_WINDOW
+    running = matched[:_DEPTH_WINDOW].sum()
+    depth = _DEPTH_WINDOW if running >= floor else 0
+    for end in range(_DEPTH_WINDOW, n_predicted):
+        running += matched[end] - matched[end - _DEPTH_WINDOW]
         if running >= floor:
             depth = end + 1
-    return max(depth, DEPTH_WINDOW)
+    return max(depth, _DEPTH_WINDOW)
 
 
 @njit

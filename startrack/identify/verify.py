@@ -62,7 +62,7 @@ def binomial_tail(n, k, p):
         return 0.0
     if p >= 1.0:
         return 1.0
-    log_term = math.lgamma(n + 1) - math.lgamma(k + 1) - math.lgamma(n - k + 1) + k * math.log(p) \
+    log_term = math.lgamma(n + 1) - math.lgamma(k + 1) - math.lgamma(n - k + 1) + k * math.log(p)\
         + (n - k) * math.log1p(-p)
     term = math.exp(log_term)
     total = term
@@ -104,7 +104,7 @@ def verify_near(obs_S, R_IS, field, n_hypotheses, n_seed):  # pragma: no cover  
     near = np.empty(vectors.shape[0], np.int64)
     near = near[:stars_near(zones, vectors, R_IS[:, 2].copy(), radius, near)]
     stars = vectors[near]
-    ok, R_IS, obs_index, star_index, n_predicted = match_and_refit(obs_S, stars, R_IS, camera_params, pass_gates,
+    ok, R_IS, obs_index, star_index, n_predicted = _match_and_refit(obs_S, stars, R_IS, camera_params, pass_gates,
                                                                    focal_px)
     if not ok:
         return False, R_IS, obs_index, star_index, 1.0, n_predicted
@@ -192,12 +192,12 @@ def predict(stars_I, R_IS, camera_params, margin_px):  # pragma: no cover  (comp
     return keep[:count], v_S[keep[:count]]
 
 
-#: Repetitions of the final-gate pass of :func:`match_and_refit` allowed while they add stars.
+#: Repetitions of the final-gate pass of :func:`_match_and_refit` allowed while they add stars.
 _EXTRA_PASSES = 3
 
 
 @njit
-def match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px):  # pragma: no cover  (compiled)
+def _match_and_refit(obs_S, stars_I, R_IS, camera_params, pass_gates, focal_px):  # pragma: no cover  (compiled)
     """Predict, match (mutual nearest within each gate of ``pass_gates`` [rad] in turn) and refit by SVD.
 
     Each pass predicts with the field grown by its gate, matches, and refits with every match; the

@@ -25,7 +25,7 @@ _GLOBAL_SAMPLE = 16384
 #: Pixels per cell used for a mesh estimate (regular subsample of the cell).
 _CELL_SAMPLE = 256
 #: 1.4826 * MAD is sigma for a normal law.
-MAD_TO_SIGMA = 1.482602218505602
+_MAD_TO_SIGMA = 1.482602218505602
 
 
 def _truncation(clip):
@@ -34,7 +34,7 @@ def _truncation(clip):
     return float(np.sqrt(1.0 - 2.0 * clip * density / (2.0 * ndtr(clip) - 1.0)))
 
 
-def clipped_level(samples, clip=3.0, iterations=5):
+def _clipped_level(samples, clip=3.0, iterations=5):
     """(level, sigma) (m,) of each row of ``samples`` (m, k) [DN]: median and 1.4826 MAD (the standard
     deviation if the MAD is 0), then the mean and standard deviation (divided by that of the normal law
     truncated at +-clip) of the values within ``clip`` sigma, repeated until the kept set stops changing
@@ -43,7 +43,7 @@ def clipped_level(samples, clip=3.0, iterations=5):
     ordered = np.sort(np.asarray(samples, dtype=float), axis=1)
     m, k = ordered.shape
     level = np.median(ordered, axis=1)
-    sigma = MAD_TO_SIGMA * np.median(np.abs(ordered - level[:, None]), axis=1)
+    sigma = _MAD_TO_SIGMA * np.median(np.abs(ordered - level[:, None]), axis=1)
     flat = sigma == 0.0
     sigma[flat] = np.std(ordered[flat], axis=1)
     sums = np.concatenate([np.zeros((m, 1)), np.cumsum(ordered, axis=1)], axis=1)
@@ -73,7 +73,7 @@ def estimate_background(image, clip=3.0, iterations=5):
     array = np.asarray(image)
     step = max(1, int(np.ceil(np.sqrt(array.size / _GLOBAL_SAMPLE))))
     sample = np.asarray(array[::step, ::step], dtype=float).reshape(1, -1)
-    level, sigma = clipped_level(sample, clip, iterations)
+    level, sigma = _clipped_level(sample, clip, iterations)
     return float(level[0]), float(sigma[0])
 
 
@@ -172,7 +172,7 @@ def mesh_background(image, cell_px=64, clip=3.0, iterations=5):
     array = np.asarray(image)
     rows, cols = _cell_edges(array.shape[0], int(cell_px)), _cell_edges(array.shape[1], int(cell_px))
     samples = _cell_samples(array, rows, cols)
-    level, sigma = clipped_level(samples.reshape(-1, samples.shape[-1]), clip, iterations)
+    level, sigma = _clipped_level(samples.reshape(-1, samples.shape[-1]), clip, iterations)
     shape = samples.shape[:2]
     level, sigma = level.reshape(shape), sigma.reshape(shape)
     level_median = ndimage.median_filter(level, size=3, mode="nearest")

@@ -22,7 +22,7 @@ other 7 (the ring, background removed) is at least 1.7 times it for a Gaussian P
 0.8 times at 0.5 px and 0.4 times at 0.4 px, whatever the pixel phase (pixel-integrated PSF), while a
 hot pixel has none and a pair of hot pixels (a few hundred of them among 10 000 hot pixels of a
 1024 x 768 sensor) only its twin, which is the pixel left out.  The frame's own stars set the cut
-(:func:`_ring_cut`: half the median ratio of its bright detections, at least :data:`MIN_RING_RATIO`);
+(:func:`_ring_cut`: half the median ratio of its bright detections, at least :data:`_MIN_RING_RATIO`);
 a detection whose ring ratio R / (I_peak - b) lies below the cut by more than 3 times its noise
 (sqrt(7) sigma_n / (I_peak - b)) is flagged: at high SNR a hot pixel is told from a star with
 certainty, near the threshold the test keeps the detection.  Clusters of three or more hot pixels pass
@@ -39,7 +39,7 @@ component's light, M = sum w (x - c)(x - c)^T / sum w with w = I - b, give its s
 sqrt(lambda_max / lambda_min) (1 for a round image; a streak of length L and width sigma_w:
 L / (sqrt(12) sigma_w)).  A detection is flagged ``extended`` when it is longer than
 :data:`MAX_ELONGATION` with at least :data:`MIN_SHAPE_PIXELS` pixels (fewer pixels do not measure a
-shape), or larger than :data:`EXTENDED_SIZE` times the median size of the frame's bright (SNR >= 20)
+shape), or larger than :data:`_EXTENDED_SIZE` times the median size of the frame's bright (SNR >= 20)
 unsaturated stars when it has 5 of them.  A saturated star's flat top widens it by about 1.5 for a
 peak 100 times the saturation level, well inside the cut.
 
@@ -62,11 +62,11 @@ from startrack.image.background import Background, estimate_background, mesh_bac
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 #: Smallest ring ratio of a star image (module text).
-MIN_RING_RATIO = 0.3
+_MIN_RING_RATIO = 0.3
 #: Largest axis ratio of a star image; fewest pixels that measure it (module text).
 MAX_ELONGATION, MIN_SHAPE_PIXELS = 3.0, 10
 #: Largest size of a star image over the median of the frame's bright stars (module text).
-EXTENDED_SIZE = 3.0
+_EXTENDED_SIZE = 3.0
 
 
 class GreyCentroid:
@@ -249,7 +249,7 @@ def _measure(values, labels, n, on_border, levels, centroider, saturation_dn, mi
         if saturation_dn is not None:
             single |= saturated & (npix < _saturated_pixels(star_size, saturation_dn - b_peak, _at(threshold, peaks) - b_peak))
     with np.errstate(invalid="ignore"):
-        extended = ((elongation > MAX_ELONGATION) & (npix >= MIN_SHAPE_PIXELS)) | (size > EXTENDED_SIZE * star_size)
+        extended = ((elongation > MAX_ELONGATION) & (npix >= MIN_SHAPE_PIXELS)) | (size > _EXTENDED_SIZE * star_size)
     keep = np.flatnonzero(npix >= min_pixels)
     keep = keep[np.argsort(-flux[keep], kind="stable")]
     summary = (float(np.median(level)) for level in levels)
@@ -299,11 +299,11 @@ def _bright(snr, npix, saturated):
 def _ring_cut(ratio, snr, npix, saturated):
     """Smallest ring ratio of a star in this frame: half the median ratio of its bright (SNR >= 20),
     unsaturated detections of 2 pixels or more when there are 5 of them -- the smallest ratio over pixel
-    phases is 0.7-0.95 times the median (sigma 0.4-0.67 px) -- within [MIN_RING_RATIO, 1.5]."""
+    phases is 0.7-0.95 times the median (sigma 0.4-0.67 px) -- within [_MIN_RING_RATIO, 1.5]."""
     bright = _bright(snr, npix, saturated)
     if np.count_nonzero(bright) < 5:
-        return MIN_RING_RATIO
-    return float(np.clip(0.5 * np.median(ratio[bright]), MIN_RING_RATIO, 1.5))
+        return _MIN_RING_RATIO
+    return float(np.clip(0.5 * np.median(ratio[bright]), _MIN_RING_RATIO, 1.5))
 
 
 def _centroid_sigma(index, n, coord, centre, npix, wsum, sigma_n):

@@ -27,7 +27,7 @@ IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy") + FITS_SUFFI
 #: Greyscale pillow modes read as they are.
 _GREY_MODES = ("L", "I;16", "I;16B", "I;16L", "I", "F", "1")
 #: ITU-R BT.601 luma weights of R, G, B.
-LUMA_WEIGHTS = np.array([0.299, 0.587, 0.114])
+_LUMA_WEIGHTS = np.array([0.299, 0.587, 0.114])
 
 
 @dataclass(frozen=True)
@@ -90,7 +90,7 @@ def _read_picture(path):
             if image.mode == "LA":
                 return np.array(image.getchannel("L")), False
             rgb = np.asarray(image.convert("RGB"), dtype=float)
-            return rgb @ LUMA_WEIGHTS, True
+            return rgb @ _LUMA_WEIGHTS, True
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
         raise InputError(f"image file {path} could not be read as an image ({error})") from None
 

@@ -26,7 +26,7 @@ from startrack.base.errors import InputError
 
 FITS_SUFFIXES = (".fits", ".fit", ".fts")
 #: File names read as FITS: those suffixes, gzipped, or tile-compressed (.fz, fpack).
-FITS_NAMES = FITS_SUFFIXES + tuple(s + ".gz" for s in FITS_SUFFIXES) + (".fz",)
+_FITS_NAMES = FITS_SUFFIXES + tuple(s + ".gz" for s in FITS_SUFFIXES) + (".fz",)
 #: Detections closer than this to a pixel without data are dropped [px] (a cut edge looks like a star).
 MASK_MARGIN_PX = 3
 #: J2000.0 as a Julian date, and the days of a Julian year.
@@ -38,15 +38,15 @@ WCS_KEYWORDS = re.compile(r"^(WCSAXES|CTYPE\d|CUNIT\d|CRPIX\d|CRVAL\d|CDELT\d|CR
 
 
 def is_fits(path):
-    """True for a file name astropy reads as FITS (:data:`FITS_NAMES`)."""
-    return Path(path).name.lower().endswith(FITS_NAMES)
+    """True for a file name astropy reads as FITS (:data:`_FITS_NAMES`)."""
+    return Path(path).name.lower().endswith(_FITS_NAMES)
 
 
 def fits_stem(path):
     """The file name without its FITS suffixes ("m42.fits.gz", "m42.fits.fz" -> "m42")."""
     name = Path(path).name
     while is_fits(name):
-        name = name[:-len(next(s for s in FITS_NAMES if name.lower().endswith(s)))]
+        name = name[:-len(next(s for s in _FITS_NAMES if name.lower().endswith(s)))]
     return name
 
 

@@ -54,21 +54,21 @@ from startrack.base.errors import InputError
 from startrack.compiled.numba_setup import njit
 
 #: Rounding of a pixel to whole DN: its variance [DN²].
-QUANTISATION_DN2 = 1.0 / 12.0
+_QUANTISATION_DN2 = 1.0 / 12.0
 #: Track points per PSF radius of smear in (1) (the renderer's midpoint rule: startrack.image.render.SMEAR_STEP_SIGMA).
-TRACK_STEP_SIGMA = 0.25
+_TRACK_STEP_SIGMA = 0.25
 #: Gauss-Newton stops when a step moves the position by less than this [px] ...
-STEP_TOLERANCE_PX = 1e-5
+_STEP_TOLERANCE_PX = 1e-5
 #: ... or after this many steps.
-MAX_STEPS = 30
+_MAX_STEPS = 30
 #: Largest step [px] of the position, and its largest distance from the start [px] beyond half the smear
 #: (a faint smeared star may be detected as a fragment of its trail; farther: ``failed``).
 MAX_STEP_PX, MAX_SHIFT_PX = 1.0, 2.0
 #: Probability of χ²(dof) below which a fit's residuals are the model's noise (above it: ``outlier``).
-OUTLIER_PROBABILITY = 0.999
+_OUTLIER_PROBABILITY = 0.999
 #: Reach of a neighbour's light beyond its track [PSF radii] for the ``blended`` flag (the renderer's extent:
 #: startrack.image.render.PSF_EXTENT_SIGMA).
-NEIGHBOUR_REACH_SIGMA = 5.0
+_NEIGHBOUR_REACH_SIGMA = 5.0
 
 
 @njit
@@ -146,13 +146,13 @@ def information(theta, r0, c0, rows, cols, su, sv, sigma, noise2, inv_gain):
 
 
 @njit
-def fit_window(data, valid, r0, c0, theta0, su, sv, sigma, noise2, inv_gain):
+def _fit_window(data, valid, r0, c0, theta0, su, sv, sigma, noise2, inv_gain):
     """Gauss-Newton of eq. (1)-(2) on one window (``data`` (rows, cols) [DN] from pixel (r0, c0), ``valid``
     the pixels that count) from θ0. Returns (θ, J at θ, χ², valid pixels, converged)."""
     rows, cols = data.shape
     theta = theta0.copy()
     converged = False
-    for _ in range(MAX_STEPS):
+    for _ in range(_MAX_STEPS):
         mu, grad = _model(theta, r0, c0, rows, cols, su, sv, sigma)
         A, y, _, _ = _normal_equations(data, valid, mu, grad, theta[3], noise2, inv_gain)
         step = np.linalg.solve(A, y)
@@ -162,7 +162,7 @@ def fit_window(data, valid, r0, c0, theta0, su, sv, sigma, noise2, inv_gain):
         if theta[2] + step[2] <= 0.0:
             step *= 0.5 * theta[2] / max(-step[2], 1e-300)
         theta += step
-        if largest < STEP_TOLERANCE_PX:
+        if largest < _STEP_TOLERANCE_PX:
             converged = True
             break
     mu, grad = _model(theta, r0, c0, rows, cols, su, sv, sigma)
@@ -191,7 +191,7 @@ class PixelNoise:
     @property
     def variance_dn2(self):
         """σ_n² + q [DN²]: the variance of a pixel without a star."""
-        return self.sigma_n_dn**2 + (QUANTISATION_DN2 if self.quantised else 0.0)
+        return self.sigma_n_dn**2 + (_QUANTISATION_DN2 if self.quantised else 0.0)
 
     @property
     def inverse_gain(self):
@@ -202,7 +202,7 @@ class PixelNoise:
 def track_offsets(smear_px, psf_sigma_px):
     """(su, sv) (K,) [px]: the track points of eq. (1) about the centre for the smear (Δu, Δv) [px]."""
     du, dv = (float(x) for x in smear_px)
-    count = max(1, int(np.ceil(np.hypot(du, dv) / (TRACK_STEP_SIGMA * psf_sigma_px))))
+    count = max(1, int(np.ceil(np.hypot(du, dv) / (_TRACK_STEP_SIGMA * psf_sigma_px))))
     s = (np.arange(count) + 0.5) / count - 0.5
     return s * du, s * dv
 
@@ -352,16 +352,16 @@ def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, sat
 def neighbour_reach(psf_sigma_px, smear_px):
     """(2,) [px]: how far from the centre of a star's fit window, per axis, the centre of another source smeared
     like it (``smear_px`` (Δu, Δv)) may lie and still send light into the window -- its track within
-    NEIGHBOUR_REACH_SIGMA σ of the window: the bounding boxes of the track and of the window, grown by that
+    _NEIGHBOUR_REACH_SIGMA σ of the window: the bounding boxes of the track and of the window, grown by that
     reach, overlap (the ``blended`` flag)."""
     smear = np.asarray(smear_px, dtype=float)
-    return half_width(psf_sigma_px, smear) + 0.5 + NEIGHBOUR_REACH_SIGMA * psf_sigma_px + 0.5 * np.abs(smear)
+    return half_width(psf_sigma_px, smear) + 0.5 + _NEIGHBOUR_REACH_SIGMA * psf_sigma_px + 0.5 * np.abs(smear)
 
 
 @functools.lru_cache(maxsize=4096)
 def _outlier_chi2(dof):
     """The χ² above which a fit of ``dof`` degrees of freedom is an ``outlier`` (its 99.9 % quantile)."""
-    return float(chi2.ppf(OUTLIER_PROBABILITY, dof))
+    return float(chi2.ppf(_OUTLIER_PROBABILITY, dof))
 
 
 def _fit_one(array, start, drift, sigma, noise, background, saturation_dn, origin, out):
@@ -380,7 +380,7 @@ def _fit_one(array, start, drift, sigma, noise, background, saturation_dn, origi
     failed, theta, cov, chi2_sum, dof = True, theta0, np.full((2, 2), np.nan), np.nan, 0
     if np.count_nonzero(valid) > 4:
         try:
-            theta, J, chi2_sum, n, converged = fit_window(data, valid, top + origin[0], left + origin[1], theta0, su,
+            theta, J, chi2_sum, n, converged = _fit_window(data, valid, top + origin[0], left + origin[1], theta0, su,
                                                           sv, sigma, noise.variance_dn2, noise.inverse_gain)
             dof = n - 4
             shift = np.hypot(*(theta[:2] - start))

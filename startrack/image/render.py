@@ -39,7 +39,7 @@ PSF_EXTENT_SIGMA = 5.0
 #: Track sampling step as a fraction of the PSF radius (midpoint rule of the smear integral).
 SMEAR_STEP_SIGMA = 0.25
 #: Upper bound on track sub-steps per exposure.
-MAX_SMEAR_STEPS = 512
+_MAX_SMEAR_STEPS = 512
 
 
 @dataclass(frozen=True)
@@ -197,7 +197,7 @@ class Windows:
 
 
 @dataclass(frozen=True)
-class Canvas:
+class _Canvas:
     """Pixels being rendered: M arrays of h x w with their image origins."""
 
     row0: np.ndarray
@@ -269,7 +269,7 @@ def expected_charge(sensor, height, width, sources=(), windows=None):
     Sums the pixel-integrated, track-averaged PSF of every source (module
     docstring); background, hot pixels and noise are not included.
     """
-    canvas = Canvas.full_frame(height, width) if windows is None else Canvas.from_windows(windows)
+    canvas = _Canvas.full_frame(height, width) if windows is None else _Canvas.from_windows(windows)
     expected = np.zeros((len(canvas.row0), canvas.height, canvas.width))
     for group in sources:
         if len(group.electrons) == 0:
@@ -294,7 +294,7 @@ def render(sensor, height, width, sources, rng, windows=None):
     """
     if not isinstance(rng, np.random.Generator):
         raise InputError("render needs a seeded numpy.random.Generator as rng")
-    canvas = Canvas.full_frame(height, width) if windows is None else Canvas.from_windows(windows)
+    canvas = _Canvas.full_frame(height, width) if windows is None else _Canvas.from_windows(windows)
     signal = expected_charge(sensor, height, width, sources, windows)
     signal = signal.reshape(len(canvas.row0), canvas.height, canvas.width)
     if sensor.hot_pixel_count:
@@ -320,7 +320,7 @@ def render(sensor, height, width, sources, rng, windows=None):
     return out[0] if windows is None else out
 
 
-def smear_times(exposure_s, omega_S, sigma_px, focal_px, fov_radius_px):
+def _smear_times(exposure_s, omega_S, sigma_px, focal_px, fov_radius_px):
     """Sub-step times (K,) [s] from mid-exposure for the midpoint rule of the smear integral.
 
     K is set so that the fastest image point (rotation about the boresight
@@ -330,7 +330,7 @@ def smear_times(exposure_s, omega_S, sigma_px, focal_px, fov_radius_px):
     omega = np.asarray(omega_S, dtype=float)
     speed = focal_px * np.hypot(omega[0], omega[1]) + abs(omega[2]) * fov_radius_px  # px/s, first order
     length = speed * exposure_s
-    k = int(min(MAX_SMEAR_STEPS, max(1, np.ceil(length / (SMEAR_STEP_SIGMA * sigma_px)))))
+    k = int(min(_MAX_SMEAR_STEPS, max(1, np.ceil(length / (SMEAR_STEP_SIGMA * sigma_px)))))
     return ((np.arange(k) + 0.5) / k - 0.5) * exposure_s
 
 
@@ -345,7 +345,7 @@ def star_sources(camera, sensor, q_IS, vectors_I, v_mag, omega_S=(0.0, 0.0, 0.0)
     if vectors_I.shape[0] != v_mag.shape[0]:
         raise InputError(f"got {vectors_I.shape[0]} star directions but {v_mag.shape[0]} magnitudes")
     fov_radius_px = 0.5 * np.hypot(camera.width, camera.height)
-    times = smear_times(sensor.exposure_s, omega_S, sensor.psf_sigma_px, camera.focal_px, fov_radius_px)
+    times = _smear_times(sensor.exposure_s, omega_S, sensor.psf_sigma_px, camera.focal_px, fov_radius_px)
     smear_px = np.linalg.norm(np.asarray(omega_S, float)) * sensor.exposure_s * (camera.focal_px + fov_radius_px)
     margin = PSF_EXTENT_SIGMA * sensor.psf_sigma_px + smear_px + 1.0
     index = camera.stars_in_field(q_IS, vectors_I, margin_px=margin)

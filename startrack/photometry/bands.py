@@ -26,7 +26,7 @@ from startrack.base.errors import InputError
 PLANCK = 6.62607015e-34
 LIGHT_SPEED = 299792458.0
 #: 1 erg s⁻¹ cm⁻² Å⁻¹ in W m⁻² m⁻¹.
-ERG_PER_S_CM2_A = 1e7
+_ERG_PER_S_CM2_A = 1e7
 
 
 @dataclass(frozen=True)
@@ -50,11 +50,11 @@ class Band:
 
 #: The bands of the product (Vega system).
 BANDS = {
-    "V": Band("V", 0.545e-6, 0.088e-6, 363.1e-11 * ERG_PER_S_CM2_A),
-    "R": Band("R", 0.641e-6, 0.138e-6, 217.7e-11 * ERG_PER_S_CM2_A),
-    "I": Band("I", 0.798e-6, 0.149e-6, 112.6e-11 * ERG_PER_S_CM2_A),
-    "J": Band("J", 1.235e-6, 0.162e-6, 3.129e-10 * ERG_PER_S_CM2_A),
-    "H": Band("H", 1.662e-6, 0.251e-6, 1.133e-10 * ERG_PER_S_CM2_A),
+    "V": Band("V", 0.545e-6, 0.088e-6, 363.1e-11 * _ERG_PER_S_CM2_A),
+    "R": Band("R", 0.641e-6, 0.138e-6, 217.7e-11 * _ERG_PER_S_CM2_A),
+    "I": Band("I", 0.798e-6, 0.149e-6, 112.6e-11 * _ERG_PER_S_CM2_A),
+    "J": Band("J", 1.235e-6, 0.162e-6, 3.129e-10 * _ERG_PER_S_CM2_A),
+    "H": Band("H", 1.662e-6, 0.251e-6, 1.133e-10 * _ERG_PER_S_CM2_A),
 }
 
 

@@ -164,10 +164,10 @@ _BESSELL_BRETT_GIANTS = np.array(
 #: V - I_C of the Sun [mag] (G2V row of the dwarf sequence), for stars with no colour at all.
 SOLAR_V_I = 0.713
 #: A parallax is good when it exceeds this many standard errors.
-PARALLAX_SNR = 5.0
+_PARALLAX_SNR = 5.0
 #: A star with a good parallax is a giant when brighter than a dwarf of its colour by more than this
 #: [mag]: half the 4.8-mag gap between K0III (M_V = 1.0, Mamajek's K0III notes) and K0V (M_V = 5.78).
-GIANT_MARGIN = 2.4
+_GIANT_MARGIN = 2.4
 
 
 def _increasing(table, column):
@@ -218,16 +218,16 @@ def band_minus_v(band, b_v, v_i, giant=None):
 
 
 def is_giant(v_mag, b_v, v_i, parallax, parallax_error):
-    """True for giants: a good parallax (> PARALLAX_SNR errors) putting the star more than GIANT_MARGIN
+    """True for giants: a good parallax (> _PARALLAX_SNR errors) putting the star more than _GIANT_MARGIN
     [mag] above the dwarf sequence's M_V at its V - I_C (V [mag], parallax and error [rad]; no
     extinction), or no good parallax: a dwarf redder than V - I_C = 0.81 (M_V > 5.5) with a parallax
     below 5 mas (5 errors of 1 mas) is fainter than V = 12, at the catalogue's limit; bluer, the
     sequences are one."""
     parallax = np.asarray(parallax, dtype=float)
-    good = parallax > PARALLAX_SNR * np.asarray(parallax_error, dtype=float)
+    good = parallax > _PARALLAX_SNR * np.asarray(parallax_error, dtype=float)
     absolute = np.asarray(v_mag, dtype=float) + 5.0 + 5.0 * np.log10(np.where(good, parallax, ARCSEC) / ARCSEC)
     dwarf_mv = np.interp(v_minus_i(b_v, v_i), DWARFS["v_i"], DWARFS["mv"])
-    return ~good | (absolute < dwarf_mv - GIANT_MARGIN)
+    return ~good | (absolute < dwarf_mv - _GIANT_MARGIN)
 
 
 def band_magnitude(band, v_mag, b_v, v_i, parallax, parallax_error):
