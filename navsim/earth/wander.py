@@ -159,6 +159,14 @@ def normal_turn(up_from, up_to):
     return axis * np.where(sine > 0.0, angle / np.where(sine > 0.0, sine, 1.0), 1.0)[..., None]
 
 
+def carried_ned(lat_from, lon_from, lat_to, lon_to):
+    """C_n'n (..., 3, 3): NED vectors at (L, λ) carried to the NED at (L', λ') [rad] by the least turn of the normal
+    (:func:`normal_turn`): C_n'e exp([δθ_e×]) C_en. Near each other it is a rotation about the vertical by the
+    meridians' convergence (δλ sin L to first order, any angle at a pole: there NED is along λ)."""
+    turn = rot.to_matrix(rot.from_rotation_vector(normal_turn(normal(lat_from, lon_from), normal(lat_to, lon_to))))
+    return np.swapaxes(c_en(lat_to, lon_to), -1, -2) @ turn @ c_en(lat_from, lon_from)
+
+
 def ned_offset(lat, lon, h, lat_ref, lon_ref, h_ref):
     """(north, east, down) [m] (..., 3) of positions (L, λ, h) from reference ones in the reference's NED: the
     turn δθ_n of the reference's normal into the other's (:func:`normal_turn`, C_en = C_en,ref (I + [δθ_n×]) to
@@ -172,9 +180,11 @@ def ned_offset(lat, lon, h, lat_ref, lon_ref, h_ref):
 
 
 def displaced(lat, lon, h, north, east):
-    """(L, λ) [rad] of the point ``north``, ``east`` [m] from (L, λ, h) along its NED axes: the normal turned by
-    C_en [δE/(R_N + h), −δN/(R_M + h), 0] (the inverse of :func:`ned_offset` to first order; at a pole, NED along λ)."""
+    """(L, λ) [rad] (arrays of the inputs' broadcast shape) of the points ``north``, ``east`` [m] from (L, λ, h) along
+    their NED axes: the normal turned by C_en [δE/(R_N + h), −δN/(R_M + h), 0] (the inverse of :func:`ned_offset` to
+    first order; at a pole, NED along λ: no cos L divides anything)."""
     r_m, r_n = radii(lat)
-    turn = c_en(lat, lon) @ np.array([east / (r_n + h), -north / (r_m + h), 0.0])
+    east, north = np.broadcast_arrays(east / (r_n + h), -north / (r_m + h))
+    turn = np.einsum("...ij,...j->...i", c_en(lat, lon), np.stack([east, north, np.zeros_like(east)], axis=-1))
     up = rot.rotate(rot.from_rotation_vector(turn), normal(lat, lon))
-    return float(np.arctan2(up[2], np.hypot(up[0], up[1]))), float(np.arctan2(up[1], up[0]))
+    return np.arctan2(up[..., 2], np.hypot(up[..., 0], up[..., 1])), np.arctan2(up[..., 1], up[..., 0])

@@ -130,8 +130,9 @@ def absent_reason(scenario, key):
         return "not isolable: at image fidelity the star noise comes from the pixels and is in every part"
     if key == "mounting" and not any(sensor["misalignment_arcsec"]):
         return "absent: star_sensor.misalignment_arcsec is zero"
-    if key == "refraction" and not (sensor["refraction"]["pressure_error_percent"] or sensor["refraction"]["temperature_error_k"]):
-        return "absent: the real air is the model's (star_sensor.refraction's errors are zero)"
+    air = sensor["refraction"]
+    if key == "refraction" and not (air["pressure_error_percent"] or air["temperature_error_k"] or air["drawn"]):
+        return "absent: the real air is the model's (star_sensor.refraction's errors are zero, none drawn)"
     if key == "aiding" and not (data.get("baro") or data["aiding"].get("position")):
         return "absent: neither a baro nor position fixes"
     if key == "inertial" and not (any(getattr(gyro, name) for name in GYRO_TERMS)

@@ -98,20 +98,28 @@ def star_sensor_model(scenario, orientation, h):
                            refraction_sigma=refraction_sigma(scenario, h))
 
 
-def real_air(scenario, truth_off=()):
+def real_air(scenario, truth_off=(), rng=None):
     """The :class:`~navsim.earth.refraction.Air` the truth's stars are refracted by: the standard atmosphere with
-    the scenario's pressure and temperature errors (none when ``truth_off`` has "refraction")."""
+    the scenario's pressure and temperature errors, plus, with ``star_sensor.refraction.drawn``, errors of the stated
+    σ drawn from the Generator ``rng`` (a run's; None: the fixed errors alone, the air's mean); none when
+    ``truth_off`` has "refraction"."""
     sensor = scenario["star_sensor"]
     refraction = sensor["refraction"]
-    air = Air(band(sensor["band"]).centre_um, refraction["pressure_error_percent"] / 100.0,
-              refraction["temperature_error_k"])
+    pressure, temperature = refraction["pressure_error_percent"] / 100.0, refraction["temperature_error_k"]
+    if refraction["drawn"] and rng is not None:
+        draw = rng.standard_normal(2)
+        pressure += draw[0] * refraction["pressure_sigma_percent"] / 100.0
+        temperature += draw[1] * refraction["temperature_sigma_k"]
+    air = Air(band(sensor["band"]).centre_um, pressure, temperature)
     return air.modelled() if "refraction" in truth_off else air
 
 
 def refraction_residual(scenario):
-    """Whether refraction leaves an error in the stars the filter fuses: uncorrected, or the real air not the model's."""
+    """Whether refraction leaves an error in the stars the filter fuses: uncorrected, or the real air not the model's
+    (given, or drawn per run)."""
     refraction = scenario["star_sensor"]["refraction"]
-    return not refraction["correction"] or bool(refraction["pressure_error_percent"] or refraction["temperature_error_k"])
+    return not refraction["correction"] or bool(refraction["pressure_error_percent"] or refraction["temperature_error_k"]
+                                                or refraction["drawn"])
 
 
 def modelled_air(scenario):
@@ -129,12 +137,12 @@ def refraction_sigma(scenario, h):
     return float(air.fraction_sigma(h, refraction["pressure_sigma_percent"] / 100.0, refraction["temperature_sigma_k"]))
 
 
-def refraction_fraction(scenario, h, truth_off=()):
-    """The truth's ε_r (...,) at heights ``h`` [m]: the real air's refraction as a fraction of the processing's model
-    (0 without a correction: no model to err)."""
+def refraction_fraction(scenario, h, air):
+    """The truth's ε_r (...,) at heights ``h`` [m]: the real ``air``'s refraction as a fraction of the processing's
+    model (0 without a correction: no model to err)."""
     if modelled_air(scenario) is None:
         return np.zeros(np.shape(h))
-    return real_air(scenario, truth_off).fraction(h)
+    return air.fraction(h)
 
 
 def gravity_uncertainty(scenario, lat, h):

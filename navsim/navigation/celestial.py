@@ -36,7 +36,6 @@ from navsim.earth.apparent import fix_rotation
 from navsim.earth.frames import q_en
 from navsim.earth.gravity import normal_gravity
 from navsim.earth.wgs84 import radii
-from navsim.navigation import build
 from startrack import rotation as rot
 from startrack import units
 
@@ -46,9 +45,9 @@ SCHULER_PERIOD_S = 5063.0
 EIGEN_COMPONENTS = 3
 
 
-def summary(scenario, series, sky, orientation, q_BS_true, geometry):
+def summary(scenario, series, sky, orientation, q_BS_true, geometry, air):
     """The ``celestial`` block of a star-aided run's summary (module docstring); ``geometry`` the frames'
-    :class:`~navsim.navigation.exclusion.SkyGeometry`."""
+    :class:`~navsim.navigation.exclusion.SkyGeometry`, ``air`` the run's real :class:`~navsim.earth.refraction.Air`."""
     sensor = scenario["star_sensor"]
     steady = series["t"] >= scenario["settle_s"]
     return {"star_sensor": {"fidelity": sensor["fidelity"], "measurement": sensor["measurement"],
@@ -57,8 +56,7 @@ def summary(scenario, series, sky, orientation, q_BS_true, geometry):
             "sky": sky_summary(geometry, series, sensor),
             "horizon_floor": horizon_floor(series, steady),
             "aberration": aberration(series, sky, orientation, q_BS_true, sensor["aberration_correction"], steady),
-            "refraction": refraction(series, sky, orientation, q_BS_true, sensor["refraction"],
-                                     build.real_air(scenario).modelled(), steady),
+            "refraction": refraction(series, sky, orientation, q_BS_true, sensor["refraction"], air, steady),
             "observability": observability(series),
             **({"star_identification": star_identification(series)} if "n_wrong" in series else {})}
 
@@ -166,20 +164,22 @@ def aberration(series, sky, orientation, q_BS_true, corrected, steady):
             "uncorrected_position_m": _position_cost(total_n, series, steady)}
 
 
-def refraction(series, sky, orientation, q_BS_true, keys, modelled, steady):
-    """The refraction of the true boresight by the real air [arcsec, mean and max over the steady frames], its
-    residual against the processing's model air at the true height, their position costs R·ΔZ [m] (module
-    docstring) and, when the filter carries it, its refraction consider state: the truth's ε_r and the filter's σ
-    (``considered``: {"fraction_true", "fraction_sigma"} of the last frame [-], else None); ``keys`` the scenario's
-    ``star_sensor.refraction`` table."""
+def refraction(series, sky, orientation, q_BS_true, keys, air, steady):
+    """The refraction of the true boresight by the real ``air`` (the run's: its pressure and temperature errors are
+    reported, drawn or given) [arcsec, mean and max over the steady frames], its residual against the processing's
+    model air at the true height, their position costs R·ΔZ [m] (module docstring) and, when the filter carries it, its
+    refraction consider state: the truth's ε_r and the filter's σ (``considered``: {"fraction_true",
+    "fraction_sigma"} of the last frame [-], else None); ``keys`` the scenario's ``star_sensor.refraction`` table."""
+    modelled = air.modelled()
     boresight = _boresight(sky, q_BS_true)
     at_rest = np.zeros_like(boresight)
     real = rot.to_rotation_vector(fix_rotation(boresight, at_rest, sky.air(slice(None))))
     a, b = modelled.coefficients(series["h_true"])
     model = rot.to_rotation_vector(fix_rotation(boresight, at_rest, (sky.up_I, a, b)))
     residual = real - model if keys["correction"] else real
-    return {"corrected": bool(keys["correction"]), "pressure_error_percent": keys["pressure_error_percent"],
-            "temperature_error_k": keys["temperature_error_k"], "total_arcsec": _arcsec(real, steady),
+    return {"corrected": bool(keys["correction"]), "drawn": bool(keys["drawn"]),
+            "pressure_error_percent": round(100.0 * air.pressure_error, 12), "temperature_error_k": air.temperature_error,
+            "total_arcsec": _arcsec(real, steady),
             "residual_arcsec": _arcsec(residual, steady),
             "residual_position_m": _position_cost(_in_navigation_axes(residual, series, orientation), series, steady),
             "uncorrected_position_m": _position_cost(_in_navigation_axes(real, series, orientation), series, steady),

@@ -175,8 +175,11 @@ def model(scenario, nominal, filt, gyro, accel, baro):
             drive = 2.0 * np.square(scale * np.asarray(gravity.sigma)) * inv_length
         else:
             m0[src["gravity"], g:g + 3] = scale * np.asarray(gravity.value)
-    if tl.base.refraction >= 0:  # the real air's refraction fraction, fixed (eq. 3 of navsim.earth.refraction)
-        m0[src["refraction"], tl.base.refraction] = build.refraction_fraction(scenario, nominal.h[0])
+    if tl.base.refraction >= 0:  # the real air's refraction fraction (eq. 3 of navsim.earth.refraction): its mean,
+        r = tl.base.refraction  # and its σ when each run draws the air
+        m0[src["refraction"], r] = build.refraction_fraction(scenario, nominal.h[0], build.real_air(scenario))
+        if scenario["star_sensor"]["refraction"]["drawn"]:
+            var("refraction", r, build.refraction_sigma(scenario, nominal.h[0]), 1)
     if tl.baro >= 0:
         var("aiding", tl.baro, baro.bias_sigma, 1)
         q[src["aiding"], tl.baro] = baro.bias_rw**2

@@ -219,7 +219,8 @@ def _refraction_text(refraction):
     corrected = "corrects it with the standard atmosphere at the INS's height" if refraction["corrected"] else "does not correct it"
     return (f"The air raises the boresight by {number(refraction['total_arcsec']['mean'])}\" on average (at most "
             f"{number(refraction['total_arcsec']['max'])}\"); the processing {corrected}. The real air departs from that "
-            f"model by {number(refraction['pressure_error_percent'])} % in pressure and {number(refraction['temperature_error_k'])} K, "
+            f"model by {number(refraction['pressure_error_percent'])} % in pressure and {number(refraction['temperature_error_k'])} K"
+            f"{' (drawn for this run from the stated σ)' if refraction.get('drawn') else ''}, "
             f"leaving {number(refraction['residual_arcsec']['mean'])}\" ({number(refraction['residual_position_m'])} m of "
             f"position); left uncorrected the refraction would cost {number(refraction['uncorrected_position_m'])} m."
             + _considered_text(refraction.get("considered")))

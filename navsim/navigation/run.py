@@ -34,7 +34,7 @@ from navsim.build.star_sensor import observers
 from navsim.closed_loop import FrameGrid, run_loop
 from navsim.earth.gravity import GravityDisturbance
 from navsim.earth.orientation import EarthOrientation
-from navsim.earth.wander import displaced
+from navsim.earth.wander import carried_ned, displaced
 from navsim.estimation.nav_filter import NavFilter
 from navsim.navigation import build, celestial, exclusion, sky_background
 from navsim.navigation.scenario import frame_rate
@@ -165,7 +165,7 @@ def simulate(prepared, seed, compiled=True):
     whatever ``prepared.truth_off`` switches off in the truth."""
     started = time.perf_counter()
     p, scenario, grid = prepared, prepared.scenario, prepared.grid
-    gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss, star_ss = np.random.SeedSequence(seed).spawn(7)
+    gyro_ss, accel_ss, init_ss, position_ss, baro_ss, gravity_ss, star_ss, air_ss = np.random.SeedSequence(seed).spawn(8)
     truth = p.truth if p.truth is not None else trajectory.with_gravity(p.kinematics, p.disturbance, gravity_ss)
     n = grid.n_frames * grid.ratio
     gyro_truth, accel_truth = truth_imu(p)
@@ -179,15 +179,15 @@ def simulate(prepared, seed, compiled=True):
     filt = NavFilter(*_start(truth, config.P0, init_ss, zero="initial" in p.truth_off, fixed=fixed), config)
     record = _aiding_record(p, truth, position_ss, baro_ss)
     sensor_run, loop_truth, jumps, sky, observer_runs = AidingRun(record), truth, None, None, []
+    air = None if p.star_sensor is None else build.real_air(scenario, p.truth_off, np.random.default_rng(air_ss))
     if p.star_sensor is not None:
-        sky = SkyTruth.of(truth, p.orientation, grid.frame_k, build.real_air(scenario, p.truth_off))
+        sky = SkyTruth.of(truth, p.orientation, grid.frame_k, air)
         stars, observer_runs, jumps = _star_run(p, sky, star_ss, filt)
         sensor_run, loop_truth = CelestialAidingRun(stars, sensor_run), sky
     log = run_loop(filt, sensor_run, np.hstack([gyro.omega, accel.force]), loop_truth, grid, jumps, observer_runs,
                    compiled)
     q_BS_true = p.star_sensor.q_BS_true if p.star_sensor is not None else None
-    refraction_true = None if p.star_sensor is None else build.refraction_fraction(scenario, truth.h[grid.frame_k],
-                                                                                    p.truth_off)
+    refraction_true = None if air is None else build.refraction_fraction(scenario, truth.h[grid.frame_k], air)
     series = navigation_series(truth, grid.frame_k, log.arrays, gyro, accel, filt.layout, q_BS_true, refraction_true)
     series["error_sigma_initial"] = np.sqrt(np.diag(config.P0))
     if p.star_sensor is not None:
@@ -202,7 +202,7 @@ def simulate(prepared, seed, compiled=True):
     summary = summarize(scenario, seed, series, grid)
     if p.star_sensor is not None:
         summary = summary.replace(celestial=celestial.summary(scenario, series, sky, p.orientation, q_BS_true,
-                                                              p.sky_geometry))
+                                                              p.sky_geometry, air))
     summary, timing = star_run.finish(summary, series, log, observer_runs, series["t"] >= scenario["settle_s"])
     summary = summary.replace(timing={"wall_seconds": round(time.perf_counter() - started, 4), **timing})
     return RunResult(summary=summary, series=series, scenario=scenario.data, sample_frame=sensor_run.sample,
@@ -259,14 +259,17 @@ def _stars_per_frame(stars, series):
 
 def _start(truth, P0, seed, zero=False, fixed=None):
     """(L, λ, h, v_n, q_nb) of the filter: the truth at t = 0 with an error x0 ~ N(0, P0) in attitude
-    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position, each part the scenario fixes
-    (``fixed``: :func:`fixed_initial_error`, NaN where drawn) taken instead of its draw (``zero``: x0 = 0)."""
+    (C_nb,est = (I − [φ×]) C_nb,true: q_est = q(−φ) ⊗ q_true), velocity and position in the truth's NED, each part
+    the scenario fixes (``fixed``: :func:`fixed_initial_error`, NaN where drawn) taken instead of its draw (``zero``:
+    x0 = 0); the attitude and velocity then carried to the NED of the displaced position
+    (:func:`navsim.earth.wander.carried_ned`: the meridians' convergence, any angle at a pole)."""
     x0 = np.linalg.cholesky(P0[:9, :9]) @ np.random.default_rng(seed).standard_normal(9) * (0.0 if zero else 1.0)
     if fixed is not None and not zero:
         x0 = np.where(np.isnan(fixed), x0, fixed)
-    q0 = rot.multiply(rot.from_rotation_vector(-x0[0:3]), truth.q_nb[0])
     lat, lon = displaced(truth.lat[0], truth.lon[0], truth.h[0], x0[6], x0[7])
-    return lat, lon, truth.h[0] + x0[8], truth.v_n[0] + x0[3:6], q0
+    C = carried_ned(truth.lat[0], truth.lon[0], lat, lon)
+    q0 = rot.multiply(rot.from_matrix(C), rot.multiply(rot.from_rotation_vector(-x0[0:3]), truth.q_nb[0]))
+    return float(lat), float(lon), truth.h[0] + x0[8], C @ (truth.v_n[0] + x0[3:6]), q0
 
 
 def fixed_initial_error(scenario):

@@ -36,7 +36,7 @@ from startrack import rotation as rot
 
 #: Bounds: speed [m/s] (below orbital speed), height [m] (the ellipsoid +/- ), a segments start's latitude [deg]
 #: (headings from north are singular at the poles: routes go there), a segment's duration [s].
-MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 7500.0, 1e5, 89.0, 2.6e6
+MAX_SPEED, MAX_HEIGHT, MAX_LATITUDE, MAX_DURATION = 7500.0, 1e5, 90.0, 2.6e6
 #: Samples of the flight on which the star sensor's boresight elevation is checked.
 ELEVATION_SAMPLES = 2000
 #: ... and of each segment, its ends included (a turn's bank, however short against the flight).
@@ -360,6 +360,9 @@ def _check_star_sensor(checked, source):
         raise InputError(f"{source}: star_sensor.refraction: pressure_sigma_percent and temperature_sigma_k are the "
                          "uncertainty of the air the processing corrects with; without the correction there is none "
                          "(set correction = true or the σ to 0)")
+    if refraction["drawn"] and not (refraction["pressure_sigma_percent"] or refraction["temperature_sigma_k"]):
+        raise InputError(f"{source}: star_sensor.refraction.drawn: each run's air is drawn from pressure_sigma_percent "
+                         "and temperature_sigma_k, which are both 0 (give the σ the processing states)")
     if sensor.get("image", {}).get("compare_without_stacking"):
         raise InputError(f"{source}: star_sensor.image.compare_without_stacking: the shadow filter of 004 §3 is the "
                          "attitude filter's; a navigation run compares the attitude solvers of the stacked frames only "

@@ -11,7 +11,7 @@ track it is that horizontal error resolved on the track's direction and its righ
 
 import numpy as np
 
-from navsim.earth.wander import ned_offset
+from navsim.earth.wander import carried_ned, ned_offset
 from navsim.estimation.consistency import nees, nees_statistics
 from navsim.estimation.nav_filter import error_state, mounting_error, state_names
 from navsim.navigation.records import RunSummary
@@ -74,8 +74,9 @@ def navigation_series(truth, frame_k, arrays, gyro, accel, layout, q_BS_true=Non
     if layout.mounting >= 0:
         parts.append(mounting_error(series["q_bs"], q_BS_true))
     series["gravity_disturbance_true"] = truth.gravity_disturbance[k]
-    if layout.gravity >= 0:  # consider states: the truth itself
-        parts.append(series["gravity_disturbance_true"])
+    if layout.gravity >= 0:  # consider states: the truth itself, carried from its NED to the estimate's (as the filter
+        C = carried_ned(truth.lat[k], truth.lon[k], series["lat"], series["lon"])  # shows them; any angle at a pole)
+        parts.append(np.einsum("...ij,...j->...i", C, series["gravity_disturbance_true"]))
     if layout.refraction >= 0:
         parts.append(np.asarray(refraction_true, dtype=float)[:, None])
     series["state_names"] = np.array(state_names(layout))

@@ -117,6 +117,9 @@ REFRACTION = Table(
                                             "(0 and 0: no state)"),
         "temperature_sigma_k": Value("float", default=0.0, minimum=0.0, maximum=60.0,
                                      doc="what the processing takes its model air's temperature error to be (1σ)"),
+        "drawn": Value("bool", default=False,
+                       doc="each run's real air departs from the errors above by a pressure and a temperature error "
+                           "drawn from pressure_sigma_percent and temperature_sigma_k (a campaign then checks that σ)"),
     },
     doc="atmospheric refraction of the stars and its correction",
 )

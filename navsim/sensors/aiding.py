@@ -5,8 +5,9 @@ it starts (:func:`draw_record`) into an :class:`AidingRecord` on the frame grid;
 frame by frame (:class:`AidingRun`, :class:`AidingFrame`), or the navigation filter takes the whole
 record at once on its compiled fast path. A frame without a measurement of a kind holds NaN there.
 
-- Position fix (GNSS-like): the true (L, λ, h) plus white NED noise of σ (σ_N, σ_E, σ_D) [m]:
-  L̃ = L + n_N/(R_M + h), λ̃ = λ + n_E/((R_N + h) cos L), h̃ = h − n_D.
+- Position fix (GNSS-like): the true (L, λ, h) plus white NED noise n of σ (σ_N, σ_E, σ_D) [m]: the point n_N, n_E
+  from the truth along its NED axes (:func:`navsim.earth.wander.displaced`: L̃ = L + n_N/(R_M + h),
+  λ̃ = λ + n_E/((R_N + h) cos L) to first order, and regular at the poles), h̃ = h − n_D.
 - Baro: :class:`navsim.sensors.baro.BaroModel` sampled at its rate (bias, random walk, noise, lag).
 """
 
@@ -14,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from navsim.earth.wgs84 import radii
+from navsim.earth.wander import displaced
 from navsim.sensors.recorded_run import RecordedRun
 
 
@@ -27,10 +28,8 @@ class PositionFixSensor:
 
     def measure(self, lat, lon, h, rng):
         """Fixes (K, 3) [rad, rad, m] of the true positions (K,) each: the truth plus NED noise."""
-        r_m, r_n = radii(lat)
         noise = self.sigma_ned * rng.standard_normal((np.size(lat), 3))
-        return np.stack([lat + noise[:, 0] / (r_m + h), lon + noise[:, 1] / ((r_n + h) * np.cos(lat)),
-                         h - noise[:, 2]], axis=-1)
+        return np.stack([*displaced(lat, lon, h, noise[:, 0], noise[:, 1]), h - noise[:, 2]], axis=-1)
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ Between two waypoints at height h the track is the geodesic of the parallel surf
 ellipsoid's geodesic to within h/R of its length and about an arcsecond of its azimuth (tested against Karney 2013).
 """
 
+import dataclasses
 import functools
 import json
 import math
@@ -38,6 +39,9 @@ MISS, STEP, ITERATIONS = 1e-3, 1.0, 30
 COINCIDENT, ANTIPODAL_DEG = 1e-7, 179.0
 #: Shortest straight part of a leg [s].
 MIN_STRAIGHT_S = 1.0
+#: Latitude [deg] from which a trajectory of segments is carried in the free-azimuth frame (the North frame's
+#: λ̇ = v_E/((R_N + h) cos L) is singular at the poles); the least meridian radius of curvature a(1 − e²) [m].
+POLAR_CAP_DEG, LEAST_MERIDIAN_RADIUS = 89.0, 6335439.327
 
 
 @dataclass(frozen=True)
@@ -208,7 +212,25 @@ def _profile(text, where):
         raise InputError(f"{where}.start: missing required key (or a [{where}.route])")
     if not table.get("segments"):
         raise InputError(f"{where}.segments: missing required key (at least one segment, or a [{where}.route])")
-    return segments.Profile.from_table({"start": table["start"], "segments": table["segments"]}, where)
+    profile = segments.Profile.from_table({"start": table["start"], "segments": table["segments"]}, where)
+    return profile if _clear_of_poles(profile) else dataclasses.replace(profile, frame=FreeAzimuth())
+
+
+def _clear_of_poles(profile):
+    """Whether a profile of segments in the North frame stays below :data:`POLAR_CAP_DEG` of latitude: at once when its
+    start lies farther from the cap than it can fly (the sum of each segment's duration times its greater speed),
+    else along its North track at :data:`STEP` (L̇ = v_N/(R_M + h) is regular at the poles; λ's value is not used)."""
+    lat0 = abs(profile.start.lat_deg)
+    ends = [seg.exit(entry).speed for seg, entry in zip(profile.segments, profile.entries)]
+    spans = np.diff(np.append(profile.starts, profile.duration))
+    reach = sum(t * max(entry.speed, end) for t, entry, end in zip(spans, profile.entries, ends))
+    if lat0 + math.degrees(reach / LEAST_MERIDIAN_RADIUS) < POLAR_CAP_DEG:
+        return True
+    if lat0 >= POLAR_CAP_DEG:
+        return False
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        lat = trajectory.track(profile, math.ceil(profile.duration / STEP) / profile.duration).lat
+    return bool(np.all(np.abs(np.degrees(lat)) < POLAR_CAP_DEG))
 
 
 def _route(table):

@@ -1,6 +1,8 @@
 """Atmospheric refraction (navsim.earth.refraction) against ERFA's observed places and against ray tracing, and
 what the truth's star sensor and the filter's processing do with it."""
 
+from pathlib import Path
+
 import erfa
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from startrack.base.units import ARCSEC
 from startrack.geometry import rotation as rot
 
 ZENITH = np.array([[0.0, 0.0, 1.0]])
+DAY = Path(__file__).resolve().parents[2] / "scenarios" / "sins_cns_aircraft_day.toml"
 
 
 def at_elevation(elevation):
@@ -214,3 +217,36 @@ def test_the_refraction_states_fix_column_against_the_fix_it_turns():
         turned = rot.multiply(rot.from_rotation_vector(-eps * rho), q_IS)
         z1 = fix_terms(nav, q_BS, q_ie, turned, np.eye(3) * 1e-10, lay, rho)[0]
         np.testing.assert_allclose(z1 - z0, H[:, lay.refraction] * eps, atol=1e-6 * eps * 20.0 * ARCSEC)
+
+
+def test_a_runs_air_is_drawn_from_the_stated_sigma():
+    """``star_sensor.refraction.drawn``: the real air of each run is the fixed errors plus draws of the processing's
+    stated σ (2000 runs' Generators: the mean within 4 standard errors, the σ within 4 of its own), so a campaign's
+    NEES checks that σ; the same seed the same air; without ``drawn`` the fixed air; none drawn with the refraction
+    switched off in the truth."""
+    from navsim.kinds import resolve_scenario
+    from navsim.navigation import build
+    from startrack import band
+
+    day = resolve_scenario(DAY)
+    drawn = resolve_scenario(DAY, ["star_sensor.refraction.drawn=true"])
+    wavelength = band(day["star_sensor"]["band"]).centre_um
+    airs = [build.real_air(drawn, (), np.random.default_rng(seed)) for seed in range(2000)]
+    pressure = np.array([a.pressure_error for a in airs])
+    temperature = np.array([a.temperature_error for a in airs])
+    n = pressure.size
+    assert abs(pressure.mean() - 0.02) < 4 * 0.03 / np.sqrt(n) and abs(pressure.std() / 0.03 - 1) < 4 / np.sqrt(2 * n)
+    assert abs(temperature.mean() + 3.0) < 4 * 5.0 / np.sqrt(n) and abs(temperature.std() / 5.0 - 1) < 4 / np.sqrt(2 * n)
+    assert build.real_air(drawn, (), np.random.default_rng(7)) == build.real_air(drawn, (), np.random.default_rng(7))
+    assert build.real_air(day, (), np.random.default_rng(7)) == Air(wavelength, 0.02, -3.0)
+    assert build.real_air(drawn, ("refraction",), np.random.default_rng(7)) == Air(wavelength)
+
+
+def test_drawing_the_air_needs_a_stated_sigma():
+    from navsim.kinds import resolve_scenario
+    from startrack import InputError
+
+    with pytest.raises(InputError, match="star_sensor.refraction.drawn"):
+        resolve_scenario(DAY, ["star_sensor.refraction.drawn=true",
+                                                                 "star_sensor.refraction.pressure_sigma_percent=0",
+                                                                 "star_sensor.refraction.temperature_sigma_k=0"])

@@ -123,10 +123,10 @@ def test_a_route_with_segments_is_refused(tmp_path, capsys):
     assert_one_clear_line(status, err, "not both", tmp_path / "out")
 
 
-def test_segments_still_start_below_89_deg(tmp_path, capsys):
-    """Headings from north are singular at the poles: a segments trajectory still starts at most at 89 deg (a route
-    goes further)."""
+def test_segments_start_at_most_at_a_pole(tmp_path, capsys):
+    """A segments trajectory starts anywhere up to a pole (near one it is carried in the free-azimuth frame:
+    tests/navsim/test_polar_segments.py); beyond 90 deg is one line naming the key."""
     out = tmp_path / "out"
-    status, err = run_cli(cli.main, ["run", BASES["navigation"], "--out", out, "--set", "trajectory.start.lat_deg=89.5"],
+    status, err = run_cli(cli.main, ["run", BASES["navigation"], "--out", out, "--set", "trajectory.start.lat_deg=90.5"],
                           capsys)
     assert_one_clear_line(status, err, "lat_deg", out)
