@@ -104,6 +104,7 @@ def star_profile(psf_sigma_px, trail_px, offset_px=(0.0, 0.0)):
     half = half_width(sigma, trail)
     su, sv = track_offsets(trail, sigma)
     track = np.stack([half + offset_px[0] + su, half + offset_px[1] + sv], axis=-1)[None]
+    # the source charge alone: expected_charge reads no property of the sensor (noise, gain, bias come later)
     return expected_charge(None, 2 * half + 1, 2 * half + 1, [Sources(track, [1.0], sigma)])
 
 
