@@ -51,6 +51,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.image.psf_fit": ("PixelNoise", "StarFits", "concatenate_fits", "fit_stars", "neighbour_reach"),
     "startrack.image.render": ("RenderedFrame", "SensorModel", "Sources", "Windows", "cosmic_ray", "expected_charge",
                                "render", "render_star_field"),
+    "startrack.image.trail_detection": ("detect_trailed", "detection_probability", "snr_map", "snr_threshold",
+                                        "trail_vector"),
     "startrack.image.sensor_photometry": ("SensorPhotometry",),
     "startrack.image.stacking": ("DimStarCache", "StackedStar", "stack"),
     "startrack.image.synthetic": ("SyntheticFrame", "centroid_frame", "random_attitude"),

@@ -170,7 +170,7 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes=()
                            stars_I=np.asarray(stars.vectors), stars_mag=np.asarray(stars.mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
                            stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true,
-                           faults=faults, photometry=budget)
+                           faults=faults, photometry=budget, detection=image["detection"])
 
 
 def _rendered_stars(star_catalog, image):

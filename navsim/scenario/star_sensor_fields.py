@@ -45,6 +45,10 @@ STAR_SENSOR = {
                                       doc="faintest star drawn into the frames"),
             "detection_sigmas": Value("float", default=5.0, exclusive_minimum=0.0, maximum=1e3,
                                       doc="a of V_th = b + a σ_n (eq. 4 of 004)"),
+            "detection": Value("str", default="threshold", choices=("threshold", "matched"),
+                               doc="full frames: threshold, 004's V_th on single pixels; matched, the matched filter "
+                                   "for the trail the predicted rate draws at the boresight (startrack.detect_trailed); "
+                                   "windows stay thresholded"),
             "centroid_sigma_px": Value("float", default=0.1, exclusive_minimum=0.0, maximum=100.0,
                                        doc="centroid error the identification assumes (its gates); the filter takes each star's covariance from its position fit"),
             "catalog_nd": Value("int", default=53, minimum=4, maximum=400,
