@@ -26,7 +26,8 @@ tropospheric part scattered into the line of sight is its own term.
   vicinity, never a night sky) take the nearest filled value of the same longitude. Other bands take its
   spectrum at 90° elongation in the ecliptic (Leinert Table 19: 2.6, 2.0, 1.3, 1.2, 0.81, 0.17 × 10⁻⁶ W m⁻²
   sr⁻¹ µm⁻¹ at 0.5, 0.7, 0.9, 1.0, 1.2, 2.2 µm), interpolated in log λ, log I, against the band's
-  zero-magnitude flux (:mod:`startrack.photometry.bands`): the reddened solar colour of their §8.
+  zero-magnitude flux (:mod:`startrack.photometry.bands`): the reddened solar colour of their §8. (The paper
+  itself was not readable here: Tables 17 and 19 are as public codes transcribe them alike, four and two copies.)
 - **Integrated starlight and diffuse Galactic light**: 30 S10(vis) at the Galactic poles, 160-640 on the
   Galactic equator (Roach & Gordon 1973, the integrated starlight of the stars fainter than the naked eye's
   V ≈ 6, as tabulated in Schlyter's "Radiometry and photometry in astronomy"); between them the csc |b| of
