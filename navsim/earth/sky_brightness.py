@@ -5,13 +5,16 @@ The model is Schaefer's (1993 §4; the program VISLIMIT.BAS of Schaefer 1998, li
 moonlight of Krisciunas & Schaefer (1991, "KS91"), both empirical fits at ground sites, carried to other
 bands and to the observer's height through the extinction components of :mod:`navsim.earth.atmosphere`:
 
-- **night** (airglow, zodiacal light, starlight): the band's dark zenith brightness above the atmosphere
-  μ0 at mean solar activity, brighter by (1 + 0.3 cos(2π (year − 1992)/11)) with the solar cycle, by the
-  van Rhijn factor 0.4 + 0.6 (1 − 0.96 sin²Z)^(−1/2) towards the horizon (60 % airglow in a thin shell),
-  extinguished along the line of sight (Schaefer 1998 lines 2140-2160). μ0(V) = 21.45 is Schaefer's
-  B0 = 1e-13 (his unit: 1.11e-15 per nL); R and I take the night sky's V − R = 0.74 and V − I = 1.90
-  measured at Paranal (Patat 2003, quoted in Patat et al. 2006 Fig. 8); J and H (the OH airglow) the
-  median moonless zenith of Calar Alto, J 15.95 and H 13.99 (Sánchez et al. 2008).
+- **night** (:mod:`navsim.earth.night_sky`): the sum of its sources, each with its own geometry -- the airglow
+  (a thin shell 90 km up: van Rhijn's factor from the observer's radius, the solar cycle 1 + 0.3 cos(2π (year −
+  1992)/11), V 150 S10 at sunspot minimum, 2.5 times the zodiacal light at the ecliptic pole as Benn & Ellison
+  1998 measured on La Palma), the zodiacal light (Leinert et al. 1998 Table 17 by helioecliptic longitude and
+  ecliptic latitude, their Table 19's colour), the integrated starlight and diffuse Galactic light (30 S10 at
+  the Galactic poles, csc |b| towards the plane; Roach & Gordon 1973) -- each extinguished along the line of
+  sight, plus the part of them the air above the observer scatters into it. R and I take the night sky's
+  V − R = 0.74 and V − I = 1.90 measured at Paranal (Patat 2003) for the sum at the poles, J and H the median
+  moonless zenith of Calar Alto, J 15.95 and H 13.99 (Sánchez et al. 2008, the OH airglow): ``night_zenith``
+  is the airglow's share, its zenith above the atmosphere at mean solar activity.
 - **moonlight** (KS91 eq. 15-21): B = f(ρ) I* 10^(−0.4 k X_m) [1 − 10^(−0.4 k X)] [nL] with
   f(ρ) = 10^5.36 (1.06 + cos²ρ) + 10^(6.15 − ρ/40) (ρ in degrees; 6.2e7 ρ⁻² instead of the second term
   below 10°), I* = 10^(−0.4 (m + 16.57)) the Moon's illuminance of magnitude m = −12.73 + 0.026 |α| +
@@ -46,10 +49,12 @@ horizon brightening Z/(360 k) takes the band's k at sea level (the term is a pro
 not of the observer's thinning air, where it would grow without bound).
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.earth import night_sky
 from navsim.earth.atmosphere import extinction
 from startrack import InputError
 from startrack import band as photometric_band
@@ -70,7 +75,8 @@ AU_MODULUS = 5.0 * np.log10(1.495978707e11 / 3.0856775814913673e17)
 @dataclass(frozen=True)
 class SkyBand:
     """What the sky model needs of a band: its name, the Sun's Vega absolute magnitude in it, the Moon's
-    reddening against the Sun [mag] and the moonless zenith sky above the atmosphere [mag arcsec⁻²]."""
+    reddening against the Sun [mag] and the airglow's zenith above the atmosphere at mean solar activity
+    [mag arcsec⁻²] (the night sky's other sources: :mod:`navsim.earth.night_sky`)."""
 
     name: str
     sun_absolute: float
@@ -89,15 +95,30 @@ class SkyBand:
         return v - (SKY_BANDS["V"].sun_absolute - self.sun_absolute) - self.moon_reddening
 
 
-#: Schaefer's night zenith in V, and R, I from Patat's V − R, V − I.
-_NIGHT_V = 21.45
+def _airglow_zeniths(bands):
+    """The airglow's zenith above the atmosphere at mean solar activity [mag arcsec⁻²] of each of ``bands`` (module
+    docstring): V from Benn & Ellison's 2.5 × the zodiacal light at the ecliptic pole at sunspot minimum; R, I what
+    Patat's colours of the moonless sky at the ecliptic and Galactic poles leave once the zodiacal light and
+    starlight are taken out; J, H the same of Calar Alto's medians."""
+    pole = 0.5 * np.pi
+    other = {name: night_sky.zodiacal_flux(name, np.pi, pole)
+             + night_sky.starlight_flux(bands["V"].sun_absolute - b.sun_absolute, pole) for name, b in bands.items()}
+    v = night_sky.AIRGLOW_TO_ZODIACAL_AT_MINIMUM * night_sky.zodiacal_flux("V", np.pi, pole) / (1.0 - night_sky.CYCLE_AMPLITUDE)
+    dark_v = night_sky.magnitude(v + other["V"])
+    totals = {"R": dark_v - 0.74, "I": dark_v - 1.90, "J": 15.95, "H": 13.99}
+    return {"V": float(night_sky.magnitude(v)),
+            **{name: float(night_sky.magnitude(night_sky.flux(mu) - other[name])) for name, mu in totals.items()}}
+
+
+#: The Sun's and the Moon's colours; the airglow's zenith (its last field) from :func:`_airglow_zeniths`.
 SKY_BANDS = {
-    "V": SkyBand("V", 4.81, 0.0, _NIGHT_V),
-    "R": SkyBand("R", 4.41, 0.146, _NIGHT_V - 0.74),
-    "I": SkyBand("I", 4.10, 0.299, _NIGHT_V - 1.90),
-    "J": SkyBand("J", 3.67, 0.561, 15.95),
-    "H": SkyBand("H", 3.34, 0.817, 13.99),
+    "V": SkyBand("V", 4.81, 0.0, np.nan),
+    "R": SkyBand("R", 4.41, 0.146, np.nan),
+    "I": SkyBand("I", 4.10, 0.299, np.nan),
+    "J": SkyBand("J", 3.67, 0.561, np.nan),
+    "H": SkyBand("H", 3.34, 0.817, np.nan),
 }
+SKY_BANDS = {name: dataclasses.replace(SKY_BANDS[name], night_zenith=mu) for name, mu in _airglow_zeniths(SKY_BANDS).items()}
 
 
 def sky_band(name):
@@ -112,7 +133,9 @@ def sky_band(name):
 class Sightline:
     """Where the sky is looked at, per frame (arrays broadcast together), angles in radians: the line of sight's
     zenith distance, the Sun's zenith distance and angle from it, the Moon's zenith distance, angle from it and
-    phase angle; the observer's height [m] and the date as a Julian year (the solar cycle)."""
+    phase angle; the observer's height [m] and the date as a Julian year (the solar cycle); the line of sight's
+    helioecliptic longitude λ − λ⊙, ecliptic latitude and Galactic latitude (the zodiacal light and starlight; by
+    default the ecliptic and Galactic poles, the darkest sky)."""
 
     zenith: np.ndarray
     sun_zenith: np.ndarray
@@ -122,16 +145,25 @@ class Sightline:
     moon_phase_angle: np.ndarray
     height: np.ndarray
     year: np.ndarray
+    helioecliptic_longitude: np.ndarray = np.pi
+    ecliptic_latitude: np.ndarray = 0.5 * np.pi
+    galactic_latitude: np.ndarray = 0.5 * np.pi
 
 
 @dataclass(frozen=True)
 class SkyBrightness:
-    """The sky's components and total [mag arcsec⁻²] (inf: none of that light)."""
+    """The sky's components and total [mag arcsec⁻²] (inf: none of that light); ``night`` is the sum of the night
+    sky's sources, each given too (:class:`navsim.earth.night_sky.NightSources`: airglow, zodiacal light,
+    starlight with the diffuse Galactic light, and the air's scattering of them)."""
 
     night: np.ndarray
     moon: np.ndarray
     day: np.ndarray
     twilight: np.ndarray
+    airglow: np.ndarray = np.inf
+    zodiacal: np.ndarray = np.inf
+    starlight: np.ndarray = np.inf
+    scattered: np.ndarray = np.inf
 
     @property
     def total(self):
@@ -170,12 +202,13 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
     k_sea = extinction(band, 0.0, **site).total
     twilight = (sky.sun_mag + TWILIGHT_ZERO - sun_elevation - np.degrees(g.zenith) / (360.0 * k_sea)
                 - 2.5 * np.log10(100.0 / rho_s * path * upper))
-    cycle = 1.0 + 0.3 * np.cos(2.0 * np.pi * (g.year - 1992.0) / 11.0)
-    van_rhijn = 0.4 + 0.6 / np.sqrt(1.0 - 0.96 * np.sin(g.zenith) ** 2)
-    night = sky.night_zenith - 2.5 * np.log10(cycle * van_rhijn) + air.along(g.zenith)
+    sources = night_sky.night_sources(band_name, sky.night_zenith, SKY_BANDS["V"].sun_absolute - sky.sun_absolute, g, air)
+    night = sources.total
     moon = np.where(moon_up, NL_ZERO - 2.5 * np.log10(np.maximum(moon_nl, 1e-300)), np.inf)
     return SkyBrightness(night=np.asarray(night, dtype=float), moon=np.asarray(moon, dtype=float),
-                         day=np.asarray(day, dtype=float), twilight=np.asarray(twilight, dtype=float))
+                         day=np.asarray(day, dtype=float), twilight=np.asarray(twilight, dtype=float),
+                         airglow=sources.airglow, zodiacal=sources.zodiacal, starlight=sources.starlight,
+                         scattered=sources.scattered)
 
 
 def _scattering_function(rho_deg):

@@ -3,7 +3,8 @@
 Along the nominal trajectory the covariance analysis samples (:func:`navsim.navigation.covariance.nominal`),
 per frame: the Sun's and the Moon's geometry and the exclusions (:mod:`navsim.navigation.exclusion`), with a
 light budget the sky's brightness and the limiting magnitude at the boresight
-(:mod:`navsim.navigation.sky_background`), and the stars the sensor reports (its vector-fidelity equivalent,
+(:mod:`navsim.navigation.sky_background`) with the sky's sources there (airglow, zodiacal light, starlight and
+diffuse Galactic light, the air's scattering of them, the Moon, the Sun), and the stars the sensor reports (its vector-fidelity equivalent,
 :func:`navsim.build.star_sensor.vector_equivalent`, noise-free) with their median σ. The same frames and stars
 a run and the covariance analysis take: the sky is decided before any filter runs.
 """
@@ -60,7 +61,33 @@ def star_availability(scenario, star_catalog=None):
     series |= {"stars": counts, "star_sigma_arcsec": units.rad_to_arcsec(sigma)}
     if getattr(sensor, "sky", None) is not None:
         series |= sensor.sky.series()
+        sources, _ = sky_background.sky_sources(scenario, geometry, nom.trajectory, nom.frame_k, sensor.photometry.band)
+        series |= source_series(sources)
     return Availability(series=series, summary=_summary(scenario, series, geometry, interval, note))
+
+
+#: The sky's sources at the boresight: (series key, name printed, SkyBrightness field or fields).
+SOURCES = (("sky_airglow_mag", "airglow", "airglow"), ("sky_zodiacal_mag", "zodiacal", "zodiacal"),
+           ("sky_starlight_mag", "starlight/DGL", "starlight"), ("sky_scattered_mag", "scattered", "scattered"),
+           ("sky_moon_mag", "moon", "moon"), ("sky_sun_mag", "twilight/day", "sun"))
+
+
+def source_series(sky):
+    """The series of the sky's sources at the boresight [mag arcsec⁻², inf: none] of a
+    :class:`~navsim.earth.sky_brightness.SkyBrightness` (the Sun's: the brighter of twilight and daylight)."""
+    sun = np.maximum(sky.day, sky.twilight)  # the lesser light of the two (Schaefer 1998 line 2380)
+    return {key: np.asarray(sun if name == "sun" else getattr(sky, name), dtype=float) for key, _, name in SOURCES}
+
+
+def _sources_summary(series):
+    """{name: median [mag arcsec⁻²] of the frames where that light is (None: never)} and the fraction of those
+    frames, for each source at the boresight and the total."""
+    out = {}
+    for key, name, _ in SOURCES + (("sky_background_mag", "total", None),):
+        values = np.asarray(series[key], dtype=float)
+        lit = np.isfinite(values)
+        out[name] = {"median_mag": float(np.median(values[lit])) if lit.any() else None, "fraction": float(lit.mean())}
+    return out
 
 
 def _summary(scenario, series, geometry, interval, note):
@@ -83,7 +110,16 @@ def _summary(scenario, series, geometry, interval, note):
             "hours": float(stars.size * interval / units.HOUR), "hours_with_stars": float(seen.sum() * interval / units.HOUR),
             "fraction_with_stars": float(seen.mean()) if stars.size else 0.0,
             "stars_per_frame": {"mean": float(stars.mean()), "median": float(np.median(stars)), "max": int(stars.max(initial=0))},
-            "frames_excluded": geometry.counts(), "hourly": hourly, "notes": [note] if note else []}
+            "frames_excluded": geometry.counts(), "hourly": hourly, "notes": [note] if note else [],
+            "sky_sources": _sources_summary(series) if "sky_airglow_mag" in series else None}
+
+
+def _source_text(name, entry):
+    """'name 21.95' (fainter than 30: '>30'; 'none' if never there), with the share of frames when not all."""
+    mu = entry["median_mag"]
+    text = "none" if mu is None else (">30" if mu > 30.0 else f"{mu:.2f}")
+    share = "" if mu is None or entry["fraction"] == 1.0 else f" ({100 * entry['fraction']:.0f} % of frames)"
+    return f"{name} {text}{share}"
 
 
 def _mean_deg(angles):
@@ -108,6 +144,9 @@ def availability_lines(summary):
     excluded = ", ".join(f"{count} {reason}" for reason, count in summary["frames_excluded"].items() if count)
     if excluded:
         lines.append(f"excluded frames     {excluded}")
+    if summary.get("sky_sources"):
+        lines.append("sky sources         median at the boresight [mag/arcsec²]: " + ", ".join(
+            _source_text(name, entry) for name, entry in summary["sky_sources"].items()))
     lines.append("hour  Sun el  Moon el  boresight el  sky mag/arcsec²  limiting mag  stars/frame  with stars")
     for row in summary["hourly"]:
         sky = "" if row["sky_mag"] is None else f"{row['sky_mag']:.2f}"

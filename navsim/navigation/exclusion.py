@@ -28,7 +28,8 @@ class SkyGeometry:
     """Per frame: the angles [rad] of the Sun and the Moon from the boresight, the boresight's elevation,
     the Sun's and the Moon's elevations [rad], the Moon's phase angle [rad] and illuminated fraction, the
     local vertical (F, 3) in ICRS axes, and the reason each frame is excluded (an index of :data:`REASONS`,
-    −1: not excluded)."""
+    −1: not excluded); the boresight's and the Sun's unit directions (F, 3) in ICRS axes (the zodiacal light's and
+    the starlight's geometry; None: not known)."""
 
     sun_angle: np.ndarray
     moon_angle: np.ndarray
@@ -39,6 +40,8 @@ class SkyGeometry:
     moon_illuminated: np.ndarray
     up_I: np.ndarray
     reason: np.ndarray
+    boresight_I: np.ndarray | None = None
+    sun_I: np.ndarray | None = None
 
     def counts(self):
         """{reason: frames it excludes} of every reason."""
@@ -63,7 +66,7 @@ def geometry(scenario, path, orientation, frame_k, q_BS_true):
     return SkyGeometry(sun_angle=sun, moon_angle=moon, boresight_elevation=elevation,
                        sun_elevation=bodies.elevation(bodies.sun_I), moon_elevation=bodies.elevation(bodies.moon_I),
                        moon_phase_angle=bodies.moon_phase_angle, moon_illuminated=bodies.moon_illuminated,
-                       up_I=bodies.up_I, reason=reason)
+                       up_I=bodies.up_I, reason=reason, boresight_I=boresight, sun_I=bodies.sun_I)
 
 
 def excluding(star_sensor, sky, t_frames):
