@@ -1,14 +1,15 @@
 """The sky a physical star sensor of a navigation run sees at its frames (:class:`navsim.sensors.frame_sky.FrameSky`):
 the sky's brightness in the sensor's band at the boresight (:mod:`navsim.earth.sky_brightness`) from the frames'
 Sun, Moon and boresight geometry (:mod:`navsim.navigation.exclusion`) and the observer's height, the extinction of
-the air above the observer (:mod:`navsim.earth.atmosphere`) and the trail of a star near the boresight from the
+the air above the observer (:mod:`navsim.earth.atmosphere`; the site's humidity, temperature and aerosol from
+``star_sensor.photometry``: visibility or optical depth, Ångström exponent) and the trail of a star near the boresight from the
 body rate, for the nominal trajectory (seed-free, like the exclusions)."""
 
 import dataclasses
 
 import numpy as np
 
-from navsim.earth.atmosphere import extinction
+from navsim.earth.atmosphere import Aerosol, extinction
 from navsim.earth.frames import julian_year
 from navsim.earth.sky_brightness import Sightline, sky_brightness
 from navsim.sensors.frame_sky import FrameSky
@@ -28,7 +29,9 @@ def frame_sky(scenario, geometry, path, frame_k, photometry, q_BS_true):
                       sun_angle=geometry.sun_angle, moon_zenith=0.5 * np.pi - geometry.moon_elevation,
                       moon_angle=geometry.moon_angle, moon_phase_angle=geometry.moon_phase_angle, height=h,
                       year=julian_year(scenario["epoch_utc"]) + path.t[frame_k] / JULIAN_YEAR_S)
-    ground = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"]}
+    aerosol = Aerosol.of_site(site["visibility_km"], site["aerosol_optical_depth"], site["angstrom_exponent"])
+    ground = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"],
+              "aerosol": aerosol}
     extinguishing = extinction(photometry.band, h, **ground)
     background = sky_brightness(photometry.band.name, sight, **ground, air=extinguishing).total
     omega_S = rot.rotate(rot.conjugate(q_BS_true), path.dtheta[frame_k - 1] * path.rate_hz)
