@@ -68,7 +68,8 @@ def test_the_ground_sky_in_four_bands_against_gou_2023():
     angle, are not readable here): the geometry is the issue's, the day flight at the ground (Sun 33° up, the boresight
     50° up, 80° from the Sun) with the default air (38 km visibility, τ_550 = 0.137, α = 1.3; its zenith transmittance
     0.81 in R and 0.88 in I beside Gou's 0.82 and 0.90). Each band within 0.5 mag and R − H within 0.3 mag (issue 53;
-    measured: R −0.42, I −0.28, J −0.12, H −0.38, R − H −1.92 against −1.88; before: R −0.54, R − H −2.28)."""
+    measured: R −0.39, I −0.24, J −0.01, H −0.25, R − H −2.02 against −1.88; before: R −0.53, I −0.27, J −0.09,
+    H −0.05, R − H −2.36)."""
     model = {name: _ground_sky(name, "silicon_cmos" if name in "RI" else "ingaas_swir") for name in GOU_2023}
     gou = {name: float(surface_brightness(name, radiance)) for name, radiance in GOU_2023.items()}
     for name in GOU_2023:
