@@ -161,3 +161,22 @@ def test_alexander_1999_limiting_magnitude_with_the_exposure_bracketed():
     m = alexander.limiting_magnitudes([sky, sky + 0.4], (0.05, 0.2))
     assert (m[1, 0] - m[0, 0]) / np.log10(4.0) == pytest.approx(1.25, abs=0.05)
     assert (m[0, 1] - m[0, 0]) / 0.4 == pytest.approx(0.5, abs=0.02)
+
+
+def test_the_balloon_scenario_is_the_studys_camera_on_navsim_skys_sky():
+    """scenarios/balloon_day_alexander1999.toml (35 km, the Sun 30° from the zenith at noon, the boresight 50° up to the
+    north, R_C, 0.3 s): ``navsim sky``'s boresight sky and limiting magnitude are the study's for the same geometry
+    and band within 0.05 mag (the scenario's Sun is 29.8-30.2° from the zenith over the minute)."""
+    from pathlib import Path
+
+    from navsim.kinds import resolve_scenario
+    from navsim.navigation.availability import star_availability
+    from startrack.photometry.bands import BANDS
+
+    alexander = _alexander()
+    balloon = Path(__file__).parents[2] / "scenarios" / "balloon_day_alexander1999.toml"
+    series = star_availability(resolve_scenario(str(balloon), ["duration_s=60.0"])).series
+    sky = float(alexander.model_skies([50.0])[0])
+    assert float(np.median(series["sky_background_mag"])) == pytest.approx(sky, abs=0.05)
+    limit = float(alexander.limiting_magnitudes([sky], (0.3,), BANDS["R"])[0, 0])
+    assert float(np.median(series["limiting_mag"])) == pytest.approx(limit, abs=0.05)
