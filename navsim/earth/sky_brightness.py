@@ -170,7 +170,7 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
     band = photometric_band(band_name)
     site = {"relative_humidity": relative_humidity, "temperature_c": temperature_c, "aerosol": aerosol}
     air = extinction(band, g.height, **site) if air is None else air
-    ref = extinction(photometric_band("V"), KS91_HEIGHT, **site)
+    ref = extinction(photometric_band("V"), KS91_HEIGHT)  # KS91's site in its own air (Schaefer's 40 %, 15 °C)
     K = air.total
     ref_rayleigh = float(ref.rayleigh)
     ref_aerosol = KS91_EXTINCTION - ref_rayleigh - float(ref.ozone + ref.water)  # the part of KS91's k that scatters
