@@ -10,12 +10,24 @@ exponential goes on.
 Schaefer (1998, VISLIMIT.BAS lines 1150-1200; Schaefer 1993 §3) with their heights made physical:
 
     k_R = 0.1066 (λ/0.55 µm)⁻⁴ p(h)/p0                              Rayleigh, ∝ the air above (1)
-    k_A = 0.1 (λ/0.55 µm)⁻¹·³ e^(−h/1500 m) (1 − 0.32/ln RH)^1.33     boundary-layer aerosol   (2)
+    k_A = 1.086 τ_550 (λ/0.55 µm)^(−α) e^(−h/H_a)                    boundary-layer aerosol   (2)
     k_S = 1.086 τ_S (λ/0.55 µm)⁻¹·³ s(h)                             stratospheric aerosol    (3)
     k_O = OZ(band) o(h),  k_W = WT(band) 0.94 RH e^(T/15 °C) e^(−h/2000 m)   ozone and water vapour (4)
 
 Schaefer's Rayleigh term falls as e^(−h/8200 m); (1) takes the pressure itself (at 12 km e^(−h/8200)
-overstates the air above by 20 %). His seasonal aerosol factor is left out (no date/latitude climate).
+overstates the air above by 20 %).
+
+**The boundary-layer aerosol** (2) is a stated model in place of Schaefer's humidity fit: an optical depth
+τ_a(λ) = τ_550 (λ/0.55 µm)^(−α) (Ångström 1929; α = 1.3 his continental mean, the default) in an exponential layer
+of scale height H_a = 1.5 km, so k_A = 2.5 log10(e) τ_a = 1.086 τ_a of the air above the observer. τ_550 is given
+(:class:`Aerosol`) or follows from the ground's visibility V by Koschmieder's law (β_ext V = −ln 0.02 = 3.912 for
+the 2 % contrast threshold; Middleton 1952): the aerosol's extinction coefficient at the ground is the total
+3.912/V less the molecules' β_R = τ_R(550)/H_R (0.0116 km⁻¹ at sea level), and τ_550 = (3.912/V − β_R) H_a
+(:meth:`Aerosol.from_visibility`; none for V ≥ 336 km, the molecules' own visibility). The default, V = 38 km,
+is τ_550 = 0.137: Schaefer's 0.1 (1 − 0.32/ln RH)^1.33 at his 40 % humidity, the model's earlier aerosol, so
+the default air is unchanged; 23 km (MODTRAN's "clear") gives τ_550 = 0.24, 5 km (haze) 1.16. The humidity now
+sets only the water vapour (the visibility carries the aerosol's swelling). Schaefer's seasonal aerosol factor
+is left out (no date/latitude climate).
 (3) is the volcanically quiet stratosphere's background aerosol, τ_S = 0.005 at 550 nm (SAGE II's 525 nm
 optical depth rose from about 0.004 to 0.008 over 2000-2010: Vernier et al. 2011), spread evenly between the
 tropopause (12 km) and 30 km (s(h) the fraction above h): nothing next to the boundary layer on the ground,
@@ -46,6 +58,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erfcx
 
+from startrack import InputError
+
 #: The Earth's mean radius [m] for the atmosphere's curvature (the ellipsoid's flattening is below its accuracy).
 EARTH_RADIUS = 6371000.0
 #: COESA 1976: g0 M / R* [K/m], the radius r0 of the geopotential height [m].
@@ -62,6 +76,15 @@ AEROSOL_SCALE_HEIGHT = 1500.0
 WATER_SCALE_HEIGHT = 2000.0
 OZONE_SHELL_HEIGHT = 22000.0
 STRATOSPHERIC_AEROSOL_SHELL_HEIGHT = 20000.0
+#: Koschmieder's constant −ln 0.02: the visibility V [m] of a black target in air of extinction coefficient β [1/m]
+#: is 3.912/β; the default visibility [km] (τ_550 = 0.137, Schaefer's aerosol at 40 % humidity) and Ångström exponent.
+KOSCHMIEDER = 3.912
+DEFAULT_VISIBILITY_KM = 38.0
+DEFAULT_ANGSTROM_EXPONENT = 1.3
+#: k [mag] = MAG_PER_OPTICAL_DEPTH τ: 2.5 log10(e).
+MAG_PER_OPTICAL_DEPTH = 2.5 * np.log10(np.e)
+#: Schaefer's sea-level Rayleigh extinction at 0.55 µm [mag per airmass] (VISLIMIT.BAS line 1160).
+RAYLEIGH_550 = 0.1066
 #: Background stratospheric aerosol optical depth at 550 nm and the layer it fills [m].
 STRATOSPHERIC_AEROSOL_DEPTH = 0.005
 STRATOSPHERIC_AEROSOL_LAYER = (12000.0, 30000.0)
@@ -136,21 +159,59 @@ class Extinction:
         return np.where(meets_ground(h, z), np.inf, total)
 
 
-def extinction(band, h, relative_humidity=0.4, temperature_c=15.0):
+@dataclass(frozen=True)
+class Aerosol:
+    """The boundary-layer aerosol (module docstring, eq. 2): optical depth at 550 nm from sea level and Ångström
+    exponent α of τ_a(λ) = τ_550 (λ/0.55 µm)^(−α)."""
+
+    optical_depth_550: float = 0.0
+    angstrom_exponent: float = DEFAULT_ANGSTROM_EXPONENT
+
+    def __post_init__(self):
+        if not np.isfinite(self.optical_depth_550) or self.optical_depth_550 < 0.0:
+            raise InputError(f"aerosol optical depth {self.optical_depth_550!r}: must be 0 or more")
+        if not np.isfinite(self.angstrom_exponent):
+            raise InputError(f"Ångström exponent {self.angstrom_exponent!r}: must be a finite number")
+
+    @classmethod
+    def from_visibility(cls, visibility_km=DEFAULT_VISIBILITY_KM, angstrom_exponent=DEFAULT_ANGSTROM_EXPONENT):
+        """The aerosol of a ground visibility [km] by Koschmieder's law: τ_550 = (3.912/V − β_R) H_a with β_R the
+        molecules' extinction coefficient at 550 nm at sea level (module docstring)."""
+        if not np.isfinite(visibility_km) or visibility_km <= 0.0:
+            raise InputError(f"visibility {visibility_km!r} km: must be more than 0")
+        beta_rayleigh = RAYLEIGH_550 / MAG_PER_OPTICAL_DEPTH / float(pressure_scale_height(0.0))
+        beta_aerosol = max(KOSCHMIEDER / (1000.0 * visibility_km) - beta_rayleigh, 0.0)
+        return cls(beta_aerosol * AEROSOL_SCALE_HEIGHT, angstrom_exponent)
+
+    @classmethod
+    def of_site(cls, visibility_km=DEFAULT_VISIBILITY_KM, optical_depth_550=None,
+                angstrom_exponent=DEFAULT_ANGSTROM_EXPONENT):
+        """The aerosol of a site: its optical depth where given, else its visibility's."""
+        if optical_depth_550 is None:
+            return cls.from_visibility(visibility_km, angstrom_exponent)
+        return cls(float(optical_depth_550), angstrom_exponent)
+
+    def optical_depth(self, wavelength_um):
+        """τ_a(λ) = τ_550 (λ/0.55 µm)^(−α) of the whole layer (Ångström's law)."""
+        return self.optical_depth_550 * (np.asarray(wavelength_um, dtype=float) / 0.55) ** -self.angstrom_exponent
+
+
+def extinction(band, h, relative_humidity=0.4, temperature_c=15.0, aerosol=None):
     """The :class:`Extinction` of ``band`` (a :class:`startrack.photometry.bands.Band`) for observers at heights ``h``
-    [m], the ground air's relative humidity (0-1) and temperature [°C] (Schaefer's defaults 40 %, 15 °C)."""
+    [m], the ground air's relative humidity (0-1) and temperature [°C] (Schaefer's defaults 40 %, 15 °C; they set
+    the water vapour) and its :class:`Aerosol` (default: the visibility of 38 km)."""
     h = np.asarray(h, dtype=float)
+    aerosol = Aerosol.from_visibility() if aerosol is None else aerosol
     x = band.centre_um / 0.55
     _, p = temperature_pressure(h)
-    humidity = (1.0 - 0.32 / np.log(relative_humidity)) ** 1.33
     low, high = STRATOSPHERIC_AEROSOL_LAYER
     strat_above = np.clip((high - h) / (high - low), 0.0, 1.0)
     ozone_above = np.clip((40000.0 - h) / 30000.0, 0.0, 1.0)
     water = _INFRARED_WATER.get(band.name, np.interp(band.centre_um, _SCHAEFER_CENTRES, _SCHAEFER_WATER))
     return Extinction(
         h=h,
-        rayleigh=0.1066 * x**-4 * p / SEA_LEVEL_PRESSURE,
-        aerosol=0.1 * x**-1.3 * np.exp(-h / AEROSOL_SCALE_HEIGHT) * humidity,
+        rayleigh=RAYLEIGH_550 * x**-4 * p / SEA_LEVEL_PRESSURE,
+        aerosol=MAG_PER_OPTICAL_DEPTH * aerosol.optical_depth(band.centre_um) * np.exp(-h / AEROSOL_SCALE_HEIGHT),
         stratospheric=1.086 * STRATOSPHERIC_AEROSOL_DEPTH * x**-1.3 * strat_above,
         ozone=np.interp(band.centre_um, _SCHAEFER_CENTRES, _SCHAEFER_OZONE) * ozone_above,
         water=water * 0.94 * relative_humidity * np.exp(temperature_c / 15.0) * np.exp(-h / WATER_SCALE_HEIGHT),

@@ -23,7 +23,8 @@ bands and to the observer's height through the extinction components of :mod:`na
   horizon.
 - **daylight** (Schaefer 1998 lines 2310-2360): the same scattering with the Sun's magnitude and his
   constant (43.27, 0.36 mag fainter than KS91's), plus a multiply scattered term 440 000 (1 − C) that
-  takes over as the Sun's own transmission C = 10^(−0.4 k X_s) falls.
+  takes over as the Sun's transmission C = 10^(−0.4 k X_s) falls: here (below) C of the light that feeds the
+  diffuse sky, k_tr = k_R + (1 − g)(k_A + k_S), and the term scaled by k_tr against KS91's site.
 - **twilight** (lines 2270-2290): 10^(−0.4 (m_sun + 32.5 − h_s − Z/(360 k))) (100/ρ_s) [1 − 10^(−0.4 k X)]
   with h_s the Sun's elevation and ρ_s its angle from the line of sight [deg]; the sky takes the lesser of
   daylight and twilight (line 2380), plus the night sky and the moonlight.
@@ -32,21 +33,33 @@ bands and to the observer's height through the extinction components of :mod:`na
 term is molecular (Rayleigh) scattering, its second the aerosols'. Single scattering is proportional to
 each scatterer's extinction, so the model scales the two terms by the band's and the height's Rayleigh
 k_R and aerosol k_A + k_S against their values at KS91's site (k_R = 0.0785 by eq. 1 of the atmosphere
-module, the rest of 0.172 taken as aerosol), and the path factor [1 − 10^(−0.4 K X)] by k_KS91/K with K
-the band's total extinction at the observer (eq. G):
+module; k_M = 0.0547, the rest of 0.172 less the ozone's 0.031 and the water vapour's 0.008 that absorb
+there), and the path factor [1 − 10^(−0.4 K X)] by k_KS91/K with K the band's total extinction at the
+observer (eq. G):
 
     f(ρ) → f_R(ρ) k_R/k_R,KS91 + f_M(ρ) (k_A + k_S)/k_M,KS91,   [1 − 10^(−0.4KX)] → [1 − 10^(−0.4KX)] k_KS91/K
 
-which is KS91 itself at KS91's site and band. The multiple-scattering and twilight terms (molecules and the
-stratosphere's aerosols above the boundary layer) scale by (k_R + k_S) against KS91's. So the sky darkens
-with height as the air above the observer thins (the daylight sky at 12 km: a fifth of the sea level's
-molecular scattering and almost none of the boundary layer's aerosol), and with wavelength as λ⁻⁴ and
-λ⁻¹·³. The Sun's and the Moon's band magnitudes take the Sun's colours (the Vega absolute magnitudes of
+which is KS91 itself at KS91's site and band. The multiply scattered daylight is the light scattered out of
+the Sun's beam into the diffuse sky, then into the line of sight: by van de Hulst's similarity (the transport
+optical depth (1 − g) τ; Joseph, Wiscombe & Weinman 1976's δ-scaling) the aerosols' forward peak stays in the
+beam (it is the aureole of f_M), absorption feeds nothing, and both steps take k_tr = k_R + (1 − g)(k_A + k_S)
+with g = 0.7, the asymmetry parameter of continental aerosol at 550 nm (OPAC's continental polluted mix, 0.698:
+Hess, Koepke & Schult 1998):
+
+    440 000 (1 − C) → 440 000 (1 − 10^(−0.4 k_tr X_s)) k_tr/k_tr,KS91
+
+(until issue 53 the term took the band's total k, water and ozone included, times the molecules' k_R: its λ⁻⁸
+made the ground sky 0.5 mag too blue in R − H against Gou et al. 2023; now 0.14). The twilight term scales by
+(k_R + k_S) against KS91's. So the sky darkens with height as the air above the observer thins (the daylight
+sky at 12 km: a fifth of the sea level's molecular scattering and almost none of the boundary layer's
+aerosol), and with wavelength as λ⁻⁴ and λ^−α (the aerosol of :class:`navsim.earth.atmosphere.Aerosol`:
+Ångström exponent α, optical depth from the site's visibility). The Sun's and the Moon's band magnitudes take the Sun's colours (the Vega absolute magnitudes of
 FSPS's filter table, Conroy, Gunn & White 2009: V 4.81, R_C 4.41, I_C 4.10, J 3.67, H 3.34) and, for the
 Moon, Schaefer's lunar reddening against the Sun (0.24 mag at 0.70 µm, 0.36 at 0.90 µm: his CM − MS
 colours) interpolated linearly in λ and extrapolated to J (0.56) and H (0.82). The twilight term's
 horizon brightening Z/(360 k) takes the band's k at sea level (the term is a property of the lit layers,
-not of the observer's thinning air, where it would grow without bound).
+not of the observer's thinning air, where it would grow without bound). :func:`spectral_radiance` turns a
+sky [mag arcsec⁻², Vega] into W cm⁻² sr⁻¹ µm⁻¹ by the band's Vega zero point.
 """
 
 import dataclasses
@@ -68,6 +81,13 @@ KS91_HEIGHT = 2800.0
 #: Schaefer 1998's daylight (line 2340) and twilight (line 2280) constants [mag].
 DAYLIGHT_ZERO = 43.27
 TWILIGHT_ZERO = 32.5
+#: Schaefer 1998's multiply scattered daylight (line 2340) [nL per foot-candle], and the aerosol's asymmetry
+#: parameter g = <cos θ> of its phase function (continental aerosol at 550 nm; module docstring).
+MULTIPLE_SCATTERING = 440000.0
+AEROSOL_ASYMMETRY = 0.7
+#: 1 arcsec² [sr]; 1 W m⁻³ in W cm⁻² µm⁻¹.
+ARCSEC2_SR = (np.pi / 648000.0) ** 2
+W_M3_TO_W_CM2_UM = 1e-10
 #: Distance modulus of 1 au [mag]: m = M + 5 log10(1 au / 10 pc).
 AU_MODULUS = 5.0 * np.log10(1.495978707e11 / 3.0856775814913673e17)
 
@@ -172,19 +192,20 @@ class SkyBrightness:
         return _magnitude(_flux(self.night) + _flux(sun) + _flux(self.moon))
 
 
-def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.0, air=None):
+def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.0, air=None, aerosol=None):
     """The :class:`SkyBrightness` of ``band_name`` (a :class:`startrack.photometry.bands.Band`'s name) for the
-    :class:`Sightline` ``geometry``; the ground air's humidity (0-1) and temperature [°C] set its aerosols
-    and water vapour (:func:`navsim.earth.atmosphere.extinction`), or ``air`` gives the observer's
+    :class:`Sightline` ``geometry``; the ground air's humidity (0-1) and temperature [°C] set its water vapour and
+    ``aerosol`` (a :class:`navsim.earth.atmosphere.Aerosol`, default the 38 km visibility's) its aerosols
+    (:func:`navsim.earth.atmosphere.extinction`), or ``air`` gives the observer's
     :class:`~navsim.earth.atmosphere.Extinction` itself."""
     g, sky = geometry, sky_band(band_name)
     band = photometric_band(band_name)
-    site = {"relative_humidity": relative_humidity, "temperature_c": temperature_c}
+    site = {"relative_humidity": relative_humidity, "temperature_c": temperature_c, "aerosol": aerosol}
     air = extinction(band, g.height, **site) if air is None else air
-    ref = extinction(photometric_band("V"), KS91_HEIGHT, **site)
+    ref = extinction(photometric_band("V"), KS91_HEIGHT)  # KS91's site in its own air (Schaefer's 40 %, 15 °C)
     K = air.total
     ref_rayleigh = float(ref.rayleigh)
-    ref_aerosol = KS91_EXTINCTION - ref_rayleigh
+    ref_aerosol = KS91_EXTINCTION - ref_rayleigh - float(ref.ozone + ref.water)  # the part of KS91's k that scatters
     ref_upper = ref_rayleigh + float(ref.stratospheric)
     X = _scattering_airmass(g.zenith)
     path = (1.0 - 10.0 ** (-0.4 * K * X)) * KS91_EXTINCTION / K
@@ -197,7 +218,9 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
     moon_up = g.moon_zenith < 0.5 * np.pi
     t_moon, t_sun = _transmission(K, g.moon_zenith), _transmission(K, g.sun_zenith)
     moon_nl = scattered(g.moon_angle) * _illuminance(sky.moon_mag(np.degrees(g.moon_phase_angle))) * t_moon * path
-    day = sky.sun_mag + DAYLIGHT_ZERO - 2.5 * np.log10(path * (scattered(g.sun_angle) * t_sun + 440000.0 * (1.0 - t_sun) * upper))
+    transport, ref_transport = _transport(air), ref_rayleigh + (1.0 - AEROSOL_ASYMMETRY) * ref_aerosol
+    diffuse = MULTIPLE_SCATTERING * (1.0 - _transmission(transport, g.sun_zenith)) * transport / ref_transport
+    day = sky.sun_mag + DAYLIGHT_ZERO - 2.5 * np.log10(path * (scattered(g.sun_angle) * t_sun + diffuse))
     sun_elevation, rho_s = 90.0 - np.degrees(g.sun_zenith), np.maximum(np.degrees(g.sun_angle), 0.25)
     k_sea = extinction(band, 0.0, **site).total
     twilight = (sky.sun_mag + TWILIGHT_ZERO - sun_elevation - np.degrees(g.zenith) / (360.0 * k_sea)
@@ -209,6 +232,26 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
                          day=np.asarray(day, dtype=float), twilight=np.asarray(twilight, dtype=float),
                          airglow=sources.airglow, zodiacal=sources.zodiacal, starlight=sources.starlight,
                          scattered=sources.scattered)
+
+
+def _transport(air):
+    """k_tr = k_R + (1 − g)(k_A + k_S) [mag per airmass]: the scattering that feeds the diffuse daylight, the
+    aerosols' by their transport share (module docstring)."""
+    return air.rayleigh + (1.0 - AEROSOL_ASYMMETRY) * (air.aerosol + air.stratospheric)
+
+
+def spectral_radiance(band_name, surface_brightness):
+    """The spectral radiance L_λ [W cm⁻² sr⁻¹ µm⁻¹] of a sky of ``surface_brightness`` [mag arcsec⁻², Vega] in the
+    band: L_λ = f_λ,0 10^(−0.4 μ) / Ω(1 arcsec²) with f_λ,0 the band's Vega zero point
+    (:mod:`startrack.photometry.bands`) and Ω(1 arcsec²) = (π/648 000)² sr = 2.3504e-11 sr."""
+    f_zero = photometric_band(band_name).flux_zero * W_M3_TO_W_CM2_UM
+    return f_zero * 10.0 ** (-0.4 * np.asarray(surface_brightness, dtype=float)) / ARCSEC2_SR
+
+
+def surface_brightness(band_name, radiance):
+    """The inverse of :func:`spectral_radiance`: μ [mag arcsec⁻²] of a spectral radiance [W cm⁻² sr⁻¹ µm⁻¹]."""
+    f_zero = photometric_band(band_name).flux_zero * W_M3_TO_W_CM2_UM
+    return -2.5 * np.log10(np.asarray(radiance, dtype=float) * ARCSEC2_SR / f_zero)
 
 
 def _scattering_function(rho_deg):

@@ -1,8 +1,9 @@
 """The sky a physical star sensor of a navigation run sees at its frames (:class:`navsim.sensors.frame_sky.FrameSky`):
 the sky's brightness in the sensor's band at the boresight (:mod:`navsim.earth.sky_brightness`) from the frames'
 Sun, Moon and boresight geometry (:mod:`navsim.navigation.exclusion`) and the observer's height, the extinction of
-the air above the observer (:mod:`navsim.earth.atmosphere`) and the trail of a star near the boresight from the
-body rate, for the nominal trajectory (seed-free, like the exclusions). The night sky's zodiacal light and
+the air above the observer (:mod:`navsim.earth.atmosphere`; the site's humidity, temperature and aerosol from
+``star_sensor.photometry``: visibility or optical depth, Ångström exponent) and the trail of a star near the boresight
+from the body rate, for the nominal trajectory (seed-free, like the exclusions). The night sky's zodiacal light and
 starlight take the boresight's ecliptic coordinates of date from the Sun's (IAU 2006 precession, ``erfa.eqec06``)
 and its Galactic latitude (``erfa.icrs2g``)."""
 
@@ -11,7 +12,7 @@ import dataclasses
 import erfa
 import numpy as np
 
-from navsim.earth.atmosphere import extinction
+from navsim.earth.atmosphere import Aerosol, extinction
 from navsim.earth.frames import julian_year, tt_epoch
 from navsim.earth.sky_brightness import Sightline, sky_brightness
 from navsim.sensors.frame_sky import FrameSky
@@ -44,7 +45,9 @@ def sky_sources(scenario, geometry, path, frame_k, band):
     """The :class:`~navsim.earth.sky_brightness.SkyBrightness` at the boresight of the frames in ``band`` (a
     :class:`startrack.photometry.bands.Band`): each source and the total (:func:`sightline`)."""
     site = scenario["star_sensor"]["photometry"]
-    ground = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"]}
+    aerosol = Aerosol.of_site(site["visibility_km"], site["aerosol_optical_depth"], site["angstrom_exponent"])
+    ground = {"relative_humidity": 0.01 * site["relative_humidity_percent"], "temperature_c": site["ground_temperature_c"],
+              "aerosol": aerosol}
     air = extinction(band, path.h[frame_k], **ground)
     return sky_brightness(band.name, sightline(scenario, geometry, path, frame_k), **ground, air=air), air
 

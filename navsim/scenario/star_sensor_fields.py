@@ -95,7 +95,15 @@ PHOTOMETRY = Table(
         "dark_e_per_px_s": Value("float", default=None, minimum=0.0, maximum=1e9),
         "full_well_e": Value("float", default=None, exclusive_minimum=0.0, maximum=1e9),
         "relative_humidity_percent": Value("float", default=40.0, minimum=1.0, maximum=95.0,
-                                           doc="of the ground air: its aerosols and water vapour (Schaefer 1998)"),
+                                           doc="of the ground air: its water vapour (Schaefer 1998)"),
+        "visibility_km": Value("float", default=38.0, exclusive_minimum=0.0, maximum=1000.0,
+                               doc="the ground's meteorological visibility: the aerosol optical depth at 550 nm by "
+                                   "Koschmieder's law, (3.912/V − β_Rayleigh) × 1.5 km (38 km: 0.137, 23 km: 0.24)"),
+        "aerosol_optical_depth": Value("float", default=None, minimum=0.0, maximum=5.0,
+                                       doc="the boundary-layer aerosol's optical depth at 550 nm from sea level "
+                                           "(given: it replaces the visibility's)"),
+        "angstrom_exponent": Value("float", default=1.3, minimum=-1.0, maximum=4.0,
+                                   doc="α of the aerosol's τ(λ) = τ_550 (λ/0.55 µm)^−α (1.3: continental)"),
         "ground_temperature_c": Value("float", default=15.0, minimum=-60.0, maximum=50.0),
     },
     optional=True,
