@@ -4,7 +4,7 @@ a representative design as a bundle of the star sensor's keys, each of which the
 - ``swir_day_3deg`` — a narrow-field short-wave infrared sensor for daytime flight (issue 30): H band, an InGaAs
   array of 640 x 512 pixels of 15 µm (``startrack.photometry.detectors``' ``ingaas_swir``), 100 mm aperture and a 3° field
   (focal length 183 mm, f/1.8), 10 ms exposures, its catalog to H = 7. At 12 km with the Sun 34-50° up and 80° away
-  it reaches H 4.5 against an H sky of 9.3 mag/arcsec² (``scenarios/sins_cns_aircraft_day.toml``).
+  it reaches H 4.4 against an H sky of 9.1-9.2 mag/arcsec² (``scenarios/sins_cns_aircraft_day.toml``).
 - ``swir_day_1deg`` — the same array behind a 150 mm aperture at a 1° field (focal length 550 mm, f/3.7), the
   field of the aircraft astro-inertial trackers (the B-2's NAS-26: 40'), 10 ms: 2.2 times the aperture on a sky
   9 times fainter per pixel, at the price of fewer stars per field.
