@@ -228,8 +228,9 @@ def test_a_runs_air_is_drawn_from_the_stated_sigma():
     from navsim.navigation import build
     from startrack import band
 
-    day = resolve_scenario(DAY)
-    drawn = resolve_scenario(DAY, ["star_sensor.refraction.drawn=true"])
+    drawn = resolve_scenario(DAY, ["star_sensor.refraction.pressure_error_percent=2",
+                                   "star_sensor.refraction.temperature_error_k=-3"])
+    day = resolve_scenario(drawn, ["star_sensor.refraction.drawn=false"])
     wavelength = band(day["star_sensor"]["band"]).centre_um
     airs = [build.real_air(drawn, (), np.random.default_rng(seed)) for seed in range(2000)]
     pressure = np.array([a.pressure_error for a in airs])
@@ -247,6 +248,5 @@ def test_drawing_the_air_needs_a_stated_sigma():
     from startrack import InputError
 
     with pytest.raises(InputError, match="star_sensor.refraction.drawn"):
-        resolve_scenario(DAY, ["star_sensor.refraction.drawn=true",
-                                                                 "star_sensor.refraction.pressure_sigma_percent=0",
-                                                                 "star_sensor.refraction.temperature_sigma_k=0"])
+        resolve_scenario(DAY, ["star_sensor.refraction.pressure_sigma_percent=0",
+                               "star_sensor.refraction.temperature_sigma_k=0"])
