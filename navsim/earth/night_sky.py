@@ -53,6 +53,7 @@ import numpy as np
 
 from navsim.earth.atmosphere import EARTH_RADIUS
 from startrack import band as photometric_band
+from startrack import units
 
 #: μ [mag arcsec⁻²] of 1 S10: a V = 10 star spread over a square degree.
 S10_MAG = 10.0 + 2.5 * np.log10(3600.0**2)
@@ -98,8 +99,6 @@ ZODIACAL_SPECTRUM = np.array([2.6e-6, 2.0e-6, 1.3e-6, 1.2e-6, 8.1e-7, 1.7e-7])
 #: Roach & Gordon 1973 (module docstring): the Galactic light at the pole and the cap on the equator [S10].
 STARLIGHT_POLE_S10 = 30.0
 STARLIGHT_EQUATOR_S10 = np.sqrt(160.0 * 640.0)
-#: Arcseconds² in a steradian.
-ARCSEC2_PER_SR = (180.0 * 3600.0 / np.pi) ** 2
 
 
 @dataclass(frozen=True)
@@ -130,7 +129,7 @@ def night_sources(band_name, airglow_zenith, sun_colour, geometry, air):
     zodiacal = zodiacal_flux(band_name, g.helioecliptic_longitude, g.ecliptic_latitude)
     starlight = starlight_flux(sun_colour, g.galactic_latitude)
     above = airglow_flux(airglow_zenith, 0.0, g.height, g.year) * HEMISPHERE_VAN_RHIJN + zodiacal + starlight
-    X = 1.0 / np.sqrt(1.0 - 0.96 * np.sin(g.zenith) ** 2)
+    X = scattering_airmass(g.zenith)
     scattered = 0.5 * above * (1.0 - 10.0 ** (-0.4 * air.scattering * X))
     extinction = air.along(g.zenith)
     return NightSources(airglow=magnitude(airglow) + extinction, zodiacal=magnitude(zodiacal) + extinction,
@@ -209,7 +208,7 @@ def _zodiacal_per_s10(name):
     band = photometric_band(name)  # every band's centre lies within the table's 0.5-2.2 µm
     log_spectrum = np.interp(np.log(band.centre_um), np.log(ZODIACAL_SPECTRUM_UM), np.log(ZODIACAL_SPECTRUM))
     per_s10 = ZODIACAL_UNITS_PER_S10 * 1e-8 * np.exp(log_spectrum) / ZODIACAL_SPECTRUM[0]  # W m⁻² sr⁻¹ µm⁻¹
-    return per_s10 * 1e6 / ARCSEC2_PER_SR / band.flux_zero  # flux_zero [W m⁻³]; per_s10 [W m⁻² sr⁻¹ µm⁻¹]
+    return per_s10 * 1e6 * units.ARCSEC**2 / band.flux_zero  # flux_zero [W m⁻³]; per_s10 [W m⁻² sr⁻¹ µm⁻¹]
 
 
 def starlight_s10(galactic_latitude):
@@ -223,6 +222,11 @@ def starlight_flux(sun_colour, galactic_latitude):
     """The starlight above the atmosphere [flux of mag 0 per arcsec²] in a band where the Sun's V − band colour is
     ``sun_colour`` [mag] (the starlight takes the Sun's colours)."""
     return starlight_s10(galactic_latitude) * flux(S10_MAG - sun_colour)
+
+
+def scattering_airmass(zenith):
+    """KS91 eq. 3: X = (1 − 0.96 sin²Z)^(−1/2), the airmass of the scattered light's path."""
+    return 1.0 / np.sqrt(1.0 - 0.96 * np.sin(zenith) ** 2)
 
 
 def flux(mu):

@@ -69,7 +69,7 @@ import numpy as np
 
 from navsim.earth import night_sky
 from navsim.earth.atmosphere import extinction
-from startrack import InputError
+from startrack import InputError, units
 from startrack import band as photometric_band
 
 #: KS91 eq. 1: B [nL] = 34.08 exp(20.7233 − 0.92104 μ), i.e. μ = NL_ZERO − 2.5 log10(B).
@@ -85,8 +85,7 @@ TWILIGHT_ZERO = 32.5
 #: parameter g = <cos θ> of its phase function (continental aerosol at 550 nm; module docstring).
 MULTIPLE_SCATTERING = 440000.0
 AEROSOL_ASYMMETRY = 0.7
-#: 1 arcsec² [sr]; 1 W m⁻³ in W cm⁻² µm⁻¹.
-ARCSEC2_SR = (np.pi / 648000.0) ** 2
+#: 1 W m⁻³ in W cm⁻² µm⁻¹.
 W_M3_TO_W_CM2_UM = 1e-10
 #: Distance modulus of 1 au [mag]: m = M + 5 log10(1 au / 10 pc).
 AU_MODULUS = 5.0 * np.log10(1.495978707e11 / 3.0856775814913673e17)
@@ -189,7 +188,7 @@ class SkyBrightness:
     def total(self):
         """The sky: night + the lesser of daylight and twilight + moonlight (Schaefer 1998 line 2380)."""
         sun = np.maximum(self.day, self.twilight)
-        return _magnitude(_flux(self.night) + _flux(sun) + _flux(self.moon))
+        return night_sky.magnitude(night_sky.flux(self.night) + night_sky.flux(sun) + night_sky.flux(self.moon))
 
 
 def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.0, air=None, aerosol=None):
@@ -207,7 +206,7 @@ def sky_brightness(band_name, geometry, relative_humidity=0.4, temperature_c=15.
     ref_rayleigh = float(ref.rayleigh)
     ref_aerosol = KS91_EXTINCTION - ref_rayleigh - float(ref.ozone + ref.water)  # the part of KS91's k that scatters
     ref_upper = ref_rayleigh + float(ref.stratospheric)
-    X = _scattering_airmass(g.zenith)
+    X = night_sky.scattering_airmass(g.zenith)
     path = (1.0 - 10.0 ** (-0.4 * K * X)) * KS91_EXTINCTION / K
     upper = (air.rayleigh + air.stratospheric) / ref_upper
 
@@ -245,13 +244,13 @@ def spectral_radiance(band_name, surface_brightness):
     band: L_λ = f_λ,0 10^(−0.4 μ) / Ω(1 arcsec²) with f_λ,0 the band's Vega zero point
     (:mod:`startrack.photometry.bands`) and Ω(1 arcsec²) = (π/648 000)² sr = 2.3504e-11 sr."""
     f_zero = photometric_band(band_name).flux_zero * W_M3_TO_W_CM2_UM
-    return f_zero * 10.0 ** (-0.4 * np.asarray(surface_brightness, dtype=float)) / ARCSEC2_SR
+    return f_zero * 10.0 ** (-0.4 * np.asarray(surface_brightness, dtype=float)) / units.ARCSEC**2
 
 
 def surface_brightness(band_name, radiance):
     """The inverse of :func:`spectral_radiance`: μ [mag arcsec⁻²] of a spectral radiance [W cm⁻² sr⁻¹ µm⁻¹]."""
     f_zero = photometric_band(band_name).flux_zero * W_M3_TO_W_CM2_UM
-    return -2.5 * np.log10(np.asarray(radiance, dtype=float) * ARCSEC2_SR / f_zero)
+    return -2.5 * np.log10(np.asarray(radiance, dtype=float) * units.ARCSEC**2 / f_zero)
 
 
 def _scattering_function(rho_deg):
@@ -262,25 +261,11 @@ def _scattering_function(rho_deg):
     return molecular, aerosol
 
 
-def _scattering_airmass(zenith):
-    """KS91 eq. 3: X = (1 − 0.96 sin²Z)^(−1/2), the airmass of the scattered light's path."""
-    return 1.0 / np.sqrt(1.0 - 0.96 * np.sin(zenith) ** 2)
-
-
 def _transmission(k, zenith):
     """10^(−0.4 k X(Z)) of a source at zenith distance Z [rad] (KS91's X, eq. 3), 0 below the horizon."""
-    return np.where(zenith < 0.5 * np.pi, 10.0 ** (-0.4 * k * _scattering_airmass(np.minimum(zenith, 0.5 * np.pi))), 0.0)
+    return np.where(zenith < 0.5 * np.pi, 10.0 ** (-0.4 * k * night_sky.scattering_airmass(np.minimum(zenith, 0.5 * np.pi))), 0.0)
 
 
 def _illuminance(mag):
     """KS91 eq. 8: the illuminance I* [foot-candles] of a body of magnitude ``mag``."""
     return 10.0 ** (-0.4 * (np.asarray(mag, dtype=float) + MOON_ILLUMINANCE_ZERO))
-
-
-def _flux(mu):
-    return 10.0 ** (-0.4 * np.asarray(mu, dtype=float))
-
-
-def _magnitude(flux):
-    with np.errstate(divide="ignore"):
-        return -2.5 * np.log10(flux)

@@ -172,12 +172,13 @@ def _empty(background, sigma_n, threshold):
     return Detections(f, f, f, f, np.zeros(0, dtype=np.int64), f, b, b, background, sigma_n, threshold, f, f, b, f, f, b)
 
 
-def _validate(image, name="image"):
+def validated_frame(image, name="image"):
+    """``image`` as an array once it is a non-empty 2-D frame of real, finite pixels (InputError naming the problem)."""
     array = np.asarray(image)
     if array.ndim != 2:
         raise InputError(f"{name} must be a 2-D greyscale array, got shape {array.shape}")
     if array.size == 0:
-        raise InputError(f"{name} has no pixels (shape {array.shape})")
+        raise InputError(f"{name} has no pixels (shape {array.shape}): a non-empty frame is needed")
     if not (np.issubdtype(array.dtype, np.number) and not np.issubdtype(array.dtype, np.complexfloating)):
         raise InputError(f"{name} must hold real numbers, got dtype {array.dtype}")
     if np.issubdtype(array.dtype, np.floating) and not np.all(np.isfinite(array)):
@@ -319,7 +320,7 @@ def _centroid_sigma(index, n, coord, centre, npix, wsum, sigma_n):
     return np.sqrt(scale * np.maximum(spread, 0.0) / wsum**2 + 1.0 / (12.0 * npix * npix))
 
 
-def _background(array, background, sigma_n, mesh_px):
+def frame_background(array, background, sigma_n, mesh_px):
     """The :class:`~startrack.image.background.Background` of a frame: the given level and noise (the missing one
     estimated over the frame), a mesh of ``mesh_px`` cells, or one estimate for the whole frame."""
     if background is None and sigma_n is None and mesh_px is not None:
@@ -386,8 +387,8 @@ def detect(image, background=None, sigma_n=None, a=5.0, threshold=None, centroid
     the detections flagged ``single_pixel``, ``extended``.  Returns :class:`Detections` (empty when
     nothing exceeds the threshold).  NaN pixels raise InputError.
     """
-    array = _validate(image)
-    found = _background(array, background, sigma_n, mesh_px)
+    array = validated_frame(image)
+    found = frame_background(array, background, sigma_n, mesh_px)
     centroider = _centroider(centroider)
     mask = array > (found.threshold(a) if threshold is None else float(threshold))
     if not mask.any():
@@ -418,12 +419,12 @@ def detect_windows(window_images, row0, col0, background, sigma_n, a=5.0, thresh
     stack = np.asarray(window_images)
     if stack.ndim != 3 or stack.shape[0] == 0 or stack.size == 0:
         raise InputError(f"windows must be a non-empty array of shape (M, s, s), got {stack.shape}")
-    _validate(stack.reshape(-1, stack.shape[2]), "windows")
+    validated_frame(stack.reshape(-1, stack.shape[2]), "windows")
     row0 = np.asarray(row0, dtype=np.int64)
     col0 = np.asarray(col0, dtype=np.int64)
     if row0.shape != (stack.shape[0],) or col0.shape != (stack.shape[0],):
         raise InputError(f"need one window origin per window: {stack.shape[0]} windows, origins {row0.shape}")
-    found = _background(stack.reshape(-1, stack.shape[2]), background, sigma_n, None)
+    found = frame_background(stack.reshape(-1, stack.shape[2]), background, sigma_n, None)
     levels = _levels(found, a, threshold, None, None)
     centroider = _centroider(centroider)
     m, h, w = stack.shape

@@ -59,8 +59,7 @@ from scipy import ndimage, optimize, signal
 from scipy.special import ndtr
 
 from startrack.base.errors import InputError
-from startrack.image.background import estimate_background, mesh_background
-from startrack.image.detection import Detections
+from startrack.image.detection import Detections, frame_background, validated_frame
 from startrack.image.psf_fit import PixelNoise, centroid_bound, fit_stars, half_width, track_offsets
 from startrack.image.render import Sources, expected_charge
 
@@ -181,40 +180,25 @@ def detection_probability(flux_dn, psf_sigma_px, trail_px, sigma_n_dn, threshold
     return total / _PHASES.size**2, flux * np.sqrt(energy) / sigma_n_dn
 
 
-def _validate(image):
-    array = np.asarray(image)
-    if array.ndim != 2 or array.size == 0:
-        raise InputError(f"image must be a non-empty 2-D greyscale array, got shape {array.shape}")
-    if not (np.issubdtype(array.dtype, np.number) and not np.issubdtype(array.dtype, np.complexfloating)):
-        raise InputError(f"image must hold real numbers, got dtype {array.dtype}")
-    array = array.astype(np.float32)
-    if not np.all(np.isfinite(array)):
-        raise InputError("image contains NaN or infinite pixel values")
-    return array
-
-
 def _levels(array, background, sigma_n, mesh_px):
-    """(b, σ_n, median b, median σ_n): numbers, or per-pixel maps (H, W) for a mesh (startrack.image.background)."""
-    if background is None and sigma_n is None and mesh_px is not None:
-        if isinstance(mesh_px, bool) or not isinstance(mesh_px, (int, np.integer)) or not 8 <= mesh_px <= 4096:
-            raise InputError(f"mesh_px = {mesh_px!r} must be an integer number of pixels in [8, 4096]")
-        found = mesh_background(array, int(mesh_px))
-        level = found.threshold(0.0)
-        return level, found.threshold(1.0) - level, found.median_level, found.median_sigma
-    if background is None or sigma_n is None:
-        b_est, s_est = estimate_background(array)
-        background = b_est if background is None else background
-        sigma_n = s_est if sigma_n is None else sigma_n
-    if not (np.isfinite(background) and np.isfinite(sigma_n) and sigma_n > 0):
-        raise InputError(f"background {background!r} and sigma_n {sigma_n!r} DN must be finite, sigma_n > 0")
-    return float(background), float(sigma_n), float(background), float(sigma_n)
+    """(b, σ_n, median b, median σ_n): numbers, or per-pixel maps (H, W) for a mesh, of the frame's
+    :func:`~startrack.image.detection.frame_background` (σ_n > 0: it divides eq. 1)."""
+    found = frame_background(array, background, sigma_n, mesh_px)
+    if found.level.size == 1:
+        b, s = found.median_level, found.median_sigma
+    else:
+        b = found.threshold(0.0)
+        s = found.threshold(1.0) - b
+    if not np.all(s > 0):
+        raise InputError(f"sigma_n {found.median_sigma!r} DN must be > 0")
+    return b, s, found.median_level, found.median_sigma
 
 
 def snr_map(image, psf_sigma_px, trail_px=(0.0, 0.0), background=None, sigma_n=None, mesh_px=None):
     """S (H, W) float32 of eq. (1) for every pixel (FFT correlation; the frame beyond its border counts as
     background), with the background b and noise σ_n given, estimated for the frame, or on a mesh of ``mesh_px``
     cells (:mod:`startrack.image.background`).  Returns (S, N̂ [DN], b, σ_n) (b, σ_n numbers or maps)."""
-    array = _validate(image)
+    array = validated_frame(image).astype(np.float32)
     template = trail_template(psf_sigma_px, trail_px)
     b, s, _, _ = _levels(array, background, sigma_n, mesh_px)
     energy = float(np.sum(template * template))
@@ -272,7 +256,7 @@ def detect_trailed(image, psf_sigma_px, trail_px=(0.0, 0.0), background=None, si
     Cramér-Rao bound at N̂ where it failed (or without ``fit``); single_pixel, extended False and size,
     elongation NaN (no shape test: the template is the star's shape).
     """
-    array = _validate(image)
+    array = validated_frame(image).astype(np.float32)
     sigma, trail = _checked(psf_sigma_px, trail_px)
     if threshold_snr is None:
         threshold_snr = snr_threshold(false_alarms, array.shape, sigma, trail)
