@@ -80,7 +80,7 @@ def run_loop(filt, sensor_run, imu, truth, grid, jumps=None, observers=(), compi
                                else None)
         frame = sensor_run.observe(request)
         update = fuse(filt, frame)
-        sensor_run.after_update(update)
+        sensor_run.after_update(update, filt.sensor_prior() if sensor_run.uses_prior else None)
         for observer in observers:
             observer.on_frame(request, frame, update)
         log.record(j, request.t, filt.snapshot(), frame, update, 1e3 * (time.perf_counter() - started))

@@ -58,7 +58,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "startrack.image.synthetic": ("SyntheticFrame", "centroid_frame", "random_attitude"),
     # identification
     "startrack.identify": ("IdentificationResult", "PlateSolver", "Prior", "StarIdentifier"),
-    "startrack.identify.prior_match": ("PriorMatch", "PriorMatches"),
+    "startrack.identify.prior_match": ("PriorMatch", "PriorMatches", "Tracks"),
 }, modules={
     # namespaces: the rotation convention (numpy, and its compiled twin), units, the address index of 000,
     # the boresight solves of 001

@@ -8,6 +8,7 @@ import numpy as np
 
 from navsim.build.faults import sensor_faults
 from navsim.scenario.star_sensor_fields import mounting
+from navsim.sensors.frame_detection import FULL_FRAME_DETECTORS
 from navsim.sensors.star_image import ImageStarSensor
 from navsim.sensors.star_prior import PriorIdentification
 from navsim.sensors.star_vector import AttitudeFixSensor, StarVectorSensor
@@ -170,7 +171,8 @@ def image_star_sensor(scenario, star_catalog, q_BS_true, faults, epoch, lanes=()
                            stars_I=np.asarray(stars.vectors), stars_mag=np.asarray(stars.mag), stars_hip=np.asarray(stars.hip),
                            detection_sigmas=image["detection_sigmas"], window_half_px=image["tracking_window_px"],
                            stacking=image["dim_star_stacking"], start_tracking=image["start_tracking"], q_BS_true=q_BS_true,
-                           faults=faults, photometry=budget, detection=image["detection"])
+                           faults=faults, photometry=budget,
+                           detection=FULL_FRAME_DETECTORS[image["detection"]](image))
 
 
 def _rendered_stars(star_catalog, image):

@@ -305,8 +305,9 @@ class NavFilter:
         """The star sensor's :class:`~navsim.sensors.star_sensor.SensorPrior` at this frame: q̂_IS (as
         :meth:`sensor_prediction`), the covariance of its error in sensor axes, δθ_S = R_SB A x + μ (A of eq. 1 of
         :mod:`navsim.estimation.celestial_kernels`, μ when the mounting is a state, the turn of the field by the
-        refraction state's −ε_r R_SI ρ when it has one), and the processing that makes catalog stars apparent
-        (:meth:`update_stars`'s)."""
+        refraction state's −ε_r R_SI ρ when it has one), the processing that makes catalog stars apparent
+        (:meth:`update_stars`'s), and the gyro's ARW and bias-error covariance (ε, in sensor axes) by which its
+        attitude drifts between frames."""
         j = self._frame()
         nav_kernels.flush(self._nav, self._P, self._acc, self.model)
         R_SB = rot.to_matrix(self._calib[MOUNTING]).T
@@ -318,7 +319,9 @@ class NavFilter:
         place = self._apparent_place(j)
         if self.layout.refraction >= 0:  # the field turned by ε_r ρ: an attitude error −ε_r R_SI ρ (fix_terms)
             G[:, self.layout.refraction] = -(rot.to_matrix(q_IS).T @ self._refraction_rotation(place, q_IS))
-        return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=place.apparent)
+        bias = R_SB @ self._P[9:12, 9:12] @ R_SB.T
+        return SensorPrior(q_IS=q_IS, P_theta=G @ self._P @ G.T, apparent=place.apparent,
+                           arw=self.config.noise.arw * np.sqrt(self.config.process_noise_scale), P_bias=bias)
 
     @staticmethod
     def _refraction_rotation(place, q_IS):

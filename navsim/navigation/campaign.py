@@ -44,12 +44,14 @@ def pool(finished, settle):
 
 def identification(per_run):
     """The runs' ``celestial.star_identification`` summed (None when the runs have none): frames and stars detected
-    and identified, wrong identifications, and the largest stated wrong-match probability."""
+    and identified (and tracked), wrong identifications, the largest stated wrong-match probability and the sum of
+    the stated probabilities (the wrong identifications expected)."""
     if not per_run or any(r is None for r in per_run):
         return None
     total = {key: int(sum(r[key] for r in per_run)) for key in ("frames_detected", "frames_identified", "stars_detected",
-                                                                 "stars_identified", "wrong")}
-    return {"runs": len(per_run), **total, "wrong_probability_max": max(r["wrong_probability_max"] for r in per_run)}
+                                                                 "stars_identified", "stars_tracked", "wrong")}
+    return {"runs": len(per_run), **total, "wrong_probability_max": max(r["wrong_probability_max"] for r in per_run),
+            "wrong_expected": float(sum(r["wrong_expected"] for r in per_run))}
 
 
 def cep(radial):

@@ -63,13 +63,16 @@ def summary(scenario, series, sky, orientation, q_BS_true, geometry, air):
 
 def star_identification(series):
     """What identifying the detections with the INS's prior did (:mod:`navsim.sensors.star_prior`): frames with
-    detections and with stars identified, stars detected and identified, the identifications the truth finds wrong
-    and the largest wrong-match probability the matcher stated."""
+    detections and with stars identified, stars detected and identified (and of them on their tracks), the
+    identifications the truth finds wrong, the largest wrong-match probability the matcher stated and the sum of them
+    all (the wrong identifications it expects)."""
     identified = series["n_identified"]
     return {"frames_detected": int(np.count_nonzero(series["n_detected"])),
             "frames_identified": int(np.count_nonzero(identified)), "stars_detected": int(series["n_detected"].sum()),
-            "stars_identified": int(identified.sum()), "wrong": int(series["n_wrong"].sum()),
-            "wrong_probability_max": float(series["wrong_probability"].max(initial=0.0))}
+            "stars_identified": int(identified.sum()), "stars_tracked": int(series["n_tracked"].sum()),
+            "wrong": int(series["n_wrong"].sum()),
+            "wrong_probability_max": float(series["wrong_probability"].max(initial=0.0)),
+            "wrong_expected": float(series["wrong_expected"].sum())}
 
 
 def sky_summary(geometry, series, sensor):

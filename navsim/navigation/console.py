@@ -40,8 +40,9 @@ def campaign_lines(summary):
     ident = summary.get("star_identification")
     if ident:
         lines.append(f"star identification {ident['stars_identified']} of {ident['stars_detected']} detections identified "
-                     f"with the prior in {ident['frames_identified']} frames of {ident['runs']} runs, {ident['wrong']} wrong "
-                     f"(largest stated wrong-match probability {ident['wrong_probability_max']:.1e})")
+                     f"with the prior in {ident['frames_identified']} frames of {ident['runs']} runs ({ident['stars_tracked']} on "
+                     f"their tracks), {ident['wrong']} wrong for {ident['wrong_expected']:.2f} expected (largest stated "
+                     f"wrong-match probability {ident['wrong_probability_max']:.1e})")
     accel = (summary.get("imu_calibration") or {}).get("accel_bias_micro_g")
     if accel:
         lines.append(f"accelerometer bias  {100 * accel['within_3_sigma']:.1f} % of the final errors within 3σ "

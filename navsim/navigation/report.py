@@ -238,8 +238,9 @@ def _identification_text(ident):
     """What naming the detections with the INS's prior did."""
     return (f"The sensor named its detections with the INS's prior: {ident['stars_identified']} of "
             f"{ident['stars_detected']} detections identified in {ident['frames_identified']} of "
-            f"{ident['frames_detected']} frames with detections, {ident['wrong']} wrongly (checked against the truth); the "
-            f"largest stated probability of a wrong match was {ident['wrong_probability_max']:.1e}.")
+            f"{ident['frames_detected']} frames with detections ({ident['stars_tracked']} of them on the tracks of stars "
+            f"identified before), {ident['wrong']} wrongly (checked against the truth) where the stated probabilities of "
+            f"a wrong match sum to {ident['wrong_expected']:.2f}; the largest was {ident['wrong_probability_max']:.1e}.")
 
 
 def _aberration_rows(aberration):

@@ -30,9 +30,9 @@ class CelestialAidingRun:
         self._star_measured = bool(frame.star_measurements)
         return dataclasses.replace(frame, aiding=self.aiding_run.observe(request).measurements)
 
-    def after_update(self, update):
+    def after_update(self, update, posterior):
         """The star sensor's part of the frame's verdict (the first update, when it measured)."""
-        self.star_run.after_update(update.updates[0] if self._star_measured else None)
+        self.star_run.after_update(update.updates[0] if self._star_measured else None, posterior)
 
     def lose_track(self):
         self.star_run.lose_track()

@@ -20,7 +20,7 @@ class RecordedRun:
     def record(self):
         return self._record
 
-    def after_update(self, update):
+    def after_update(self, update, posterior):
         pass
 
     def lose_track(self):

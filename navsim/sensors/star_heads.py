@@ -195,10 +195,11 @@ class ImageHeadsRun:
         for run in self.runs:
             run.lose_track()
 
-    def after_update(self, update):
+    def after_update(self, update, posterior):
         """Each head's tracking follows the filter's verdict on its own stars."""
         for h, run in enumerate(self.runs):
-            run.after_update(None if update is None else _Verdict(int(np.count_nonzero(update.accepted[self._heads == h]))))
+            run.after_update(None if update is None else _Verdict(int(np.count_nonzero(update.accepted[self._heads == h]))),
+                             posterior)
 
     def observe(self, request):
         frames = []

@@ -7,8 +7,8 @@ Per frame (:meth:`ImageRun.observe`), given the filter's predicted attitude q̂_
    on a vehicle near the Earth, the stars' apparent directions (:mod:`navsim.earth.apparent`):
    windows around the predicted stars while tracking, the full frame otherwise — windows sized to
    hold the smear trail the predicted rate implies;
-3. detection and centroids (full frames by 004's threshold, or with ``detection = "matched"`` by the matched
-   filter for the trail the predicted rate draws, :mod:`startrack.image.trail_detection`); identification
+3. detection and centroids (full frames by the sensor's detector, :mod:`navsim.sensors.frame_detection`: 004's
+   threshold, or the matched filter for the trail the predicted rate draws); identification
    with the prediction as prior — while tracking, the predicted attitude (tracking windows, then the predicted sub-catalog); after a lost track (an
    outage, a dropped frame, a rejected frame), the predicted boresight only: the predicted
    sub-catalog with its 4 redundant neighbours, then full-sky lost-in-space
@@ -46,8 +46,6 @@ from startrack import (
     Windows,
     concatenate_fits,
     cosmic_ray,
-    detect,
-    detect_trailed,
     detect_windows,
     fit_stars,
     neighbour_reach,
@@ -75,9 +73,8 @@ TIMING_FIELDS = {"id_ms": ((), np.float64, np.nan)}
 class ImageStarSensor:
     """The seed-free image-fidelity sensor, built once per scenario (:func:`navsim.build.star_sensor.star_sensor`):
     camera and detector model, the identifier over the navigation catalog, the stars drawn into the
-    frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n (and the full
-    frame's ``detection``: "threshold", 004's, or "matched", :func:`startrack.detect_trailed` for the trail the predicted
-    rate draws at the boresight),
+    frames (unit vectors in I, V magnitudes, HIP), detection threshold a of V_th = b + a σ_n (the readout windows'),
+    the full frame's ``detection`` (a strategy of :mod:`navsim.sensors.frame_detection`),
     tracking window half-width [px], dim-star stacking on/off, whether the first frame is already
     tracked (004's set-up), the true mounting and the faults; with a light budget (``photometry``) the frames'
     sky (``sky``). Each fused star's direction and its covariance come from its position fit
@@ -97,11 +94,11 @@ class ImageStarSensor:
     start_tracking: bool
     q_BS_true: np.ndarray
     faults: object
+    detection: object
     photometry: object = None
     sky: object = None
     radiation: object = None
     occultation: object = None
-    detection: str = "threshold"
 
     @property
     def catalog(self):
@@ -170,7 +167,7 @@ class ImageRun:
         self._tracking = False
         self._cache.reset()
 
-    def after_update(self, update):
+    def after_update(self, update, posterior):
         """Tracking continues while the filter accepts two stars (one, once tracking)."""
         accepted = 0 if update is None else update.n_accepted
         self._tracking = accepted >= 2 or (self._tracking and accepted >= 1)
@@ -245,22 +242,16 @@ class ImageRun:
         frame = render_star_field(camera, model, q_IS_true, stars_I, stars_mag, self._render_rng,
                                   omega_S=self._R_SB_true @ request.truth.omega_B, windows=windows,
                                   extra_sources=self._false_stars(request.t) + self._hits(request.index))
-        b, sigma_n = model.background_dn, model.noise_dn
-        if full and s.detection == "matched":
-            found = detect_trailed(frame.image, model.psf_sigma_px, self._boresight_trail(request), background=b,
-                                   sigma_n=sigma_n, saturation_dn=model.saturation_dn, fit=False)
-        elif full:
-            found = detect(frame.image, background=b, sigma_n=sigma_n, a=s.detection_sigmas,
-                           saturation_dn=model.saturation_dn)
+        if full:
+            found = s.detection.find(frame.image, model, lambda: self._boresight_trail(request))
         else:
-            found = _unique(detect_windows(frame.image, windows.row0, windows.col0, b, sigma_n, a=s.detection_sigmas,
-                                           saturation_dn=model.saturation_dn))
+            found = _unique(detect_windows(frame.image, windows.row0, windows.col0, model.background_dn, model.noise_dn,
+                                           a=s.detection_sigmas, saturation_dn=model.saturation_dn))
         return frame.image, windows, found
 
     def _boresight_trail(self, request):
-        """(Δu, Δv) [px]: the trail the predicted attitude and rate draw over the exposure at the boresight, the
-        matched filter's for the whole frame (a roll about the boresight lengthens the trails off the centre,
-        which this one template does not follow)."""
+        """(Δu, Δv) [px]: the trail the predicted attitude and rate draw over the exposure at the boresight (what a
+        full-frame detector of :mod:`navsim.sensors.frame_detection` may use)."""
         camera, exposure = self.sensor.camera, self.sensor.frame_model(request.index).exposure_s
         boresight_I = rot.rotate(request.q_IS_pred, np.array([0.0, 0.0, 1.0]))
         track = camera.angular_velocity_track(request.q_IS_pred, request.omega_S_pred, (-0.5 * exposure, 0.5 * exposure),

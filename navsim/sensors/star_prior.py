@@ -12,6 +12,18 @@ apparent). The matches are fused as star vectors (one star updates two axes); th
 a detection matched to a star it is not). The same path serves any frame with few stars, by night or after an
 outage. The processing is taken to correct the extinction of each star exactly (its magnitude compared with the
 catalog's above the air).
+
+Track gate. A star the filter accepted is tracked for :data:`TRACK_LIFETIME`: in later frames it is gated on the
+direction it was last measured at (:class:`startrack.identify.prior_match.Tracks`), carried by the INS's own
+relative attitude -- the filter's attitude with the corrections its updates made since then taken out. With K the
+product of the updates' corrections q_post ⊗ q_prior* since the run began (in I), a star measured at o_j (S) with
+the posterior attitude R_IS,j is predicted at frame j' at
+
+    s = R_SI,j' [K_j' K_jᵀ R_IS,j o_j + a_j' − a_j],   C_t = C_o,j + N² Δt I + Δt² P_ε,                    (1)
+
+a the processing's apparent direction of its catalog entry (its aberration and refraction change between the
+frames) and the drift of :meth:`~navsim.sensors.star_sensor.SensorPrior.drift`. The attitude's own error then
+cancels: the gate is that of two centroids and the gyro's drift over Δt, not the prior's.
 """
 
 import time
@@ -20,13 +32,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from navsim.sensors.star_sensor import MODE_CODE, StarFrame, isotropic_covariance
+from startrack import Tracks
+from startrack import rotation as rot
 
-#: The run log's per-frame fields (shape, dtype, fill): the mode, detections, stars identified (none stacked), the
-#: identifications the truth finds wrong and the largest wrong-match probability of the frame's matches (eq. 2 of
-#: :mod:`startrack.identify.prior_match`); and the identification's wall time.
+#: The run log's per-frame fields (shape, dtype, fill): the mode, detections, stars identified (none stacked) and of
+#: them those gated on their track, the identifications the truth finds wrong, the largest wrong-match probability
+#: of the frame's matches (eq. 2 of :mod:`startrack.identify.prior_match`) and their sum (the wrong matches the
+#: matcher expects); and the identification's wall time.
 LOG_FIELDS = {"mode": ((), np.int8, MODE_CODE["no_fix"]), "n_detected": ((), np.int32, 0),
-              "n_identified": ((), np.int32, 0), "n_stacked": ((), np.int32, 0), "n_wrong": ((), np.int32, 0),
-              "wrong_probability": ((), np.float64, 0.0)}
+              "n_identified": ((), np.int32, 0), "n_tracked": ((), np.int32, 0), "n_stacked": ((), np.int32, 0),
+              "n_wrong": ((), np.int32, 0), "wrong_probability": ((), np.float64, 0.0),
+              "wrong_expected": ((), np.float64, 0.0)}
+#: How long [s] a star stays tracked after the filter last accepted it; then it is gated on the prior again. Eq. (1)
+#: neglects what grows with the time between (the scale factor's error times the turn, the refraction's change times
+#: the model air's error): within it, those stay below a tenth of an arcsecond on the shipped vehicles.
+TRACK_LIFETIME = 60.0
 TIMING_FIELDS = {"id_ms": ((), np.float64, np.nan)}
 
 
@@ -60,7 +80,8 @@ class Detections:
 
 class PriorIdentifiedRun:
     """The per-run sensor: the pre-drawn :class:`Detections`, identified frame by frame with the filter's prior by
-    ``matcher`` over the catalog ``star_vectors`` (catalog directions: the filter makes them apparent)."""
+    ``matcher`` over the catalog ``star_vectors`` (catalog directions: the filter makes them apparent), the stars the
+    filter accepted gated on their tracks (eq. 1)."""
 
     log_fields = LOG_FIELDS
     timing_fields = TIMING_FIELDS
@@ -70,12 +91,16 @@ class PriorIdentifiedRun:
 
     def __init__(self, detections, matcher, star_vectors):
         self._detections, self._matcher, self._vectors = detections, matcher, star_vectors
+        self._K = np.array([0.0, 0.0, 0.0, 1.0])  # the updates' corrections so far (eq. 1)
+        self._tracks = {}  # catalog row -> (K_jᵀ R_IS,j o_j (3,), a_j (3,), C_o,j in I (3, 3), t_j [s])
+        self._prior, self._matched = None, None
 
     def record(self):
         return None
 
     def observe(self, request):
         d, j = self._detections, request.index
+        self._prior, self._matched = request.prior, None
         rows = slice(d.offsets[j], d.offsets[j + 1])
         detected = rows.stop - rows.start
         if not d.available[j] or not detected:
@@ -83,25 +108,54 @@ class PriorIdentifiedRun:
         started = time.perf_counter()
         obs_S = d.obs_S[rows]
         cov = isotropic_covariance(obs_S, d.sigma[rows])
-        prior = request.prior
+        prior, tracks = request.prior, self._track_gates(request.t, request.prior)
         found = self._matcher.match(obs_S, d.mag[rows], d.mag_sigma[rows], cov, prior.q_IS, prior.P_theta,
-                                    d.limiting_mag[j], prior.apparent)
+                                    d.limiting_mag[j], prior.apparent, tracks)
         k = found.obs_index
+        self._matched = (request.t, found.star_index, obs_S[k], cov[k])
         wrong = int(np.count_nonzero(d.truth[rows][k] != found.star_index))
         mode = "prior" if k.size else "no_fix"
-        info = _info(mode, detected, k.size, wrong, float(found.wrong_probability.max(initial=0.0)),
-                     1e3 * (time.perf_counter() - started))
+        info = _info(mode, detected, k.size, int(np.count_nonzero(np.isin(found.star_index, tracks.star_index))),
+                     wrong, found.wrong_probability, 1e3 * (time.perf_counter() - started))
         if not k.size:
             return StarFrame(mode="no_fix", reason="no detection identified with the prior", info=info)
         return StarFrame(mode="prior", ref_I=self._vectors[found.star_index], obs_S=obs_S[k], cov_S=cov[k], info=info)
 
-    def after_update(self, update):
-        pass
+    def after_update(self, update, posterior):
+        """The frame's corrections into K, and a track for each match the filter accepted (eq. 1)."""
+        q_post = posterior.q_IS
+        self._K = rot.normalize(rot.multiply(rot.multiply(q_post, rot.conjugate(self._prior.q_IS)), self._K))
+        if self._matched is None or update is None:
+            return
+        t, stars, obs_S, cov = self._matched
+        accepted = update.accepted
+        R = rot.to_matrix(rot.multiply(rot.conjugate(self._K), q_post))  # K_jᵀ R_IS,j
+        carried, C = obs_S[accepted] @ R.T, R @ cov[accepted] @ R.T
+        apparent = posterior.apparent(self._vectors[stars[accepted]])
+        for star, v, a, c in zip(stars[accepted], carried, apparent, C):
+            self._tracks[int(star)] = (v, a, c, t)
 
     def lose_track(self):
-        pass
+        self._tracks = {}
+
+    def _track_gates(self, t, prior):
+        """The :class:`~startrack.identify.prior_match.Tracks` of eq. (1) at time ``t`` [s] for ``prior``; tracks
+        older than :data:`TRACK_LIFETIME` are dropped."""
+        self._tracks = {star: track for star, track in self._tracks.items() if t - track[3] <= TRACK_LIFETIME}
+        if not self._tracks:
+            return Tracks.none()
+        stars = np.fromiter(self._tracks, np.int64, len(self._tracks))
+        carried, a, C, t_last = (np.array(column) for column in zip(*self._tracks.values()))
+        R_SI = rot.to_matrix(prior.q_IS).T
+        inertial = carried @ rot.to_matrix(self._K).T + prior.apparent(self._vectors[stars]) - a
+        s = inertial @ R_SI.T
+        s /= np.linalg.norm(s, axis=1, keepdims=True)
+        K = rot.to_matrix(self._K)  # C_o,j was stored in the corrections-free frame K_jᵀ I: carried to I by K
+        cov = R_SI @ K @ C @ K.T @ R_SI.T + np.array([prior.drift(t - tj) for tj in t_last])
+        return Tracks(star_index=stars, s=s, cov=cov)
 
 
-def _info(mode, detected, identified=0, wrong=0, probability=0.0, id_ms=np.nan):
-    return {"mode": MODE_CODE[mode], "n_detected": detected, "n_identified": identified, "n_wrong": wrong,
-            "wrong_probability": probability, "id_ms": id_ms}
+def _info(mode, detected, identified=0, tracked=0, wrong=0, probabilities=(), id_ms=np.nan):
+    return {"mode": MODE_CODE[mode], "n_detected": detected, "n_identified": identified, "n_tracked": tracked,
+            "n_wrong": wrong, "wrong_probability": float(np.max(probabilities, initial=0.0)),
+            "wrong_expected": float(np.sum(probabilities)), "id_ms": id_ms}

@@ -7,8 +7,9 @@ which answers three calls:
 
 - ``observe(request) -> StarFrame``: the frame's measurements (identified star vectors with their
   covariances, or an attitude fix), the mode used, counts, timings and the diagnostics observers read;
-- ``after_update(update)``: the filter's verdict on the frame (tracking continues while it accepts
-  the stars), ``None`` when nothing was fused;
+- ``after_update(update, posterior)``: the filter's verdict on the frame (tracking continues while it accepts
+  the stars), ``None`` when nothing was fused, and for a run that ``uses_prior`` the filter's :class:`SensorPrior`
+  after the frame's updates (None otherwise);
 - ``lose_track()``: the estimate was knocked off (attitude-jump fault), start acquiring again.
 
 ``uses_prediction`` says whether the run points itself with the filter's predicted attitude and rate
@@ -58,12 +59,23 @@ class FrameRequest:
 @dataclass(frozen=True)
 class SensorPrior:
     """What the filter knows of the sensor's attitude at a frame: its estimate ``q_IS``, the covariance ``P_theta``
-    (3, 3) [rad², sensor axes] of its error, and ``apparent``, its processing's map of catalog unit vectors (K, 3)
-    in I to the apparent directions it predicts them at (aberration and refraction as it corrects them)."""
+    (3, 3) [rad², sensor axes] of its error, ``apparent``, its processing's map of catalog unit vectors (K, 3)
+    in I to the apparent directions it predicts them at (aberration and refraction as it corrects them), and what
+    its attitude error gains over a time: the gyro's angle random walk ``arw`` [rad/√s] it assumes and the
+    covariance ``P_bias`` (3, 3) [rad²/s², sensor axes] of its gyro-bias error (:meth:`drift`)."""
 
     q_IS: np.ndarray
     P_theta: np.ndarray
     apparent: object
+    arw: float = 0.0
+    P_bias: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    def drift(self, dt):
+        """The covariance (3, 3) [rad², sensor axes] of the attitude error the INS gains over ``dt`` [s] from now:
+        N² dt I + dt² P_ε, from φ̇ = … − C_wb ε − w of :func:`navsim.estimation.nav_kernels.continuous_f` (the gyro's white noise
+        and its bias error; the Earth-rate and transport terms, ω dt of the error, and the scale factor's error times
+        the turn are neglected)."""
+        return self.arw**2 * dt * np.eye(3) + dt**2 * self.P_bias
 
 
 @dataclass(frozen=True)

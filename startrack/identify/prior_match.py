@@ -15,6 +15,17 @@ T the 2x3 tangent basis at s. The gate is d² <= χ²₂(p_gate) = −2 ln(1 −
 it with probability 1 − p_gate), and the magnitudes must agree: |m_obs − m_cat| <= k_m √(σ_obs² + σ_cat²), σ_cat
 the band magnitudes' own error (:mod:`startrack.photometry.colours`: 0.10-0.14 mag RMS in J and H).
 
+Track gate. A star matched in an earlier frame is predicted instead where it was last measured: its measured
+direction carried to this frame by the attitude the caller knows between the two frames (an INS's relative
+attitude), of covariance C_t = C_o,last + the relative attitude's error (:class:`Tracks`, built by the caller).
+In (1) the star's s is then the track's and [s×] P_θ [s×]ᵀ is replaced by C_t: a gate of ~2 centroid σ² in place of
+the prior's, so the chance (2) that a coincidence falls inside it shrinks by the ratio of the two areas, and a
+detection that lies in the prior's gate but not in the track's is not that star. This is the validation gate of a confirmed
+track in target tracking (Bar-Shalom, Li & Kirubarajan). A match on a track is wrong only when the star went
+undetected and a false detection fell inside its gate: its (2) keeps the ρ_f P_miss term alone. Another star
+inside the gate, √χ²₂ √2 σ_c ≈ 6 centroid σ from the track, is one the sensor does not resolve from it, and one
+that stays there was there at the track's first match, whose (2) counts it.
+
 Uniqueness. A detection is matched to a star only when that star is the only one in its gate and the detection
 the only one in the star's gate.
 
@@ -66,6 +77,21 @@ class PriorMatches:
 
 
 @dataclass(frozen=True)
+class Tracks:
+    """Stars matched before, as eq. (1) predicts them now: catalog rows ``star_index`` (T,), predicted unit
+    directions ``s`` (T, 3) in the sensor's axes and the covariance ``cov`` (T, 3, 3) [rad²] of each prediction's
+    error (the last measurement's and the relative attitude's); the module docstring's track gate."""
+
+    star_index: np.ndarray
+    s: np.ndarray
+    cov: np.ndarray
+
+    @classmethod
+    def none(cls):
+        return cls(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)))
+
+
+@dataclass(frozen=True)
 class PriorMatch:
     """Few-star identification against ``vectors`` (N, 3) catalog unit vectors in I with their magnitudes ``mags``
     (N,) in the sensor's band (module docstring).
@@ -104,13 +130,14 @@ class PriorMatch:
         """ρ_f [sr⁻¹]: the expected false detections over the field's solid angle."""
         return self.false_per_frame / (2.0 * np.pi * (1.0 - np.cos(self.field_radius)))
 
-    def match(self, obs_S, obs_mag, obs_mag_sigma, cov_S, q_IS, P_theta, limiting_mag=None, apparent=None):
+    def match(self, obs_S, obs_mag, obs_mag_sigma, cov_S, q_IS, P_theta, limiting_mag=None, apparent=None,
+              tracks=None):
         """The matches (:class:`PriorMatches`) of detections ``obs_S`` (M, 3) (unit, sensor axes) of magnitudes
         ``obs_mag`` (M,) ± ``obs_mag_sigma`` (M,) and direction covariances ``cov_S`` (M, 3, 3) [rad²], for the
         prior attitude ``q_IS`` (4,) whose error in sensor axes has the covariance ``P_theta`` (3, 3) [rad²], on a
         frame of limiting magnitude ``limiting_mag`` (None: unknown, any star may have been missed); ``apparent`` maps
         catalog unit vectors (K, 3) in I to the directions the sensor sees them at (aberration, refraction; None: the
-        catalog's)."""
+        catalog's); ``tracks`` (:class:`Tracks` or None) the stars gated on their last measured position."""
         obs_S = np.atleast_2d(np.asarray(obs_S, dtype=float))
         R_SI = rot.to_matrix(np.asarray(q_IS, dtype=float)).T
         boresight = R_SI[2]
@@ -118,14 +145,19 @@ class PriorMatch:
         candidates = np.flatnonzero(self.vectors @ boresight >= np.cos(min(reach, np.pi)))
         u = self.vectors[candidates]
         s = (u if apparent is None else apparent(u)) @ R_SI.T  # predicted directions (K, 3) in S
-        d2, area = _mahalanobis(obs_S, np.asarray(cov_S, dtype=float), s, np.asarray(P_theta, dtype=float))
+        C = _attitude_covariance(s, np.asarray(P_theta, dtype=float))
+        tracked = np.zeros(candidates.size, dtype=bool)
+        if tracks is not None:
+            rows, k = np.intersect1d(tracks.star_index, candidates, assume_unique=True, return_indices=True)[1:]
+            s[k], C[k], tracked[k] = tracks.s[rows], tracks.cov[rows], True
+        d2, area = _mahalanobis(obs_S, np.asarray(cov_S, dtype=float), s, C)
         window = self.mag_sigmas * np.hypot(np.asarray(obs_mag_sigma, dtype=float), self.catalog_mag_sigma)
         mag_ok = np.abs(np.asarray(obs_mag, dtype=float)[:, None] - self.mags[candidates][None, :]) <= window[:, None]
         inside = (d2 <= self.gate) & mag_ok
         density = self._window_density(boresight, np.asarray(obs_mag, dtype=float), window)
         miss = (np.ones(candidates.size) if limiting_mag is None
                 else norm.cdf((self.mags[candidates] - limiting_mag) / _LIMIT_WIDTH))
-        return self._unique(inside, d2, area, density, miss, candidates)
+        return self._unique(inside, d2, area, density, miss, candidates, tracked)
 
     def _window_density(self, boresight, obs_mag, window):
         """ρ_m (M,) [sr⁻¹]: catalog stars within each detection's magnitude window per steradian of the cap of
@@ -135,8 +167,9 @@ class PriorMatch:
         counts = np.array([np.count_nonzero(np.abs(near - m) <= w) for m, w in zip(obs_mag, window)])
         return np.maximum(counts, 1) / (2.0 * np.pi * (1.0 - np.cos(radius)))
 
-    def _unique(self, inside, d2, area, density, miss, candidates):
-        """The mutually unique gate pairs, each kept when its eq. (2) is under the ceiling."""
+    def _unique(self, inside, d2, area, density, miss, candidates, tracked):
+        """The mutually unique gate pairs, each kept when its eq. (2) is under the ceiling (its false-detection term
+        alone for a ``tracked`` (K,) star: the module docstring's track gate)."""
         per_obs, per_star = inside.sum(axis=1), inside.sum(axis=0)
         obs_index, star_index, wrong, dist, rejected = [], [], [], [], []
         for i in range(inside.shape[0]):
@@ -150,7 +183,7 @@ class PriorMatch:
             if per_star[k] > 1:
                 rejected.append("shared")
                 continue
-            p = -np.expm1(-(density[i] + self.false_density * miss[k]) * self.gate * area[i, k])
+            p = -np.expm1(-((0.0 if tracked[k] else density[i]) + self.false_density * miss[k]) * self.gate * area[i, k])
             if p > self.max_wrong:
                 rejected.append("chance")
                 continue
@@ -163,14 +196,18 @@ class PriorMatch:
                             wrong_probability=np.array(wrong), d2=np.array(dist), rejected=tuple(rejected))
 
 
-def _mahalanobis(obs_S, cov_S, s, P_theta):
+def _attitude_covariance(s, P_theta):
+    """[s×] P_θ [s×]ᵀ (K, 3, 3) [rad²]: the covariance of each predicted direction s (K, 3) from the attitude's error
+    (eq. 1)."""
+    cross = rot.skew(s)
+    return cross @ P_theta[None] @ np.swapaxes(cross, 1, 2)
+
+
+def _mahalanobis(obs_S, cov_S, s, C):
     """(d² (M, K) of eq. (1), gate-ellipse area per unit χ², π √det S (M, K) [sr]) of every detection against every
-    predicted star s (K, 3)."""
+    predicted star s (K, 3) of prediction covariance C (K, 3, 3)."""
     T = tangent_basis(s)  # (K, 2, 3)
-    cross = np.zeros((len(s), 3, 3))
-    cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -s[:, 2], s[:, 1], -s[:, 0]
-    cross[:, 1, 0], cross[:, 2, 0], cross[:, 2, 1] = s[:, 2], -s[:, 1], s[:, 0]
-    prior = np.einsum("kab,kbc,kdc->kad", T @ cross, P_theta[None], T @ cross)  # (K, 2, 2)
+    prior = np.einsum("kab,kbc,kdc->kad", T, C, T)  # (K, 2, 2)
     meas = np.einsum("kab,mbc,kdc->mkad", T, cov_S, T)  # (M, K, 2, 2)
     S = prior[None] + meas
     r = np.einsum("kab,mkb->mka", T, obs_S[:, None, :] - s[None, :, :])

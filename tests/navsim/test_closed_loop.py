@@ -200,7 +200,7 @@ class _ScriptedSensor:
         return StarFrame(mode="subcatalog", ref_I=stars, obs_S=stars, cov_S=isotropic_covariance(stars, 1.0),
                          fix_q_IS=request.q_IS_pred, info={"mode": MODE_CODE["subcatalog"]})
 
-    def after_update(self, update):
+    def after_update(self, update, posterior):
         self.verdicts.append(None if update is None else update.n_accepted)
 
     def lose_track(self):

@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+from navsim.scenario.star_sensor_fields import STAR_SENSOR
+from navsim.sensors.frame_detection import FULL_FRAME_DETECTORS
 from navsim.sensors.star_sensor import FrameRequest
 from navsim.simulation import prepare
 from startrack.geometry import rotation as rot
@@ -44,3 +46,12 @@ def test_the_matched_filter_finds_more_trailed_stars_and_identifies_the_frame():
     in_front = np.all(np.isfinite(uv), axis=1) & (sensor.camera.to_sensor(q_IS_true, directions)[:, 2] > 0)
     distance, _ = cKDTree(uv[in_front]).query(matched.diagnostics["detections"].uv)
     assert np.all(distance <= 1.5 + 0.5 * trail_px), np.round(distance, 1)
+
+
+def test_every_detector_the_schema_offers_is_a_strategy_of_the_registry():
+    """``star_sensor.image.detection``'s choices are the keys of navsim.sensors.frame_detection's registry (the
+    scenario layer, a floor below, cannot import it), and each builds a detector from the image table."""
+    choices = STAR_SENSOR["image"].entries["detection"].choices
+    assert set(choices) == set(FULL_FRAME_DETECTORS)
+    for name in choices:
+        assert callable(FULL_FRAME_DETECTORS[name]({"detection_sigmas": 5.0}).find)

@@ -3,13 +3,14 @@ daytime field: 1, 2 or 3 stars and 0-2 false detections, the prior's σ from 5" 
 
 import numpy as np
 import pytest
+from scipy.stats import norm
 
 from startrack.base.errors import InputError
 from startrack.base.units import ARCSEC
 from startrack.catalog.hipparcos import load_star_catalog
 from startrack.geometry import rotation as rot
 from startrack.geometry.sphere import tangent_basis
-from startrack.identify.prior_match import PriorMatch
+from startrack.identify.prior_match import PriorMatch, Tracks
 
 #: A 2-deg SWIR field in H: the catalog to H = 6, detections of the stars to H = 4, 2" centroids, 0.1 mag photometry;
 #: the band magnitudes from the colours err by 0.12 mag RMS (tests/startrack/test_colours.py: 0.10 J, 0.14 H).
@@ -115,3 +116,23 @@ def test_bad_settings_are_one_clear_error(key, value):
     settings = {"field_radius": FIELD_RADIUS, key: value}
     with pytest.raises(InputError, match="prior match"):
         PriorMatch(np.array([[0.0, 0.0, 1.0]]), np.array([3.0]), **settings)
+
+
+def test_a_tracked_star_is_gated_on_its_track_and_states_the_false_detections_chance_alone():
+    """A star tracked 60" from where a 5" prior puts it (its last measurement, carried by the INS): the prior alone
+    leaves the detection on the track ("no star"); with the track it is matched, and its eq. (2) is the false
+    detections' term alone, 1 − exp(−ρ_f P_miss χ²₂ π √det S), S = T (C_t + C_o) Tᵀ."""
+    u = np.array([[0.0, 0.0, 1.0], [np.sin(0.01), 0.0, np.cos(0.01)]])
+    matcher = PriorMatch(u, np.array([3.0, 3.2]), FIELD_RADIUS, false_per_frame=2.0)
+    moved = np.array([60.0 * ARCSEC, 0.0, 1.0]) / np.hypot(60.0 * ARCSEC, 1.0)
+    cov = CENTROID_SIGMA**2 * (np.eye(3) - np.outer(moved, moved))[None]
+    args = (moved[None], np.array([3.0]), np.array([0.1]), cov, np.array([0.0, 0.0, 0.0, 1.0]),
+            (5.0 * ARCSEC) ** 2 * np.eye(3), 4.0)
+    assert matcher.match(*args).rejected == ("no star",)
+    tracks = Tracks(star_index=np.array([0]), s=moved[None], cov=2.0 * cov)
+    found = matcher.match(*args, tracks=tracks)
+    assert found.rejected == ("",) and found.star_index.tolist() == [0]
+    area = np.pi * np.sqrt(np.linalg.det(3.0 * CENTROID_SIGMA**2 * np.eye(2)))
+    miss = norm.cdf((3.0 - 4.0) / 0.3)
+    assert found.wrong_probability[0] == pytest.approx(-np.expm1(-matcher.false_density * miss * matcher.gate * area),
+                                                       rel=1e-6)
