@@ -146,12 +146,10 @@ class PriorIdentifiedRun:
             return Tracks.none()
         stars = np.fromiter(self._tracks, np.int64, len(self._tracks))
         carried, a, C, t_last = (np.array(column) for column in zip(*self._tracks.values()))
-        R_SI = rot.to_matrix(prior.q_IS).T
-        inertial = carried @ rot.to_matrix(self._K).T + prior.apparent(self._vectors[stars]) - a
-        s = inertial @ R_SI.T
+        R_SK = rot.to_matrix(prior.q_IS).T @ rot.to_matrix(self._K)  # from the corrections-free frame K_jᵀ I to S
+        s = carried @ R_SK.T + (prior.apparent(self._vectors[stars]) - a) @ rot.to_matrix(prior.q_IS)
         s /= np.linalg.norm(s, axis=1, keepdims=True)
-        K = rot.to_matrix(self._K)  # C_o,j was stored in the corrections-free frame K_jᵀ I: carried to I by K
-        cov = R_SI @ K @ C @ K.T @ R_SI.T + np.array([prior.drift(t - tj) for tj in t_last])
+        cov = R_SK @ C @ R_SK.T + np.array([prior.drift(t - tj) for tj in t_last])
         return Tracks(star_index=stars, s=s, cov=cov)
 
 
