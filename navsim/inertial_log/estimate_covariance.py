@@ -10,12 +10,11 @@ structure function D(s), the second differences' cross-covariance is R_ab(l) = �
 with n_ab(l) the pairs (i, i + l) in both sums -- the variance of a quadratic form of Gaussian variables, the sum
 Greenhall & Riley 2003 evaluate for the EDF of one power-law noise (their eq. (7)-(8)); ν = 2 σ⁴ / Var(σ̂²) is its
 EDF, here of the fitted mixture. The model's terms (:mod:`.noise_fit`) give D(s): quantisation 2 Q² (s ≠ 0), white
-rate N² |s|, flicker rate −(B²/π) s² ln|s|, rate random walk −K² |s|³/6, Gauss-Markov 2 σ_g² T² (|s|/T − 1 + e^(−|s|/T))
-(each gives the term's σ²(τ) = (4 D(τ) − D(2τ)) / (2 τ²) of IEEE 952's model; a rate ramp is deterministic and adds
+rate N² |s|, flicker rate −(B²/π) s² ln|s|, rate random walk −K² |s|³/6 (each gives the term's σ²(τ) = (4 D(τ) − D(2τ)) / (2 τ²) of IEEE 952's model; a rate ramp is deterministic and adds
 none). The sum over lags is taken at a step of min(m_a, m_b)/16 (the cluster sizes are powers of two: R_ab is
 smooth between multiples of it), the quantisation's part, non-zero only at the lags where the two differences share a
-point, exactly at those, over the lags where the two differences share data, 4 (m_a + m_b) more for the
-flicker and Gauss-Markov terms; cluster times more than ``_REACH`` octaves apart are taken as uncorrelated. Since R_ab is linear in the squared
+point, exactly at those, over the lags where the two differences share data and 4 (m_a + m_b) more (the flicker
+term's reach); cluster times more than ``_REACH`` octaves apart are taken as uncorrelated. Since R_ab is linear in the squared
 coefficients c, the covariance is Σ_ij c_i c_j G_ij: :func:`covariance_terms` computes the G of a log once, and
 :func:`estimate_covariance` is the sum for any c.
 """
@@ -29,23 +28,21 @@ _REACH = 10
 _TERMS = 5
 
 
-def covariance_terms(sizes, samples, rate_hz, correlation_time):
+def covariance_terms(sizes, samples, rate_hz):
     """G (T, T, 5, 5) [unit⁴ per unit of the c_i c_j]: the covariance of the estimates at cluster ``sizes`` of a log of
-    ``samples`` at ``rate_hz`` for each pair of terms (Q, N, B, K, R) of unit squared coefficients (the bias a
-    Gauss-Markov of ``correlation_time`` [s], or the flicker term when None; the ramp's row is 0)."""
-    gm_time = -1.0 if correlation_time is None else float(correlation_time)
-    return _covariance_terms(np.asarray(sizes, dtype=np.int64), samples, 1.0 / rate_hz, gm_time)
+    ``samples`` at ``rate_hz`` for each pair of terms (Q, N, B, K, R) of unit squared coefficients (the ramp's are 0)."""
+    return _covariance_terms(np.asarray(sizes, dtype=np.int64), samples, 1.0 / rate_hz)
 
 
 def estimate_covariance(terms, coefficients):
-    """Cov(σ̂²_a, σ̂²_b) (T, T) [unit⁴] of a noise of squared ``coefficients`` (Q², N², B² or σ_g², K², R²) from its
+    """Cov(σ̂²_a, σ̂²_b) (T, T) [unit⁴] of a noise of squared ``coefficients`` (Q², N², B², K², R²) from its
     log's :func:`covariance_terms`."""
     c = np.asarray(coefficients, dtype=float)
     return np.einsum("abij,i,j->ab", terms, c, c)
 
 
 @njit
-def _unit_cross(lag, ma, mb, tau0, gm_time, out):
+def _unit_cross(lag, ma, mb, tau0, out):
     """R_ab(lag) of each term of unit coefficient but the quantisation (out[0] = 0): −½ Σ_p Σ_q c_p c_q D_i(...)."""
     weights = (1.0, -2.0, 1.0)
     for i in range(_TERMS):
@@ -57,10 +54,7 @@ def _unit_cross(lag, ma, mb, tau0, gm_time, out):
                 continue
             w = -0.5 * weights[p] * weights[q]
             out[1] += w * s
-            if gm_time > 0.0:
-                out[2] += w * 2.0 * gm_time**2 * (s / gm_time - 1.0 + np.exp(-s / gm_time))
-            else:
-                out[2] -= w * s * s * np.log(s) / np.pi
+            out[2] -= w * s * s * np.log(s) / np.pi
             out[3] -= w * s**3 / 6.0
 
 
@@ -78,7 +72,7 @@ def _quantization_cross(lag, ma, mb):
 
 
 @njit
-def _pair(ma, mb, na, nb, tau0, gm_time):
+def _pair(ma, mb, na, nb, tau0):
     """Σ_l n_ab(l) R_i R_j (5, 5) of one pair of cluster sizes."""
     total = np.zeros((_TERMS, _TERMS))
     r = np.empty(_TERMS)
@@ -90,7 +84,7 @@ def _pair(ma, mb, na, nb, tau0, gm_time):
     for lag in range(low, high + 1, step):
         pairs = min(na, nb - lag) - max(0, -lag)
         if pairs > 0:
-            _unit_cross(lag, ma, mb, tau0, gm_time, r)
+            _unit_cross(lag, ma, mb, tau0, r)
             for i in range(1, _TERMS - 1):  # the quantisation's and the ramp's parts are 0 here
                 for j in range(1, _TERMS - 1):
                     total[i, j] += step * pairs * r[i] * r[j]
@@ -107,7 +101,7 @@ def _pair(ma, mb, na, nb, tau0, gm_time):
                 continue
             seen[count] = lag
             count += 1
-            _unit_cross(lag, ma, mb, tau0, gm_time, r)
+            _unit_cross(lag, ma, mb, tau0, r)
             rq = _quantization_cross(lag, ma, mb)
             for i in range(_TERMS):
                 total[0, i] += pairs * rq * r[i]
@@ -117,14 +111,14 @@ def _pair(ma, mb, na, nb, tau0, gm_time):
 
 
 @njit
-def _covariance_terms(sizes, samples, tau0, gm_time):
+def _covariance_terms(sizes, samples, tau0):
     k = sizes.size
     out = np.zeros((k, k, _TERMS, _TERMS))
     for a in range(k):
         for b in range(a, min(k, a + _REACH + 1)):
             ma, mb = sizes[a], sizes[b]
             na, nb = samples + 1 - 2 * ma, samples + 1 - 2 * mb
-            g = 2.0 * _pair(ma, mb, na, nb, tau0, gm_time) / (4.0 * (ma * tau0) ** 2 * (mb * tau0) ** 2 * na * nb)
+            g = 2.0 * _pair(ma, mb, na, nb, tau0) / (4.0 * (ma * tau0) ** 2 * (mb * tau0) ** 2 * na * nb)
             out[a, b] = g
             out[b, a] = g
     return out
