@@ -20,6 +20,12 @@ order: t (time), gx gy gz (gyro), ax ay az (accelerometer), - (not used); any su
 each sensor's unit: gyro rad/s | deg/s | deg/h | rad | deg (the last two: angle increments per sample),
 accel m/s^2 | g | mg | m/s (velocity increments per sample), time s | ms | us | ns.
 
+It prints each axis's terms (SI) and the block; --out DIR writes DIR/imu.toml (the block: arw_deg_per_sqrt_h,
+rrw_deg_per_h_per_sqrt_h, bias_instability_deg_per_h + bias_correlation_s, quantization_arcsec and the
+accelerometer's vrw_m_per_s_per_sqrt_h, bias_rw_micro_g_per_sqrt_h, bias_instability_micro_g, quantization_m_per_s;
+a term the log does not resolve is 0 with its upper bound in a comment, the rate ramp only in a comment) and
+DIR/fit.json (the curves, bands, EDF, terms with their sigma; docs/design.md).
+
 Example: navsim imu fit static.csv --columns t,gx,gy,gz,ax,ay,az --units gyro=deg/s,accel=g --out fit/ --plot allan.pdf
 """
 

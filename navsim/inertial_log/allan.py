@@ -59,6 +59,6 @@ def _second_differences(phase, sizes):
 
 def chi_square_interval(avar, dof, confidence):
     """The two-sided ``confidence`` interval (low, high) of a variance estimate ``avar`` of ``dof`` equivalent degrees
-    of freedom: ν σ̂² / χ²_(ν, 1−p/2) ≤ σ² ≤ ν σ̂² / χ²_(ν, p/2), p = 1 − confidence (the chi-square interval of Riley 2008, §5.3)."""
+    of freedom: ν σ̂² / χ²_(ν, 1−p/2) ≤ σ² ≤ ν σ̂² / χ²_(ν, p/2), p = 1 − confidence (the chi-square interval of Riley 2008)."""
     p = 1.0 - confidence
     return dof * avar / stats.chi2.ppf(1.0 - p / 2.0, dof), dof * avar / stats.chi2.ppf(p / 2.0, dof)

@@ -8,7 +8,7 @@ structure function D(s), the second differences' cross-covariance is R_ab(l) = �
     Cov(σ̂²_a, σ̂²_b) = 2 Σ_l n_ab(l) R_ab(l)² / (4 τ_a² τ_b² n_a n_b)
 
 with n_ab(l) the pairs (i, i + l) in both sums -- the variance of a quadratic form of Gaussian variables, the sum
-Greenhall & Riley 2003 evaluate for the EDF of one power-law noise (their eq. (7)-(8)); ν = 2 σ⁴ / Var(σ̂²) is its
+Greenhall & Riley 2003 evaluate for the EDF of one power-law noise; ν = 2 σ⁴ / Var(σ̂²) is its
 EDF, here of the fitted mixture. The model's terms (:mod:`.noise_fit`) give D(s): quantisation 2 Q² (s ≠ 0), white
 rate N² |s|, flicker rate −(B²/π) s² ln|s|, rate random walk −K² |s|³/6 (each gives the term's σ²(τ) = (4 D(τ) − D(2τ)) / (2 τ²) of IEEE 952's model; a rate ramp is deterministic and adds
 none). The sum over lags is taken at a step of min(m_a, m_b)/16 (the cluster sizes are powers of two: R_ab is

@@ -1,6 +1,6 @@
 """The IEEE 952 noise model fitted to an Allan variance curve by generalised least squares on its logarithm.
 
-The model (annex C of IEEE 952, eq. (C.12)-(C.16) and their sum; IEEE 1554 §7):
+The model (annex C of IEEE 952: the Allan variance of each noise term and their sum; IEEE 1554 likewise):
 
     σ²(τ) = 3 Q²/τ² + N²/τ + (2 ln 2/π) B² + K² τ/3 + R² τ²/2
 

@@ -6,7 +6,7 @@ into the models of :mod:`navsim.sensors.inertial`, so that each means what the f
 - white noise N: σ_v of the model (σ² = N²/τ), ``arw_deg_per_sqrt_h`` / ``vrw_m_per_s_per_sqrt_h``;
 - rate random walk K: σ_u of the model (σ² = K² τ/3), ``rrw_deg_per_h_per_sqrt_h`` / ``bias_rw_micro_g_per_sqrt_h``;
 - quantisation Q: the model rounds the summed increments to an LSB S, whose error (uniform, S²/12) gives
-  σ² = 3 (S²/12)/τ² (eq. (C.12) of IEEE 952), so S = √12 Q: ``quantization_arcsec`` / ``quantization_m_per_s``;
+  σ² = 3 (S²/12)/τ² (IEEE 952 annex C: Q = S/√12), so S = √12 Q: ``quantization_arcsec`` / ``quantization_m_per_s``;
 - bias instability B: the model's first-order Gauss-Markov bias of steady σ_g and correlation time T, whose Allan
   deviation peaks at 0.6174 σ_g at τ = 1.893 T (the maximum of :func:`navsim.sensors.inertial.allan_variance`;
   IEEE 952 annex C), is set to the flicker floor 0.664 B (``bias_instability_deg_per_h`` / ``_micro_g`` is B:

@@ -111,8 +111,8 @@ def _table(path, variable):
             table = _matlab(path, variable)
         else:
             table = _text(path)
-    except (ValueError, OSError) as error:
-        raise InputError(f"{path}: cannot read the log ({error})") from None
+    except (ValueError, OSError, NotImplementedError) as error:  # NotImplementedError: a MATLAB v7.3 (HDF5) file
+        raise InputError(f"{path}: cannot read the log ({str(error).splitlines()[0] if str(error) else type(error).__name__})") from None
     if table.ndim != 2 or not np.issubdtype(table.dtype, np.number):
         raise InputError(f"{path}: the log must be a 2-D numeric table (one row a sample), got shape {table.shape} "
                          f"of {table.dtype}")
