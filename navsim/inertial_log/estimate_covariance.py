@@ -11,7 +11,8 @@ with n_ab(l) the pairs (i, i + l) in both sums -- the variance of a quadratic fo
 Greenhall & Riley 2003 evaluate for the EDF of one power-law noise; ν = 2 σ⁴ / Var(σ̂²) is its
 EDF, here of the fitted mixture. The model's terms (:mod:`.noise_fit`) give D(s): quantisation 2 Q² (s ≠ 0), white
 rate N² |s|, flicker rate −(B²/π) s² ln|s|, rate random walk −K² |s|³/6 (each gives the term's σ²(τ) = (4 D(τ) − D(2τ)) / (2 τ²) of IEEE 952's model; a rate ramp is deterministic and adds
-none). The sum over lags is taken at a step of min(m_a, m_b)/16 (the cluster sizes are powers of two: R_ab is
+none by itself, but its second differences R τ² shift the noise's, which adds 4 R² τ_a² τ_b² Σ_l n_ab(l) R_ab(l) to the
+numerator above). The sum over lags is taken at a step of min(m_a, m_b)/16 (the cluster sizes are powers of two: R_ab is
 smooth between multiples of it), the quantisation's part, non-zero only at the lags where the two differences share a
 point, exactly at those, over the lags where the two differences share data and 4 (m_a + m_b) more (the flicker
 term's reach); cluster times more than ``_REACH`` octaves apart are taken as uncorrelated. Since R_ab is linear in the squared
@@ -30,7 +31,8 @@ _TERMS = 5
 
 def covariance_terms(sizes, samples, rate_hz):
     """G (T, T, 5, 5) [unit⁴ per unit of the c_i c_j]: the covariance of the estimates at cluster ``sizes`` of a log of
-    ``samples`` at ``rate_hz`` for each pair of terms (Q, N, B, K, R) of unit squared coefficients (the ramp's are 0)."""
+    ``samples`` at ``rate_hz`` for each pair of terms (Q, N, B, K, R) of unit squared coefficients (the ramp's with each
+    noise term; ramp with ramp 0)."""
     return _covariance_terms(np.asarray(sizes, dtype=np.int64), samples, 1.0 / rate_hz)
 
 
@@ -73,8 +75,9 @@ def _quantization_cross(lag, ma, mb):
 
 @njit
 def _pair(ma, mb, na, nb, tau0):
-    """Σ_l n_ab(l) R_i R_j (5, 5) of one pair of cluster sizes."""
+    """Σ_l n_ab(l) R_i R_j (5, 5) and Σ_l n_ab(l) R_i (5) of one pair of cluster sizes."""
     total = np.zeros((_TERMS, _TERMS))
+    linear = np.zeros(_TERMS)
     r = np.empty(_TERMS)
     extra = 4 * (ma + mb)
     step = max(1, ma // _STEPS_PER_CLUSTER)
@@ -86,6 +89,7 @@ def _pair(ma, mb, na, nb, tau0):
         if pairs > 0:
             _unit_cross(lag, ma, mb, tau0, r)
             for i in range(1, _TERMS - 1):  # the quantisation's and the ramp's parts are 0 here
+                linear[i] += step * pairs * r[i]
                 for j in range(1, _TERMS - 1):
                     total[i, j] += step * pairs * r[i] * r[j]
     seen = np.empty(9, dtype=np.int64)
@@ -107,7 +111,8 @@ def _pair(ma, mb, na, nb, tau0):
                 total[0, i] += pairs * rq * r[i]
                 total[i, 0] += pairs * rq * r[i]
             total[0, 0] += pairs * rq * rq
-    return total
+            linear[0] += pairs * rq
+    return total, linear
 
 
 @njit
@@ -118,7 +123,11 @@ def _covariance_terms(sizes, samples, tau0):
         for b in range(a, min(k, a + _REACH + 1)):
             ma, mb = sizes[a], sizes[b]
             na, nb = samples + 1 - 2 * ma, samples + 1 - 2 * mb
-            g = 2.0 * _pair(ma, mb, na, nb, tau0) / (4.0 * (ma * tau0) ** 2 * (mb * tau0) ** 2 * na * nb)
+            quadratic, linear = _pair(ma, mb, na, nb, tau0)
+            g = 2.0 * quadratic / (4.0 * (ma * tau0) ** 2 * (mb * tau0) ** 2 * na * nb)
+            for i in range(_TERMS - 1):  # the ramp's: its second differences R τ² times the noise's, halved for i, j
+                g[i, _TERMS - 1] = 0.5 * linear[i] / (na * nb)
+                g[_TERMS - 1, i] = 0.5 * linear[i] / (na * nb)
             out[a, b] = g
             out[b, a] = g
     return out

@@ -166,11 +166,13 @@ def _solve(columns, target, factor, start):
     def residual(p):
         return linalg.solve_triangular(factor, target - np.log(np.maximum(columns @ (p * scale), 1e-300)), lower=True)
 
-    done = optimize.least_squares(residual, start / scale, bounds=(0.0, np.inf), x_scale="jac", xtol=1e-10,
-                                  ftol=1e-10)
+    def jacobian(c):  # of the residual with respect to c
+        return -linalg.solve_triangular(factor, columns / np.maximum(columns @ c, 1e-300)[:, None], lower=True)
+
+    done = optimize.least_squares(residual, start / scale, jac=lambda p: jacobian(p * scale) * scale,
+                                  bounds=(0.0, np.inf), x_scale="jac", xtol=1e-10, ftol=1e-10)
     c = done.x * scale
-    jacobian = -linalg.solve_triangular(factor, columns / (columns @ c)[:, None], lower=True)
-    return _Solution(c, _sigma(jacobian), float(np.sum(done.fun**2)))
+    return _Solution(c, _sigma(jacobian(c)), float(np.sum(done.fun**2)))
 
 
 def _sigma(jacobian):

@@ -65,8 +65,8 @@ def sensor_figures(fits):
                         for a in present if fits[a].fit.terms[term].resolved]
             bounds = [fits[a].fit.terms[term].upper_bound / size for a in present if not fits[a].fit.terms[term].resolved]
             value, sigma, axis = max(resolved) if resolved else (None, None, None)
-            figures[term] = {"key": key, "unit": unit, "value": value, "sigma": sigma, "axis": axis,
-                             "upper_bound": max(bounds) if bounds and not resolved else None}
+            figures[term] = {"key": key, "unit": unit, "value": value, "sigma": _finite(sigma), "axis": axis,
+                             "upper_bound": _finite(max(bounds)) if bounds and not resolved else None}
         if figures["B"]["value"] is not None:
             axis = fits[figures["B"]["axis"]]
             tau_min = axis.tau[int(np.argmin(axis.fit.avar(axis.tau)))]
@@ -105,6 +105,11 @@ def _number(value):
     return f"{value:.4g}" if value is not None else "inf"
 
 
+def _finite(value):
+    """``value``, or None when it is not a finite number (a bound the log cannot set: strict JSON has no inf)."""
+    return value if value is not None and np.isfinite(value) else None
+
+
 def summary(log, fits, figures, source, block):
     """The JSON summary (``FORMAT``): the log, each axis's curve, interval, EDF and terms (SI), the sensors'
     figures (the keys' units) and the block."""
@@ -114,7 +119,7 @@ def summary(log, fits, figures, source, block):
             "tau_s": axis.tau.tolist(), "adev": axis.adev.tolist(), "adev_low": axis.low.tolist(),
             "adev_high": axis.high.tolist(), "dof": axis.fit.dof.tolist(), "fit_adev": np.sqrt(axis.fit.avar(axis.tau)).tolist(),
             "chi_square": axis.fit.chi_square, "fit_dof": axis.fit.fit_dof,
-            "terms_si": {term: {"value": t.value, "sigma": t.sigma, "upper_bound": t.upper_bound}
+            "terms_si": {term: {"value": t.value, "sigma": _finite(t.sigma), "upper_bound": _finite(t.upper_bound)}
                          for term, t in axis.fit.terms.items()},
         }
     return {"format": FORMAT, "log": {"source": str(source), "rate_hz": log.rate_hz, "samples": log.samples,

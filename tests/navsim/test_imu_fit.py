@@ -1,6 +1,6 @@
 """navsim.inertial_log: the Allan deviation against allantools, the estimates' covariance against the exact
 quadratic forms and Greenhall's EDF, and the noise fit on logs of the project's own sensor models of known
-parameters (each recovered within 3 of its stated σ on >= 95 % of seeds), whose [imu] block the scenarios take and
+parameters and a rate ramp (each recovered within 3 of its stated σ on >= 95 % of seeds), whose [imu] block the scenarios take and
 whose model's curve lies in the log's band."""
 
 import re
@@ -53,9 +53,10 @@ def test_overlapping_adev_is_allantools_oadev():
 
 
 def test_estimate_covariance_is_the_exact_covariance_of_the_quadratic_forms():
-    """2 tr(A_a Σ A_b Σ) of a 40-sample log of white rate, the model's interval-mean rate random walk and white
-    angle (quantisation) noise, built as explicit matrices (every lag is summed there: rounding level)."""
-    n, c = 40, np.array([0.3, 1.0, 0.0, 0.2, 0.0])
+    """2 tr(A_a Σ A_b Σ) + 4 μᵀ A_a Σ A_b μ of a 40-sample log of white rate, the model's interval-mean rate random
+    walk, white angle (quantisation) noise and a rate ramp (the phase's mean μ), built as explicit matrices (every
+    lag is summed there: rounding level)."""
+    n, c = 40, np.array([0.3, 1.0, 0.0, 0.2, 0.1])
     sizes = allan.cluster_sizes(n)
     k = np.arange(n)
     lower = np.minimum.outer(k, k)
@@ -68,7 +69,9 @@ def test_estimate_covariance_is_the_exact_covariance_of_the_quadratic_forms():
         d = np.array([np.eye(n + 1)[i + 2 * m] - 2 * np.eye(n + 1)[i + m] + np.eye(n + 1)[i] for i in range(n + 1 - 2 * m)])
         return d.T @ d / (2.0 * m**2 * (n + 1 - 2 * m))
 
-    exact = np.array([[2.0 * np.trace(quadratic(a) @ phase @ quadratic(b) @ phase) for b in sizes] for a in sizes])
+    mean = np.sqrt(c[4]) * np.arange(n + 1) ** 2 / 2.0  # Σ_(k<i) of the ramp's interval means R (k + ½)
+    exact = np.array([[2.0 * np.trace(quadratic(a) @ phase @ quadratic(b) @ phase)
+                       + 4.0 * mean @ quadratic(a) @ phase @ quadratic(b) @ mean for b in sizes] for a in sizes])
     np.testing.assert_allclose(estimate_covariance(covariance_terms(sizes, n, 1.0), c), exact, rtol=1e-10)
 
 
@@ -85,31 +88,35 @@ def test_edf_of_one_noise_is_greenhalls(term, alpha):
     np.testing.assert_allclose(dof, greenhall, rtol=0.03)
 
 
-def _coverage(model, seeds, samples):
-    """The fraction of seeds whose Q, N, K all lie within 3 of their stated σ, and whose B and R are not resolved."""
-    truth, good = _truth(model), 0
-    force = np.zeros((samples, 3))
+#: A gyro of white noise only, and the rate ramp [rad/s²] added to its log (the models have none).
+WHITE, RAMP = GyroModel(rate_hz=RATE_HZ, arw=ARW), 1e-7
+CASES = {"gyro": (GYRO, 0.0), "accelerometer": (ACCELEROMETER, 0.0), "ramp": (WHITE, RAMP)}
+
+
+def _coverage(case, seeds, samples):
+    """The fraction of seeds whose terms all lie within 3 of their stated σ (Q, N, K of the model, R of the ramp),
+    the terms absent from the log not resolved."""
+    model, ramp = CASES[case]
+    truth = {t: v for t, v in {**_truth(model), "B": 0.0, "R": ramp}.items() if v > 0.0}
+    good = 0
     for seed in seeds:
-        fit = _fit_axis(model.measure(force, np.random.SeedSequence(seed)).__dict__[_field(model)][:, seed % 3])
-        inside = all(fit.terms[t].resolved and abs(fit.terms[t].value - v) <= 3.0 * fit.terms[t].sigma
-                     for t, v in truth.items())
-        good += inside and not fit.terms["B"].resolved and not fit.terms["R"].resolved
+        record = model.measure(np.zeros((samples, 3)), np.random.SeedSequence(seed))
+        rates = (record.omega if isinstance(model, GyroModel) else record.force)[:, seed % 3]
+        fit = _fit_axis(rates + ramp * (np.arange(samples) + 0.5) / RATE_HZ)
+        good += all(fit.terms[t].resolved == (t in truth) for t in noise_fit.TERMS) and all(
+            abs(fit.terms[t].value - v) <= 3.0 * fit.terms[t].sigma for t, v in truth.items())
     return good / len(seeds)
 
 
-def _field(model):
-    return "omega" if isinstance(model, GyroModel) else "force"
-
-
-@pytest.mark.parametrize("model", [GYRO, ACCELEROMETER], ids=["gyro", "accelerometer"])
-def test_the_fit_gives_the_models_parameters_back(model):
-    assert _coverage(model, range(20), 2**17) >= 0.95
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_fit_gives_the_models_parameters_back(case):
+    assert _coverage(case, range(20), 2**17) >= 0.95
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("model", [GYRO, ACCELEROMETER], ids=["gyro", "accelerometer"])
-def test_the_fit_gives_the_models_parameters_back_on_many_long_logs(model):
-    assert _coverage(model, range(100, 200), 2**19) >= 0.95
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_fit_gives_the_models_parameters_back_on_many_long_logs(case):
+    assert _coverage(case, range(100, 200), 2**19) >= 0.95
 
 
 def _fits(seed, samples=2**18):
