@@ -10,7 +10,8 @@ deg/s, 3 accelerometer axes in m/s²): a 3-hour 100 Hz log (1.08e6 samples x 6 a
 
     python benchmarks/imu_fit.py [--repeats 3]
 
-Prints a table and writes benchmarks/results/imu_fit.json. Asserts nothing.
+Prints a table and writes benchmarks/results/imu_fit.json (with the machine's load average: the cores may be
+shared). Asserts nothing.
 """
 
 import argparse
@@ -89,7 +90,7 @@ def main():
                   f"{difference:.1e})", flush=True)
     result = {"benchmark": "imu_fit", "rate_hz": RATE_HZ, "repeats": args.repeats, "logs": rows,
               "machine": {"python": platform.python_version(), "processor": platform.processor() or platform.machine(),
-                          "cpus": os.cpu_count()}}
+                          "cpus": os.cpu_count(), "load_average_1_5_15_min": os.getloadavg()}}
     path = ROOT / "benchmarks" / "results" / "imu_fit.json"
     path.write_text(json.dumps(result, indent=2) + "\n")
     print(f"written to {path}")

@@ -31,7 +31,7 @@ FORMAT = "navsim.imu-fit/1"
 GAUSS_MARKOV_PEAK_TAU = 1.8926
 _SQRT12 = np.sqrt(12.0)
 
-#: Per sensor: {term: (scenario key, SI -> key unit factor divisor, the unit in words)}; the ramp's key is the summary's.
+#: Per sensor: {term: (its key, the SI size of one of the key's units, that unit)}; the ramp's key is the summary's only.
 KEYS = {
     "gyro": {
         "Q": ("quantization_arcsec", units.ARCSEC / _SQRT12, "arcsec (LSB)"),
