@@ -16,7 +16,7 @@ their 1-sigma, and the [imu] block a scenario takes (the worst axis of each sens
 
 The log: CSV/TXT (comma, semicolon, tab or blank separated; header lines skipped), .npy, .npz or .mat (one 2-D
 array, one row a sample; --variable names it in an .npz/.mat holding several). --columns names each column in
-order: t (time), gx gy gz (gyro), ax ay az (accelerometer), - (not used); any subset of the axes. --units gives
+order: t (time), gx gy gz (gyro), ax ay az (accelerometer), skip (not used); any subset of the axes. --units gives
 each sensor's unit: gyro rad/s | deg/s | deg/h | rad | deg (the last two: angle increments per sample),
 accel m/s^2 | g | mg | m/s (velocity increments per sample), time s | ms | us | ns.
 

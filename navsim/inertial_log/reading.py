@@ -3,7 +3,7 @@
 A log is a table of samples, one row each: CSV/TXT (comma, semicolon, tab or blank separated; header and ``#``
 lines before the numbers skipped), NumPy ``.npy`` (a 2-D array), ``.npz`` or MATLAB ``.mat`` (a 2-D array named by
 ``variable``, or the only one). The column map names each column in order: ``t`` (time), ``gx gy gz`` (gyro),
-``ax ay az`` (accelerometer), ``-`` (a column not used). Units: gyro ``rad/s``, ``deg/s``, ``deg/h`` (rates) or
+``ax ay az`` (accelerometer), ``skip`` (a column not used). Units: gyro ``rad/s``, ``deg/s``, ``deg/h`` (rates) or
 ``rad``, ``deg`` (angle increments per sample); accelerometer ``m/s^2``, ``g``, ``mg`` (specific force) or ``m/s``
 (velocity increments per sample); time ``s``, ``ms``, ``us``, ``ns``. The sample rate comes from the time column
 or from ``rate_hz``.
@@ -18,7 +18,7 @@ from startrack import InputError, units
 
 #: The names a column map may use, and the axes of each sensor.
 AXES = {"gyro": ("gx", "gy", "gz"), "accelerometer": ("ax", "ay", "az")}
-TIME, SKIP = "t", "-"
+TIME, SKIP = "t", "skip"
 #: Each unit as (factor to SI, whether it is an increment per sample).
 GYRO_UNITS = {"rad/s": (1.0, False), "deg/s": (units.DEG, False), "deg/h": (units.DEG / units.HOUR, False),
               "rad": (1.0, True), "deg": (units.DEG, True)}
@@ -48,7 +48,7 @@ def parse_columns(text):
     known = {TIME, SKIP, *AXES["gyro"], *AXES["accelerometer"]}
     for name in names:
         if name not in known:
-            raise InputError(f"--columns: unknown column {name!r}; use t, gx, gy, gz, ax, ay, az or - (not used)")
+            raise InputError(f"--columns: unknown column {name!r}; use t, gx, gy, gz, ax, ay, az or skip (not used)")
     repeated = sorted({n for n in names if n != SKIP and names.count(n) > 1})
     if repeated:
         raise InputError(f"--columns: {', '.join(repeated)} named more than once")
@@ -111,6 +111,8 @@ def _table(path, variable):
             table = _matlab(path, variable)
         else:
             table = _text(path)
+    except InputError:  # already one line naming the problem (an InputError is a ValueError)
+        raise
     except (ValueError, OSError, NotImplementedError) as error:  # NotImplementedError: a MATLAB v7.3 (HDF5) file
         raise InputError(f"{path}: cannot read the log ({str(error).splitlines()[0] if str(error) else type(error).__name__})") from None
     if table.ndim != 2 or not np.issubdtype(table.dtype, np.number):

@@ -86,6 +86,14 @@ def test_a_log_too_short_for_any_cluster(tmp_path):
     assert "too short for the Allan fit" in _fails(tmp_path, _log(10))
 
 
-def test_an_npz_with_several_arrays_needs_its_variable(tmp_path):
-    np.savez(tmp_path / "log.npz", imu=_log(2**10), other=np.zeros(3))
-    assert "name the log's with --variable" in _fails(tmp_path, tmp_path / "log.npz")
+
+
+def test_a_matlab_file_with_several_variables_needs_its_variable_and_a_skipped_column(tmp_path):
+    from scipy import io
+
+    io.savemat(tmp_path / "log.mat", {"imu": _log(2**10), "other": np.zeros(2)})
+    assert "holds imu, other; name the log's with --variable" in _fails(tmp_path, tmp_path / "log.mat")
+    done = navsim_cli("imu", "fit", tmp_path / "log.mat", "--variable", "imu", "--columns", "skip,gx,gy,gz,skip,skip,skip",
+                      "--rate-hz", RATE_HZ, "--units", "gyro=deg/s")
+    assert done.returncode == 0, done.stderr
+    assert "gyro = {" in done.stdout and "accelerometer" not in done.stdout.split("[imu]")[1]
