@@ -9,6 +9,8 @@
     navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
                  [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
     navsim sky SCENARIO.toml [--set key=value ...] [--report FILE.pdf]
+    navsim imu fit LOG [--columns t,gx,gy,gz,ax,ay,az] [--units gyro=U,accel=U,time=U] [--rate-hz F] [--variable NAME]
+                   [--out DIR] [--plot FILE.pdf|.png]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -302,7 +304,15 @@ def build_parser():
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.add_argument("--report", default=None, metavar="FILE.pdf", help="also typeset the availability as a PDF")
     p.set_defaults(func=_sky)
+    _add_imu_command(sub)
     return parser
+
+
+def _add_imu_command(sub):
+    """``navsim imu fit`` (:mod:`navsim.imu_command`, imported when it runs)."""
+    from navsim import imu_command
+
+    imu_command.add_parser(sub)
 
 
 def _add_sizing_commands(sub):

@@ -17,7 +17,7 @@ FLOORS = (
     {"kinematics", "kinematics_jit", "earth", "scenario"},   # geometry, numerics, the scenario files' machinery
     {"orbit"},                                               # a spacecraft's orbit and what it sees of the Earth
     {"truth", "sensors", "ins"},                             # the truth, the sensor models, the strapdown INS
-    {"estimation"},                                          # the filters
+    {"estimation", "inertial_log"},                          # the filters; the sensors' noise from recorded logs
     {"closed_loop", "records", "output", "places", "pooling", "analysis"},
     {"studies"},                                             # the source documents' experiments
     {"build", "typeset", "star_run"},                        # what the run kinds share
@@ -25,7 +25,7 @@ FLOORS = (
     {"spacecraft"},                                          # the run kind that builds on the attitude kind
     {"kinds"},                                               # their registry
     {"simulation"},                                          # the front door
-    {"campaign", "report"},
+    {"campaign", "report", "imu_command"},
     {"cli"},
 )
 FLOOR = {name: level for level, names in enumerate(FLOORS) for name in names}
