@@ -9,6 +9,7 @@
     navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
                  [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
     navsim sky SCENARIO.toml [--set key=value ...] [--report FILE.pdf]
+    navsim replay REPLAY.toml --out DIR [--set key=value ...]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -221,6 +222,16 @@ def _sky(args):
     return 0
 
 
+def _replay(args):
+    from navsim.replay import output, summary
+
+    check_output(args.out, "replay")
+    data, result, series = output.replay(args.replay, args.set or ())
+    out = publish(args.out, "replay", lambda directory: output.write(directory, data, result, series))
+    print("\n".join(summary.lines(result) + [f"written to          {out}"]))
+    return 0
+
+
 def _sweep(args):
     from navsim.campaign.sweep import parse_vary, run_sweep
     from navsim.report import write_report
@@ -302,6 +313,13 @@ def build_parser():
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
     p.add_argument("--report", default=None, metavar="FILE.pdf", help="also typeset the availability as a PDF")
     p.set_defaults(func=_sky)
+
+    p = sub.add_parser("replay", help="a recorded IMU through the strapdown INS and the navigation filter, aided by its "
+                                      "GNSS fixes outside simulated outages; the error against the fixes held out")
+    p.add_argument("replay", help="replay TOML file (a [replay] table)")
+    p.add_argument("--out", required=True, help="output directory (summary.json, timeseries.npz)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a replay value (repeatable)")
+    p.set_defaults(func=_replay)
     return parser
 
 
