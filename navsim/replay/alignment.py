@@ -6,9 +6,11 @@ rest, the heading from the GNSS velocity once the car moves.
 - levelling: the mean specific force f̄ of a span at rest gives roll φ = atan2(−f̄_y, −f̄_z) and pitch
   θ = atan(f̄_x / √(f̄_y² + f̄_z²)) (Groves, 2nd ed., eqs. (5.101)-(5.102), body axes forward-right-down); the heading
   is unknown there (a MEMS gyro cannot gyrocompass) and left 0;
-- heading: at the first fix with a horizontal speed of at least ``min_speed`` the heading is the course
+- heading: at the first fix with a horizontal speed of at least ``heading_speed_m_per_s`` the heading is the course
   ψ = atan2(v_E, v_N) (a car moves along its body x axis; the sideslip and the mounting's residual yaw are the
-  heading's error, its initial σ), applied as a turn of the attitude about the local vertical.
+  heading's error, its initial σ); the filter starts with the heading the gyros' yaw from the start to that fix
+  turns into it (:func:`start_heading`), so that it never integrates the first metres in a wrong direction (a replay
+  is post-processing: it may look seconds ahead for its alignment).
 """
 
 import numpy as np
@@ -39,13 +41,12 @@ def q_nb(roll, pitch, yaw):
     return rot.from_matrix(euler_matrix(roll, pitch, yaw).T)
 
 
-def heading_turn(q_nb_now, course):
-    """The rotation vector (3,) [rad, body axes] that turns the attitude ``q_nb_now`` about the local vertical so that
-    its heading becomes ``course`` [rad]: q(C_nb r) ⊗ q_nb = q_nb ⊗ q(r) with C_nb r = [0, 0, Δψ]."""
-    C_nb = rot.to_matrix(q_nb_now)
-    heading = np.arctan2(C_nb[1, 0], C_nb[0, 0])
-    turn = (course - heading + np.pi) % (2.0 * np.pi) - np.pi
-    return C_nb.T @ np.array([0.0, 0.0, turn])
+def start_heading(course, q_level, gyro, dt):
+    """ψ0 [rad]: the heading at the start that the gyros ``gyro`` (K, 3) [rad/s], of intervals ``dt`` [s] from the start
+    to the aligning fix, turn into the GNSS ``course`` [rad] there: ψ0 = course − Σ (C_nb ω_b)_D dt, C_nb the levelled
+    attitude ``q_level`` (the yaw rate about the local vertical; the Earth's rate, < 0.01 deg/min, left out)."""
+    turned = float(np.sum(gyro @ rot.to_matrix(q_level)[2])) * dt
+    return (course - turned + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def rest_span(fixes, start, seconds, max_speed):

@@ -23,14 +23,17 @@ POS_COLUMNS = ("lat_deg", "lon_deg", "h_m", "quality", "satellites", "sd_n_m", "
                "sd_vn_m_per_s", "sd_ve_m_per_s", "sd_vu_m_per_s")
 #: The names a CSV column map may use (time, position, its σ, optionally quality and NED velocity).
 CSV_COLUMNS = ("time_s", "lat_deg", "lon_deg", "h_m", "sd_n_m", "sd_e_m", "sd_u_m", "quality", "v_n_m_per_s",
-               "v_e_m_per_s", "v_u_m_per_s")
+               "v_e_m_per_s", "v_u_m_per_s", "sd_vn_m_per_s", "sd_ve_m_per_s", "sd_vu_m_per_s")
+#: The velocity's columns and their σ's: all or none.
+_VELOCITY = ("v_n_m_per_s", "v_e_m_per_s", "v_u_m_per_s", "sd_vn_m_per_s", "sd_ve_m_per_s", "sd_vu_m_per_s")
 _REQUIRED = ("time_s", "lat_deg", "lon_deg", "h_m", "sd_n_m", "sd_e_m", "sd_u_m")
 
 
 @dataclass(frozen=True)
 class Fixes:
     """Fixes in time order: ``t`` [s] (GPST since 1970 for a .pos), ``lat``, ``lon`` [rad], ``h`` [m], ``sigma`` (N, 3)
-    [m] NED, ``quality`` (N,) and ``v_n`` (N, 3) [m/s] NED (None when the file has no velocity)."""
+    [m] NED, ``quality`` (N,), ``v_n`` (N, 3) [m/s] NED and its σ ``v_sigma`` (N, 3) [m/s] (both None when the file
+    has no velocity)."""
 
     t: np.ndarray
     lat: np.ndarray
@@ -39,6 +42,7 @@ class Fixes:
     sigma: np.ndarray
     quality: np.ndarray
     v_n: np.ndarray | None
+    v_sigma: np.ndarray | None
 
     def __len__(self):
         return self.t.size
@@ -46,7 +50,7 @@ class Fixes:
     def subset(self, keep):
         """The fixes where the mask ``keep`` holds."""
         return Fixes(self.t[keep], self.lat[keep], self.lon[keep], self.h[keep], self.sigma[keep], self.quality[keep],
-                     None if self.v_n is None else self.v_n[keep])
+                     None if self.v_n is None else self.v_n[keep], None if self.v_n is None else self.v_sigma[keep])
 
 
 def gpst_seconds(date, time):
@@ -102,6 +106,10 @@ def read_csv(path, columns, qualities=(1,)):
         raise InputError(f"{path}: {table.shape[1]} columns, gnss.columns names {len(columns)}")
     named = {c: table[:, i] for i, c in enumerate(columns) if c != "-"}
     named.setdefault("quality", np.ones(table.shape[0]))
+    given = [c for c in _VELOCITY if c in named]
+    if given and len(given) < len(_VELOCITY):
+        raise InputError(f"gnss.columns: a velocity needs all of {', '.join(_VELOCITY)}; "
+                         f"{next(c for c in _VELOCITY if c not in named)!r} is missing")
     return _fixes(path, named, qualities)
 
 
@@ -127,8 +135,11 @@ def _fixes(path, named, qualities):
     sigma = np.stack([named["sd_n_m"], named["sd_e_m"], named["sd_u_m"]], axis=1)
     if not (sigma > 0.0).all():
         raise InputError(f"{path}: a stated position sigma (sdn, sde, sdu) is not > 0")
-    velocity = None
-    if "v_n_m_per_s" in named:  # NEU in the file, NED here
+    velocity = v_sigma = None
+    if "sd_vu_m_per_s" in named:  # NEU in the file, NED here
         velocity = np.stack([named["v_n_m_per_s"], named["v_e_m_per_s"], -named["v_u_m_per_s"]], axis=1)
+        v_sigma = np.stack([named["sd_vn_m_per_s"], named["sd_ve_m_per_s"], named["sd_vu_m_per_s"]], axis=1)
+        if not (v_sigma > 0.0).all():
+            raise InputError(f"{path}: a stated velocity sigma (sdvn, sdve, sdvu) is not > 0")
     return Fixes(t=named["time_s"], lat=units.deg_to_rad(named["lat_deg"]), lon=units.deg_to_rad(named["lon_deg"]),
-                 h=named["h_m"], sigma=sigma, quality=named["quality"].astype(int), v_n=velocity)
+                 h=named["h_m"], sigma=sigma, quality=named["quality"].astype(int), v_n=velocity, v_sigma=v_sigma)

@@ -1,6 +1,7 @@
 """A replay's run directory: ``scenario.json`` (the checked replay file), ``summary.json``
 (:func:`navsim.replay.summary.summarize`) and ``timeseries.npz`` (the per-fix-epoch log of :mod:`navsim.replay.run`:
-t [s after the start], lat, lon [rad], h [m], v_n, q_nb, sigma_ned, error_ned [m], accepted, nis, outage, held_out),
+t [s after the start], lat, lon [rad], h [m], v_n, q_nb, sigma_ned, error_ned [m], accepted, nis, gyro_bias [rad/s],
+accel_bias [m/s²], sigma_bias (ε, ∇), outage, held_out),
 written by :func:`navsim.output.write_npz` (no pickle)."""
 
 from pathlib import Path

@@ -3,8 +3,8 @@
 the fixes inside them are the reference the filter's error is measured against.
 
 The filter starts at the first fix at or after the IMU's first row, at rest: position that fix's, velocity zero,
-level from the accelerometers over ``alignment.level_s`` (:func:`navsim.replay.alignment.level`), heading 0 until the
-first fix at ``heading_speed_m_per_s`` turns it to the GNSS course. The IMU is mechanized on its uniform grid
+level from the accelerometers over ``alignment.level_s`` (:func:`navsim.replay.alignment.level`), heading the one the
+gyros turn into the GNSS course at the first fix at ``heading_speed_m_per_s`` (:func:`navsim.replay.alignment.start_heading`). The IMU is mechanized on its uniform grid
 (:mod:`navsim.replay.recording`); a fix at time t_f is applied at the IMU interval's end t_k nearest to it, moved to
 t_k along its own velocity (else the filter's): p_f + v (t_k − t_f), so that the grid's half-interval (up to 8 cm at
 16 m/s and 100 Hz) is not an error. Every fix epoch is logged (the filter's solution and σ before the update) with
@@ -47,10 +47,14 @@ def read(config):
                              imu_table["time_offset_s"])
     C_b_imu = alignment.euler_matrix(*units.deg_to_rad(imu_table["mounting_rpy_deg"]))
     body = np.concatenate([imu.samples[:, 0:3] @ C_b_imu.T, imu.samples[:, 3:6] @ C_b_imu.T], axis=1)
-    imu = recording.ImuRecording(t0=imu.t0, dt=imu.dt, samples=body, filled=imu.filled, gaps=imu.gaps)
+    keep = body.shape[0] if imu_table["duration_s"] is None else min(body.shape[0], round(imu_table["duration_s"] / imu.dt))
+    imu = recording.ImuRecording(t0=imu.t0, dt=imu.dt, samples=body[:keep], filled=imu.filled[:keep],
+                                 gaps=imu.gaps[imu.gaps[:, 0] < imu.t0 + keep * imu.dt])
     solution = (fixes.read_pos(gnss["file"], tuple(gnss["qualities"])) if gnss["format"] == "rtklib_pos"
                 else fixes.read_csv(gnss["file"], gnss["columns"], tuple(gnss["qualities"])))
     solution = solution.subset((solution.t >= imu.t0) & (solution.t <= imu.end))
+    if gnss["use_velocity"] and solution.v_n is None:
+        raise InputError(f"{gnss['file']}: replay.gnss.use_velocity, but the solution has no velocity columns")
     if len(solution) < 2:
         raise InputError(f"{gnss['file']}: fewer than two fixes inside the IMU log's time "
                          f"({imu.t0:.3f} to {imu.end:.3f} s); check the time tags and time_offset_s")
@@ -88,12 +92,15 @@ def filter_config(replay):
 
 
 def initial_filter(replay):
-    """The :class:`NavFilter` at the replay's start: the first fix, at rest, levelled (module docstring)."""
-    imu, k0 = replay.imu, replay.k0
-    span = imu.samples[k0:k0 + max(1, round(replay.level_end / imu.dt)), 3:6]
-    roll, pitch = alignment.level(span)
-    f = replay.fixes
-    return NavFilter(f.lat[0], f.lon[0], f.h[0], np.zeros(3), alignment.q_nb(roll, pitch, 0.0), filter_config(replay))
+    """The :class:`NavFilter` at the replay's start: the first fix, at rest, levelled, its heading the one the gyros
+    turn into the GNSS course at the aligning fix (module docstring)."""
+    imu, k0, f = replay.imu, replay.k0, replay.fixes
+    roll, pitch = alignment.level(imu.samples[k0:k0 + max(1, round(replay.level_end / imu.dt)), 3:6])
+    j = int(np.searchsorted(f.t, replay.start + replay.aligned - 1e-9))
+    course = float(np.arctan2(*alignment.velocity_ne(f)[j, ::-1]))
+    k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
+    heading = alignment.start_heading(course, alignment.q_nb(roll, pitch, 0.0), imu.samples[k0:k_j, 0:3], imu.dt)
+    return NavFilter(f.lat[0], f.lon[0], f.h[0], np.zeros(3), alignment.q_nb(roll, pitch, heading), filter_config(replay))
 
 
 def simulate(replay):
@@ -106,9 +113,9 @@ def simulate(replay):
     free = replay.config["outages"]["free_ins"]
     held = (window >= 0) | (free & (t_rel > replay.aligned))
     k = replay.k0
-    log = {name: [] for name in ("t", "lat", "lon", "h", "v_n", "q_nb", "sigma_ned", "error_ned", "accepted", "nis")}
-    course = np.arctan2(*alignment.velocity_ne(f)[:, ::-1].T)
-    aligned, floor = False, replay.config["gnss"]["sigma_floor_m"]
+    log = {name: [] for name in ("t", "lat", "lon", "h", "v_n", "q_nb", "sigma_ned", "error_ned", "accepted", "nis",
+                                 "gyro_bias", "accel_bias", "sigma_bias")}
+    floor, velocity = replay.config["gnss"]["sigma_floor_m"], replay.config["gnss"]["use_velocity"]
     for j in range(1, len(f)):
         k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
         if k_j > k:
@@ -116,12 +123,11 @@ def simulate(replay):
             k = k_j
         t_state = imu.t0 + k * imu.dt
         lat, lon, h = _moved_fix(f, j, nav, t_state - f.t[j])
-        before = (nav.position, nav.v_n, nav.q_nb, nav.P)
+        before = (nav.position, nav.v_n, nav.q_nb, nav.P, nav.gyro_bias, nav.accel_bias)
         error = ned_offset(*before[0], lat, lon, h)
         result = None if held[j] else nav.update_position(lat, lon, h, np.maximum(f.sigma[j], floor))
-        if not aligned and t_rel[j] >= replay.aligned - 1e-9:
-            nav.disturb(alignment.heading_turn(nav.q_nb, course[j]))
-            aligned = True
+        if velocity and not held[j]:
+            nav.update_velocity(f.v_n[j], f.v_sigma[j])
         _log_epoch(log, t_rel[j], before, error, result)
         if k >= imu.samples.shape[0]:
             break
@@ -142,9 +148,10 @@ def _moved_fix(f, j, nav, lag):
 
 
 def _log_epoch(log, t, before, error, result):
-    """Append one fix epoch: the solution before the update ``before`` ((L, λ, h), v_n, q_nb, P), its NED position σ,
-    the error against the fix, whether it was used and accepted (−1: held out) and its NIS (NaN: held out)."""
-    (lat, lon, h), v_n, q_nb, P = before
+    """Append one fix epoch: the solution before the update ``before`` ((L, λ, h), v_n, q_nb, P, b̂_g, b̂_a), its NED
+    position σ and the biases' σ, the error against the fix, whether it was used and accepted (−1: held out) and its
+    NIS (NaN: held out)."""
+    (lat, lon, h), v_n, q_nb, P, gyro_bias, accel_bias = before
     log["t"].append(t)
     log["lat"].append(lat)
     log["lon"].append(lon)
@@ -152,6 +159,9 @@ def _log_epoch(log, t, before, error, result):
     log["v_n"].append(v_n)
     log["q_nb"].append(q_nb)
     log["sigma_ned"].append(np.sqrt(np.diag(P)[6:9]))
+    log["gyro_bias"].append(gyro_bias)
+    log["accel_bias"].append(accel_bias)
+    log["sigma_bias"].append(np.sqrt(np.diag(P)[9:15]))
     log["error_ned"].append(error)
     log["accepted"].append(-1 if result is None else int(result.accepted[0]))
     log["nis"].append(np.nan if result is None else float(result.nis[0]))

@@ -4,8 +4,10 @@ schema (:mod:`navsim.scenario.schema`): every problem one :class:`InputError` na
 
     name = "car"
     [replay.imu]       file, columns, quantity, accel_unit, gyro_unit, time_unit, time_tag_file, time_offset_s,
-                       mounting_rpy_deg (the IMU's axes to the body's, Groves eq. 2.22)
-    [replay.gnss]      file, format ("rtklib_pos" | "csv"), columns (csv), qualities
+                       mounting_rpy_deg (the IMU's axes to the body's, Groves eq. 2.22), duration_s (replay only
+                       the first seconds of the log)
+    [replay.gnss]      file, format ("rtklib_pos" | "csv"), columns (csv), qualities, sigma_floor_m (a floor under
+                       the stated position σ), use_velocity (update with the fixes' velocity and its σ too)
     [replay.alignment] level_s, rest_speed_m_per_s, heading_speed_m_per_s
     [replay.filter]    initial σ, the IMU noise the filter assumes, covariance_interval, gate_probability
     [replay.outages]   windows = [{start_s, duration_s}, ...] and/or schedule = {first_s, lengths_s, spacing_s}
@@ -37,6 +39,7 @@ SCHEMA = Table({
             "time_tag_file": Value("str", default=""),
             "time_offset_s": Value("float", default=0.0, minimum=-10.0, maximum=10.0),
             "mounting_rpy_deg": Value("vector", default=[0.0, 0.0, 0.0], minimum=-360.0, maximum=360.0),
+            "duration_s": Value("float", default=None, exclusive_minimum=0.0),
         }),
         "gnss": Table({
             "file": Value("str"),
@@ -44,6 +47,7 @@ SCHEMA = Table({
             "columns": Value("strs", default=[], choices=(*fixes.CSV_COLUMNS, "-")),
             "qualities": Value("ints", default=[1], min_length=1, minimum=0),
             "sigma_floor_m": Value("float", default=0.0, minimum=0.0, maximum=100.0),
+            "use_velocity": Value("bool", default=False),
         }),
         "alignment": Table({
             "level_s": _positive(10.0, maximum=600.0),
