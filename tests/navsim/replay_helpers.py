@@ -32,7 +32,8 @@ def car_truth():
 
 
 def write_recording(directory, truth, seed=5, drop=()):
-    """Write ``imu.csv`` (increments in the mounted IMU's axes, time [s]; rows ``drop`` left out: a gap) and
+    """Write ``imu.csv`` (increments in the mounted IMU's axes, time [s]; the rows ``drop`` (consecutive) left out, their
+    increments in the row after them, as an accumulating IMU's after lost packets: a gap) and
     ``fixes.csv`` (4 Hz, with σ) of ``truth`` into ``directory``; returns their paths."""
     directory = Path(directory)
     gyro_rng, accel_rng, fix_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3))
@@ -42,7 +43,9 @@ def write_recording(directory, truth, seed=5, drop=()):
     C_imu_b = euler_matrix(*units.deg_to_rad(MOUNTING_RPY_DEG)).T
     rows = np.concatenate([dv @ C_imu_b.T, dtheta @ C_imu_b.T, truth.t[1:, None] + T0], axis=1)
     rows = np.concatenate([[[0.0] * 6 + [T0]], rows])  # the first row: the clock's start, its increments unused
-    rows = np.delete(rows, list(drop), axis=0)
+    if len(drop):
+        rows[max(drop) + 1, :6] += rows[list(drop), :6].sum(axis=0)
+        rows = np.delete(rows, list(drop), axis=0)
     imu = directory / "imu.csv"
     np.savetxt(imu, rows, delimiter=",", fmt="%.12g")
     every = int(round(RATE_HZ / FIX_HZ))
