@@ -9,7 +9,7 @@
     navsim sweep SCENARIO.toml --vary KEY=V1,V2,... [--vary ...] --metric NAME[@TIME] --out DIR [--requirement VALUE]
                  [--method covariance | --method montecarlo --runs N] [--workers K | --scheduler tcp://HOST:PORT]
     navsim sky SCENARIO.toml [--set key=value ...] [--report FILE.pdf]
-    navsim replay REPLAY.toml --out DIR [--set key=value ...]
+    navsim replay REPLAY.toml --out DIR [--set key=value ...] [--report [FILE.pdf]]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -225,10 +225,18 @@ def _sky(args):
 def _replay(args):
     from navsim.replay import output, summary
 
+    from startrack import check_file
+
     check_output(args.out, "replay")
+    if args.report:
+        check_file(args.report, "--report", (".pdf",))
     data, result, series = output.replay(args.replay, args.set or ())
     out = publish(args.out, "replay", lambda directory: output.write(directory, data, result, series))
     print("\n".join(summary.lines(result) + [f"written to          {out}"]))
+    if args.report is not None:
+        from navsim.report import write_report
+
+        print(f"report              {write_report(out, args.report or Path(out) / 'report.pdf')}")
     return 0
 
 
@@ -319,6 +327,8 @@ def build_parser():
     p.add_argument("replay", help="replay TOML file (a [replay] table)")
     p.add_argument("--out", required=True, help="output directory (summary.json, timeseries.npz)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a replay value (repeatable)")
+    p.add_argument("--report", nargs="?", const="", default=None, metavar="FILE.pdf",
+                   help="also write a PDF report (default file: DIR/report.pdf)")
     p.set_defaults(func=_replay)
     return parser
 

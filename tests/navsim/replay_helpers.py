@@ -48,7 +48,7 @@ def write_recording(directory, truth, seed=5, drop=()):
         rows = np.delete(rows, list(drop), axis=0)
     imu = directory / "imu.csv"
     np.savetxt(imu, rows, delimiter=",", fmt="%.12g")
-    every = int(round(RATE_HZ / FIX_HZ))
+    every = round(RATE_HZ / FIX_HZ)
     k = np.arange(0, truth.t.size, every)
     noise = FIX_SIGMA * fix_rng.standard_normal((k.size, 3))
     lat, lon = displaced(truth.lat[k], truth.lon[k], truth.h[k], noise[:, 0], noise[:, 1])

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pypdf
 import pytest
 
 from tests.support import HANG_S
@@ -23,7 +24,7 @@ def navsim_cli(*args):
 
 
 def test_replay_writes_its_run_directory(tmp_path):
-    done = navsim_cli("replay", DRIVE, "--out", tmp_path / "r", *SHORT)
+    done = navsim_cli("replay", DRIVE, "--out", tmp_path / "r", *SHORT, "--report")
     assert done.returncode == 0, done.stderr
     summary = json.loads((tmp_path / "r" / "summary.json").read_text())
     assert summary["kind"] == "replay" and summary["outages"][0]["duration_s"] == 20.0
@@ -33,6 +34,8 @@ def test_replay_writes_its_run_directory(tmp_path):
         assert series["held_out"].sum() == 80
     assert json.loads((tmp_path / "r" / "navsim-output.json").read_text()) == {"kind": "replay"}
     assert "outage    60.0 s +  20.0 s" in done.stdout
+    text = pypdf.PdfReader(tmp_path / "r" / "report.pdf").pages[0].extract_text()
+    assert "Replay: replay_car_drive_0708" in text and "60.0 20.0 80" in text  # the outage's row of the table
 
 
 def _copy(tmp_path, imu_rows=None, pos_lines=None):
@@ -67,12 +70,12 @@ def _float_only(lines):
 
 
 @pytest.mark.parametrize("edit, extra, message", [
-    (dict(imu_rows=_nan_row), [], "imu_1934.csv: row 4 is not finite"),
-    (dict(imu_rows=_time_back), [], "imu_1934.csv: time not increasing at row 4"),
-    (dict(imu_rows=_constant_gyro_z), [], "imu_1934.csv: column gyro_z is constant over the whole log"),
+    ({"imu_rows": _nan_row}, [], "imu_1934.csv: row 4 is not finite"),
+    ({"imu_rows": _time_back}, [], "imu_1934.csv: time not increasing at row 4"),
+    ({"imu_rows": _constant_gyro_z}, [], "imu_1934.csv: column gyro_z is constant over the whole log"),
     ({}, ["--set", "replay.imu.accel_unit=furlong"], "accel_unit: unknown unit 'furlong' for rates"),
     ({}, ["--set", "replay.imu.file=none.csv"], "none.csv: IMU log not found"),
-    (dict(pos_lines=_float_only), [], "gnss_1934_sf.pos: no fixes of quality 1 (qualities present: 2)"),
+    ({"pos_lines": _float_only}, [], "gnss_1934_sf.pos: no fixes of quality 1 (qualities present: 2)"),
     ({}, ["--set", "replay.outages.schedule.first_s=520"], "is outside the recording after its alignment"),
     ({}, ["--set", "replay.outages.schedule.first_s=10"], "is outside the recording after its alignment"),
 ])
