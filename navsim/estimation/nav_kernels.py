@@ -325,7 +325,7 @@ def position_update(nav, calib, P, acc, model, fix, sigma, gate, estimated):
 def velocity_update(nav, calib, P, acc, model, v_n, sigma, gate, estimated):
     """Flush the covariance, then the gated update of the ``estimated`` states with a NED velocity ``v_n`` (3,) [m/s]
     of NED σ ``sigma`` (3,) [m/s] (a GNSS velocity, or zero at a stop): z = v̂_w − C_wn v_n, H = [0 I 0] on δv (the
-    error state's δv = v̂_w − v_w, :func:`reset`), R = C_wn diag(σ²) C_nw (Groves, 2nd ed., eq. (14.103), loosely
+    error state's δv = v̂_w − v_w, :func:`reset`), R = C_wn diag(σ²) C_nw (Groves, 2nd ed., §14.4.1, loosely
     coupled velocity measurement, in w). Returns (z in NED (3,) [m/s], nis, accepted)."""
     flush(nav, P, acc, model)
     _, _, alpha = frame_angles(rk.quat_to_matrix(nav[0:4]))

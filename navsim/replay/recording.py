@@ -53,11 +53,6 @@ class ImuRecording:
     gaps: np.ndarray
 
     @property
-    def times(self):
-        """The end of each sample's interval [s] (M,)."""
-        return self.t0 + self.dt * np.arange(1, self.samples.shape[0] + 1)
-
-    @property
     def end(self):
         return self.t0 + self.dt * self.samples.shape[0]
 
