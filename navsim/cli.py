@@ -11,6 +11,7 @@
     navsim sky SCENARIO.toml [--set key=value ...] [--report FILE.pdf]
     navsim imu fit LOG [--columns t,gx,gy,gz,ax,ay,az] [--units gyro=U,accel=U,time=U] [--rate-hz F] [--variable NAME]
                    [--out DIR] [--plot FILE.pdf|.png]
+    navsim replay REPLAY.toml --out DIR [--set key=value ...] [--report [FILE.pdf]]
 
 Bad input ends with one line ``navsim: error: ...`` and exit status 2, never a traceback.
 """
@@ -223,6 +224,24 @@ def _sky(args):
     return 0
 
 
+def _replay(args):
+    from navsim.replay import output, summary
+
+    from startrack import check_file
+
+    check_output(args.out, "replay")
+    if args.report:
+        check_file(args.report, "--report", (".pdf",))
+    data, result, series = output.replay(args.replay, args.set or ())
+    out = publish(args.out, "replay", lambda directory: output.write(directory, data, result, series))
+    print("\n".join(summary.lines(result) + [f"written to          {out}"]))
+    if args.report is not None:
+        from navsim.report import write_report
+
+        print(f"report              {write_report(out, args.report or Path(out) / 'report.pdf')}")
+    return 0
+
+
 def _sweep(args):
     from navsim.campaign.sweep import parse_vary, run_sweep
     from navsim.report import write_report
@@ -305,6 +324,15 @@ def build_parser():
     p.add_argument("--report", default=None, metavar="FILE.pdf", help="also typeset the availability as a PDF")
     p.set_defaults(func=_sky)
     _add_imu_command(sub)
+
+    p = sub.add_parser("replay", help="a recorded IMU through the strapdown INS and the navigation filter, aided by its "
+                                      "GNSS fixes outside simulated outages; the error against the fixes held out")
+    p.add_argument("replay", help="replay TOML file (a [replay] table)")
+    p.add_argument("--out", required=True, help="output directory (summary.json, timeseries.npz)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a replay value (repeatable)")
+    p.add_argument("--report", nargs="?", const="", default=None, metavar="FILE.pdf",
+                   help="also write a PDF report (default file: DIR/report.pdf)")
+    p.set_defaults(func=_replay)
     return parser
 
 

@@ -48,6 +48,8 @@ INTERFACE = ("NAME", "TABLE", "validate", "prepare", "simulate", "lanes", "TRUTH
 KINDS = {kind.NAME: kind for kind in (attitude, navigation, spacecraft)}
 #: The name of the static studies' kind, and the table that marks them.
 STUDY = "study"
+#: The table that marks a replay file (:mod:`navsim.replay`, ``navsim replay``).
+REPLAY = "replay"
 
 
 def kind_name(data):
@@ -59,7 +61,10 @@ def kind_name(data):
 
 
 def validate(data, source="<scenario>"):
-    """A :class:`Scenario` of ``data`` checked against its kind's schema and rules."""
+    """A :class:`Scenario` of ``data`` checked against its kind's schema and rules (a replay file, with a ``[replay]``
+    table, is not a scenario: :mod:`navsim.replay`)."""
+    if isinstance(data, dict) and REPLAY in data:
+        raise InputError(f"{source}: a replay of a recording, not a simulation scenario; run it with `navsim replay`")
     name = kind_name(data)
     checked = studies.validate(data, source) if name == STUDY else KINDS[name].validate(data, source)
     return Scenario(data=checked, source=source, kind=name)

@@ -1,7 +1,7 @@
 """Output directories: checked before any work, marked with what they hold, replaced whole, locked.
 
 A directory that navsim writes carries ``navsim-output.json`` naming its kind (run, study,
-campaign, budget, covariance, sweep or imu-fit). Before a command starts working it checks its ``--out`` (:func:`check_output`): not a
+campaign, budget, covariance, sweep, imu-fit or replay). Before a command starts working it checks its ``--out`` (:func:`check_output`): not a
 file, not under a file, created and writable, and empty or holding an output of the same kind —
 never another kind, never somebody else's files. A run or study is written into a sibling directory and swapped in
 when complete (:func:`publish`), so nothing is half-written and no file of an earlier run survives.
@@ -18,7 +18,7 @@ from pathlib import Path
 from startrack import InputError, probe_directory
 
 MARKER = "navsim-output.json"
-KINDS = ("run", "study", "campaign", "budget", "covariance", "sweep", "imu-fit")
+KINDS = ("run", "study", "campaign", "budget", "covariance", "sweep", "imu-fit", "replay")
 #: Files that identify the kind of an output written before the marker existed.
 _LEGACY = (("campaign", ("campaign.json",)), ("run", ("summary.json", "timeseries.npz")),
            ("study", ("summary.json", "study.npz")))

@@ -12,7 +12,7 @@ state (:mod:`navsim.estimation.nav_kernels`, docs/design.md), which it shows in 
 INS does not know and ε_r the fractional error of the air its star processing corrects the refraction with
 (consider states: Schmidt). ``predict(samples, dt)`` mechanizes the corrected IMU
 samples at the IMU rate and propagates P every ``covariance_interval`` intervals (Φ, Q_d by series,
-tested against expm and Van Loan); the updates — ``update_position``, ``update_baro``,
+tested against expm and Van Loan); the updates — ``update_position``, ``update_velocity``, ``update_baro``,
 ``update_attitude`` (a star-sensor fix) and ``update_stars`` (identified stars one by one,
 :mod:`navsim.estimation.celestial_kernels`) — gate each measurement by its chi-square NIS against
 the prior, update in Joseph form and reset the estimate into the nominal state. With a star sensor
@@ -224,6 +224,15 @@ class NavFilter:
                                                        np.array([lat, lon, h], dtype=float), sigma, self.gates[0],
                                                        self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m")
+
+    def update_velocity(self, v_n, sigma):
+        """Update with a NED velocity ``v_n`` (3,) [m/s] of NED σ ``sigma`` (3,) [m/s], gated at 3 dof
+        (:func:`nav_kernels.velocity_update`); the innovation is reported in NED m/s."""
+        sigma = np.broadcast_to(np.asarray(sigma, dtype=float), (3,)) * self.sigma_scale
+        z, nis, accepted = nav_kernels.velocity_update(self._nav, self._calib, self._P, self._acc, self.model,
+                                                       np.asarray(v_n, dtype=float), np.ascontiguousarray(sigma),
+                                                       self.gates[0], self.estimated)
+        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m/s")
 
     def update_baro(self, h, sigma):
         """Update with a baro height ``h`` [m] of σ ``sigma`` [m], gated at 1 dof; it corrects the

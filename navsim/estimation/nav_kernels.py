@@ -322,6 +322,25 @@ def position_update(nav, calib, P, acc, model, fix, sigma, gate, estimated):
 
 
 @njit
+def velocity_update(nav, calib, P, acc, model, v_n, sigma, gate, estimated):
+    """Flush the covariance, then the gated update of the ``estimated`` states with a NED velocity ``v_n`` (3,) [m/s]
+    of NED σ ``sigma`` (3,) [m/s] (a GNSS velocity, or zero at a stop): z = v̂_w − C_wn v_n, H = [0 I 0] on δv (the
+    error state's δv = v̂_w − v_w, :func:`reset`), R = C_wn diag(σ²) C_nw (Groves, 2nd ed., §14.4.1, loosely
+    coupled velocity measurement, in w). Returns (z in NED (3,) [m/s], nis, accepted)."""
+    flush(nav, P, acc, model)
+    _, _, alpha = frame_angles(rk.quat_to_matrix(nav[0:4]))
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    C_nw = np.array([[ca, -sa, 0.0], [sa, ca, 0.0], [0.0, 0.0, 1.0]])
+    z = nav[5:8] - C_nw.T @ v_n
+    H = np.zeros((3, P.shape[0]))
+    for i in range(3):
+        H[i, 3 + i] = 1.0
+    R = C_nw.T @ np.diag(sigma * sigma) @ C_nw
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
+    return C_nw @ z, nis, accepted
+
+
+@njit
 def baro_update(nav, calib, P, acc, model, height, sigma, gate, estimated):
     """Flush the covariance, then the gated update of the ``estimated`` states (:data:`BARO_STATES`, or
     all) with a baro height [m] of σ [m]: z = ĥ − h_baro, H = e_h. Returns (z (1,) [m], nis, accepted)."""

@@ -1,5 +1,5 @@
-"""PDF reports of a run directory, a static-study directory, a Monte Carlo campaign directory or an error
-budget's directory.
+"""PDF reports of a run directory, a static-study directory, a Monte Carlo campaign directory, an error
+budget's directory or a replay's (``navsim replay``).
 
     >>> from navsim.report import write_report
     >>> write_report("reports/out/demo", "reports/out/demo.pdf")   # doctest: +SKIP
@@ -18,6 +18,7 @@ from navsim.kinds import of
 from navsim.output import read_npz
 from navsim.report.budget import budget_report
 from navsim.report.covariance import covariance_report, sweep_report
+from navsim.report.replay import replay_report
 from navsim.report.study import load_study, study_report
 from navsim.typeset.inputs import campaign_runs, directory_kind, load_campaign, load_run, read_json
 from startrack import InputError
@@ -48,6 +49,8 @@ def _typeset(directory, output):
         return covariance_report(read_json(directory / "summary.json"), read_npz(directory / "timeseries.npz"))
     if output == "sweep":
         return sweep_report(read_json(directory / "sweep.json"))
+    if output == "replay":
+        return replay_report(read_json(directory / "summary.json"), read_npz(directory / "timeseries.npz"))
     if output == "budget":
         series = directory / "timeseries.npz"
         return budget_report(read_json(directory / "budget.json"), read_npz(series) if series.is_file() else None)

@@ -138,7 +138,7 @@ def read_series(path: Path, required, names=None) -> dict:
 
 
 def directory_kind(directory: Path) -> str:
-    """'run', 'study', 'campaign', 'budget', 'covariance' or 'sweep'; anything else is an InputError."""
+    """'run', 'study', 'campaign', 'budget', 'covariance', 'sweep' or 'replay'; anything else is an InputError."""
     if not directory.exists():
         raise InputError(f"{directory}: no such directory.")
     if not directory.is_dir():
@@ -153,7 +153,7 @@ def directory_kind(directory: Path) -> str:
             encoding="utf-8", errors="replace"):
         return "covariance"
     if (directory / "timeseries.npz").is_file() and (directory / "summary.json").is_file():
-        return "run"
+        return "replay" if '"kind": "replay"' in (directory / "summary.json").read_text(encoding="utf-8", errors="replace") else "run"
     if (directory / "study.npz").is_file() and (directory / "summary.json").is_file():
         return "study"
     raise InputError(f"{directory}: neither a run directory (summary.json and timeseries.npz), a static-study "

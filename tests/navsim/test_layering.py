@@ -21,7 +21,7 @@ FLOORS = (
     {"closed_loop", "records", "output", "places", "pooling", "analysis"},
     {"studies"},                                             # the source documents' experiments
     {"build", "typeset", "star_run"},                        # what the run kinds share
-    {"attitude", "navigation"},                              # the run kinds
+    {"attitude", "navigation", "replay"},                    # the run kinds, and the replays of recordings
     {"spacecraft"},                                          # the run kind that builds on the attitude kind
     {"kinds"},                                               # their registry
     {"simulation"},                                          # the front door

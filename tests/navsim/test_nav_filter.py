@@ -253,6 +253,29 @@ def test_baro_update_pulls_the_height():
     assert not rejected.accepted[0] and f.position[2] == pytest.approx(100.0 + 20.0 / 101.0)
 
 
+def test_velocity_update_is_the_kalman_update():
+    """A NED velocity of σ (0.1, 0.2, 0.3) m/s against a P with velocity-attitude-bias correlations (wander angle 0
+    at the start: w is NED): NIS, P and the corrected velocity are the textbook update's, K = P Hᵀ (H P Hᵀ + R)⁻¹
+    with H = [0 I 0] on δv (numpy), and the update is gated like the others."""
+    noise = ImuNoise(arw=1e-5, vrw=1e-3)
+    rng = np.random.default_rng(4)
+    A = rng.normal(size=(15, 15)) * 0.1
+    P = np.diag([1e-4] * 3 + [0.5] * 3 + [1.0] * 3 + [1e-6] * 3 + [1e-3] * 3) + A @ A.T * 1e-3
+    f = NavFilter(0.5, 0.1, 120.0, np.array([1.0, 2.0, 0.0]), [0, 0, 0, 1.0], NavFilterConfig(P, noise, 0.01))
+    P0, v0 = f.P, f.v_n.copy()
+    measured, sigma = np.array([1.5, 1.6, 0.2]), np.array([0.1, 0.2, 0.3])
+    H = np.zeros((3, 15))
+    H[:, 3:6] = np.eye(3)
+    S = H @ P0 @ H.T + np.diag(sigma**2)
+    K = P0 @ H.T @ np.linalg.inv(S)
+    z = v0 - measured
+    result = f.update_velocity(measured, sigma)
+    assert result.accepted[0] and result.nis[0] == pytest.approx(z @ np.linalg.solve(S, z), rel=1e-9)
+    np.testing.assert_allclose(f.v_n, v0 - (K @ z)[3:6], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(f.P, P0 - K @ S @ K.T, rtol=0, atol=1e-9)
+    assert not f.update_velocity(measured + 100.0, sigma).accepted[0]
+
+
 def test_bad_filter_input_is_named():
     noise = ImuNoise(arw=1e-5, vrw=1e-3)
     with pytest.raises(InputError, match="filter.P: must be 15x15"):

@@ -95,9 +95,18 @@ def test_files_missing_or_broken(tmp_path):
 
 
 def test_shipped_scenarios_are_valid():
+    """Every file of scenarios/ by its loader: a simulation scenario by its kind's, a replay (a ``[replay]`` table) by
+    navsim.replay's, which ``navsim run`` refuses in one line."""
     from pathlib import Path
+
+    from navsim.replay import scenario as replay_file
 
     files = sorted((Path(__file__).resolve().parents[2] / "scenarios").glob("*.toml"))
     assert files
     for path in files:
-        assert load_scenario(path).name
+        if "[replay." in path.read_text():
+            assert replay_file.load(path)["name"]
+            with pytest.raises(InputError, match="a replay of a recording, not a simulation scenario"):
+                load_scenario(path)
+        else:
+            assert load_scenario(path).name

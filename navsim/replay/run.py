@@ -1,0 +1,167 @@
+"""A replay: the recorded IMU through the strapdown mechanization and the navigation filter
+(:class:`navsim.estimation.nav_filter.NavFilter`), aided by the recording's GNSS fixes outside the simulated outages;
+the fixes inside them are the reference the filter's error is measured against.
+
+The filter starts at the first fix at or after the IMU's first row, at rest: position that fix's, velocity zero,
+level from the accelerometers over ``alignment.level_s`` (:func:`navsim.replay.alignment.level`), heading the one the
+gyros turn into the GNSS course at the first fix at ``heading_speed_m_per_s`` (:func:`navsim.replay.alignment.start_heading`). The IMU is mechanized on its uniform grid
+(:mod:`navsim.replay.recording`); a fix at time t_f is applied at the IMU interval's end t_k nearest to it, moved to
+t_k along its own velocity (else the filter's): p_f + v (t_k − t_f), so that the grid's half-interval (up to 8 cm at
+16 m/s and 100 Hz) is not an error. Every fix epoch is logged (the filter's solution and σ before the update) with
+its error against the fix.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from navsim.earth.wander import displaced, ned_offset
+from navsim.estimation.nav_filter import ImuNoise, NavFilter, NavFilterConfig
+from navsim.replay import alignment, fixes, outages, recording
+from startrack import InputError, units
+
+
+@dataclass(frozen=True)
+class Replay:
+    """The inputs of a replay read and checked: ``imu`` (:class:`~navsim.replay.recording.ImuRecording`, body axes),
+    ``fixes`` (:class:`~navsim.replay.fixes.Fixes`), ``start`` [s] the first fix used and ``k0`` its IMU interval,
+    ``level_end`` and ``aligned`` [s after start] the ends of levelling and the heading's alignment, ``windows``
+    (K, 2) [s after start] the outages, ``config`` the checked ``[replay]`` table."""
+
+    imu: recording.ImuRecording
+    fixes: fixes.Fixes
+    start: float
+    k0: int
+    level_end: float
+    aligned: float
+    windows: np.ndarray
+    config: dict
+
+
+def read(config):
+    """The :class:`Replay` of a checked ``[replay]`` table (:mod:`navsim.replay.scenario`)."""
+    imu_table, gnss = config["imu"], config["gnss"]
+    imu = recording.read_imu(imu_table["file"], imu_table["columns"], imu_table["quantity"], imu_table["accel_unit"],
+                             imu_table["gyro_unit"], imu_table["time_unit"], imu_table["time_tag_file"] or None,
+                             imu_table["time_offset_s"])
+    C_b_imu = alignment.euler_matrix(*units.deg_to_rad(imu_table["mounting_rpy_deg"]))
+    body = np.concatenate([imu.samples[:, 0:3] @ C_b_imu.T, imu.samples[:, 3:6] @ C_b_imu.T], axis=1)
+    keep = body.shape[0] if imu_table["duration_s"] is None else min(body.shape[0], round(imu_table["duration_s"] / imu.dt))
+    imu = recording.ImuRecording(t0=imu.t0, dt=imu.dt, samples=body[:keep], filled=imu.filled[:keep],
+                                 gaps=imu.gaps[imu.gaps[:, 0] < imu.t0 + keep * imu.dt])
+    solution = (fixes.read_pos(gnss["file"], tuple(gnss["qualities"])) if gnss["format"] == "rtklib_pos"
+                else fixes.read_csv(gnss["file"], gnss["columns"], tuple(gnss["qualities"])))
+    solution = solution.subset((solution.t >= imu.t0) & (solution.t <= imu.end))
+    if gnss["use_velocity"] and solution.v_n is None:
+        raise InputError(f"{gnss['file']}: replay.gnss.use_velocity, but the solution has no velocity columns")
+    if len(solution) < 2:
+        raise InputError(f"{gnss['file']}: fewer than two fixes inside the IMU log's time "
+                         f"({imu.t0:.3f} to {imu.end:.3f} s); check the time tags and time_offset_s")
+    start = float(solution.t[0])
+    a = config["alignment"]
+    level_end = alignment.rest_span(solution, start, a["level_s"], a["rest_speed_m_per_s"]) - start
+    moving = np.flatnonzero((alignment.horizontal_speed(solution) >= a["heading_speed_m_per_s"])
+                            & (solution.t >= start + level_end))
+    if not moving.size:
+        raise InputError(f"{gnss['file']}: the vehicle never reaches alignment.heading_speed_m_per_s "
+                         f"({a['heading_speed_m_per_s']:g} m/s); the heading cannot be aligned")
+    aligned = float(solution.t[moving[0]] - start)
+    o = config["outages"]
+    windows = [[w["start_s"], w["duration_s"]] for w in o["windows"]]
+    if "schedule" in o:
+        windows += outages.scheduled(o["schedule"]["first_s"], o["schedule"]["lengths_s"], o["schedule"]["spacing_s"]).tolist()
+    windows = outages.checked(np.array(windows, dtype=float).reshape(-1, 2), aligned, imu.end - start)
+    k0 = int(np.ceil((start - imu.t0) / imu.dt - 1e-9))
+    return Replay(imu=imu, fixes=solution, start=start, k0=k0, level_end=level_end, aligned=aligned, windows=windows,
+                  config=config)
+
+
+def filter_config(replay):
+    """The :class:`~navsim.estimation.nav_filter.NavFilterConfig` of ``replay.config['filter']``: P0 of the initial σ
+    (the position's the first fix's), the IMU noise the filter assumes, the covariance interval and the gate."""
+    f = replay.config["filter"]
+    sigma = [*[units.deg_to_rad(f["initial_tilt_sigma_deg"])] * 2, units.deg_to_rad(f["initial_heading_sigma_deg"]),
+             *[f["initial_velocity_sigma_m_per_s"]] * 3, *replay.fixes.sigma[0],
+             *[units.deg_to_rad(f["initial_gyro_bias_sigma_deg_per_s"])] * 3, *[f["initial_accel_bias_sigma_m_per_s2"]] * 3]
+    noise = ImuNoise(arw=float(units.deg_to_rad(f["gyro_arw_deg_per_sqrt_s"])), vrw=f["accel_vrw_m_per_s_per_sqrt_s"],
+                     gyro_bias_rw=float(units.deg_to_rad(f["gyro_bias_rw_deg_per_s_per_sqrt_s"])),
+                     accel_bias_rw=f["accel_bias_rw_m_per_s2_per_sqrt_s"])
+    return NavFilterConfig(np.diag(np.square(np.array(sigma, dtype=float))), noise, replay.imu.dt,
+                           covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"])
+
+
+def initial_filter(replay):
+    """The :class:`NavFilter` at the replay's start: the first fix, at rest, levelled, its heading the one the gyros
+    turn into the GNSS course at the aligning fix (module docstring)."""
+    imu, k0, f = replay.imu, replay.k0, replay.fixes
+    roll, pitch = alignment.level(imu.samples[k0:k0 + max(1, round(replay.level_end / imu.dt)), 3:6])
+    j = int(np.searchsorted(f.t, replay.start + replay.aligned - 1e-9))
+    course = float(np.arctan2(*alignment.velocity_ne(f)[j, ::-1]))
+    k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
+    heading = alignment.start_heading(course, alignment.q_nb(roll, pitch, 0.0), imu.samples[k0:k_j, 0:3], imu.dt)
+    return NavFilter(f.lat[0], f.lon[0], f.h[0], np.zeros(3), alignment.q_nb(roll, pitch, heading), filter_config(replay))
+
+
+def simulate(replay):
+    """Run the replay; returns (series, counts): the per-fix-epoch log (:func:`_log_epoch`) and what the run did."""
+    started = time.perf_counter()
+    nav = initial_filter(replay)
+    imu, f = replay.imu, replay.fixes
+    t_rel = f.t - replay.start
+    window = outages.held_out(t_rel, replay.windows)
+    free = replay.config["outages"]["free_ins"]
+    held = (window >= 0) | (free & (t_rel > replay.aligned))
+    k = replay.k0
+    log = {name: [] for name in ("t", "lat", "lon", "h", "v_n", "q_nb", "sigma_ned", "error_ned", "accepted", "nis",
+                                 "gyro_bias", "accel_bias", "sigma_bias")}
+    floor, velocity = replay.config["gnss"]["sigma_floor_m"], replay.config["gnss"]["use_velocity"]
+    for j in range(1, len(f)):
+        k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
+        if k_j > k:
+            nav.predict(imu.samples[k:k_j], imu.dt)
+            k = k_j
+        t_state = imu.t0 + k * imu.dt
+        lat, lon, h = _moved_fix(f, j, nav, t_state - f.t[j])
+        before = (nav.position, nav.v_n, nav.q_nb, nav.P, nav.gyro_bias, nav.accel_bias)
+        error = ned_offset(*before[0], lat, lon, h)
+        result = None if held[j] else nav.update_position(lat, lon, h, np.maximum(f.sigma[j], floor))
+        if velocity and not held[j]:
+            nav.update_velocity(f.v_n[j], f.v_sigma[j])
+        _log_epoch(log, t_rel[j], before, error, result)
+        if k >= imu.samples.shape[0]:
+            break
+    series = {name: np.array(values) for name, values in log.items()}
+    series["outage"] = window[1:series["t"].size + 1]
+    series["held_out"] = held[1:series["t"].size + 1]
+    counts = {"fixes": len(f), "imu_intervals": int(k - replay.k0), "filled_intervals": int(imu.filled[replay.k0:k].sum()),
+              "gaps": int(imu.gaps.shape[0]), "gap_seconds": float(imu.gaps[:, 1].sum()) if imu.gaps.size else 0.0,
+              "wall_seconds": round(time.perf_counter() - started, 3)}
+    return series, counts
+
+
+def _moved_fix(f, j, nav, lag):
+    """(L, λ, h) of fix ``j`` moved by ``lag`` [s] along its velocity (else the filter's, ``nav.v_n``)."""
+    v = f.v_n[j] if f.v_n is not None else nav.v_n
+    lat, lon = displaced(f.lat[j], f.lon[j], f.h[j], v[0] * lag, v[1] * lag)
+    return float(lat), float(lon), float(f.h[j] - v[2] * lag)
+
+
+def _log_epoch(log, t, before, error, result):
+    """Append one fix epoch: the solution before the update ``before`` ((L, λ, h), v_n, q_nb, P, b̂_g, b̂_a), its NED
+    position σ and the biases' σ, the error against the fix, whether it was used and accepted (−1: held out) and its
+    NIS (NaN: held out)."""
+    (lat, lon, h), v_n, q_nb, P, gyro_bias, accel_bias = before
+    log["t"].append(t)
+    log["lat"].append(lat)
+    log["lon"].append(lon)
+    log["h"].append(h)
+    log["v_n"].append(v_n)
+    log["q_nb"].append(q_nb)
+    log["sigma_ned"].append(np.sqrt(np.diag(P)[6:9]))
+    log["gyro_bias"].append(gyro_bias)
+    log["accel_bias"].append(accel_bias)
+    log["sigma_bias"].append(np.sqrt(np.diag(P)[9:15]))
+    log["error_ned"].append(error)
+    log["accepted"].append(-1 if result is None else int(result.accepted[0]))
+    log["nis"].append(np.nan if result is None else float(result.nis[0]))
