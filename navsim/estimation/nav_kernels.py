@@ -1,6 +1,6 @@
 """Compiled kernels of the navigation error-state filter (numba): the continuous error dynamics F,
-their discretisation (Φ, Q_d), propagation over IMU increments, the position and baro updates and
-the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kernels`).
+their discretisation (Φ, Q_d), propagation over IMU increments, the position, velocity, body-velocity
+(a land vehicle's non-holonomic constraint) and baro updates and the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kernels`).
 
 Error state x (zero between updates; docs/design.md), each optional group where :class:`Layout`
 puts it:

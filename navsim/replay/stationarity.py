@@ -1,6 +1,7 @@
 """Whether a land vehicle is at rest, from its IMU alone: the acceleration-moving variance detector of Skog et al. 2010
-(§III, the MV detector of the GLRT family; the car's accelerometers, not its gyros: idling, the drive's gyros shake
-by 0.8-2.8 deg/s RMS, as much as while driving, its accelerometers by under 0.16 m/s² against 0.4-2 m/s² moving).
+(§III, the MV detector of its likelihood-ratio family; the accelerometers, not the gyros: idling, the car drive's
+gyros shake by 0.8-2.8 deg/s RMS, as much as while driving, its accelerometers' RMS deviation |y − ȳ| is under
+0.16 m/s² at rest against 0.37-2.2 m/s² moving). Smooth motion without vibration looks like rest to it.
 
 Over the W samples y_k (specific force [m/s²]) of a window, with ȳ their mean and σ_a the accelerometers' white noise
 per sample [m/s²],
