@@ -12,7 +12,8 @@ state (:mod:`navsim.estimation.nav_kernels`, docs/design.md), which it shows in 
 INS does not know and ε_r the fractional error of the air its star processing corrects the refraction with
 (consider states: Schmidt). ``predict(samples, dt)`` mechanizes the corrected IMU
 samples at the IMU rate and propagates P every ``covariance_interval`` intervals (Φ, Q_d by series,
-tested against expm and Van Loan); the updates — ``update_position``, ``update_velocity``, ``update_baro``,
+tested against expm and Van Loan); the updates — ``update_position``, ``update_velocity``, ``update_body_velocity`` (a land vehicle's
+non-holonomic constraint), ``update_baro``,
 ``update_attitude`` (a star-sensor fix) and ``update_stars`` (identified stars one by one,
 :mod:`navsim.estimation.celestial_kernels`) — gate each measurement by its chi-square NIS against
 the prior, update in Joseph form and reset the estimate into the nominal state. With a star sensor
@@ -232,6 +233,16 @@ class NavFilter:
         z, nis, accepted = nav_kernels.velocity_update(self._nav, self._calib, self._P, self._acc, self.model,
                                                        np.asarray(v_n, dtype=float), np.ascontiguousarray(sigma),
                                                        self.gates[0], self.estimated)
+        return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m/s")
+
+    def update_body_velocity(self, v_yz, sigma):
+        """Update with the body's lateral and vertical velocity ``v_yz`` (2,) [m/s] (zero for a land vehicle: the
+        non-holonomic constraint) of σ ``sigma`` (2,) [m/s], gated at 2 dof (:func:`nav_kernels.body_velocity_update`,
+        attitude and velocity coupled); the innovation is reported in body m/s."""
+        sigma = np.broadcast_to(np.asarray(sigma, dtype=float), (2,)) * self.sigma_scale
+        z, nis, accepted = nav_kernels.body_velocity_update(self._nav, self._calib, self._P, self._acc, self.model,
+                                                            np.asarray(v_yz, dtype=float), np.ascontiguousarray(sigma),
+                                                            self.gates[2], self.estimated)
         return UpdateResult(z=z[None, :], nis=np.array([nis]), accepted=np.array([accepted]), unit="m/s")
 
     def update_baro(self, h, sigma):

@@ -1,6 +1,6 @@
 """Compiled kernels of the navigation error-state filter (numba): the continuous error dynamics F,
-their discretisation (Φ, Q_d), propagation over IMU increments, the position and baro updates and
-the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kernels`).
+their discretisation (Φ, Q_d), propagation over IMU increments, the position, velocity, body-velocity
+(a land vehicle's non-holonomic constraint) and baro updates and the reset (the star sensor's updates are :mod:`navsim.estimation.celestial_kernels`).
 
 Error state x (zero between updates; docs/design.md), each optional group where :class:`Layout`
 puts it:
@@ -338,6 +338,39 @@ def velocity_update(nav, calib, P, acc, model, v_n, sigma, gate, estimated):
     R = C_nw.T @ np.diag(sigma * sigma) @ C_nw
     nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
     return C_nw @ z, nis, accepted
+
+
+@njit
+def body_velocity_terms(nav, n):
+    """(ŷ (2,) [m/s], H (2, n)) of the body's lateral and vertical velocity ŷ = (C_bw v̂_w)_y,z, the non-holonomic
+    constraint of a land vehicle (Groves, 2nd ed., §15.3.1; Shin 2001, §4.3). With C_wb,est = (I − [φ×]) C_wb,true and
+    δv = v̂_w − v_w (:func:`reset`), C_bw,est v̂ = C_bw,true (I + [φ×]) (v + δv), so to first order
+    z = ŷ − y = C_bw δv − C_bw [v̂×] φ: H_v = (C_bw)_y,z, H_φ = −(C_bw [v̂×])_y,z."""
+    C_wb = rk.quat_to_matrix(nav[8:12])
+    V = rk.skew(nav[5:8])
+    y = np.zeros(2)
+    H = np.zeros((2, n))
+    for r in range(2):
+        for k in range(3):  # row 1 + r of C_bw is column 1 + r of C_wb
+            c = C_wb[k, 1 + r]
+            y[r] += c * nav[5 + k]
+            H[r, 3 + k] = c
+            for j in range(3):
+                H[r, j] -= c * V[k, j]
+    return y, H
+
+
+@njit
+def body_velocity_update(nav, calib, P, acc, model, v_yz, sigma, gate, estimated):
+    """Flush the covariance, then the gated update of the ``estimated`` states with the body's lateral and vertical
+    velocity ``v_yz`` (2,) [m/s] (zero: the non-holonomic constraint) of σ ``sigma`` (2,) [m/s]: z = ŷ − v_yz, H of
+    :func:`body_velocity_terms`, R = diag(σ²). Returns (z in body y, z (2,) [m/s], nis, accepted)."""
+    flush(nav, P, acc, model)
+    y, H = body_velocity_terms(nav, P.shape[0])
+    z = y - v_yz
+    R = np.diag(sigma * sigma)
+    nis, accepted = gated_update(nav, calib, P, H, R, z, gate, estimated, model.layout)
+    return z, nis, accepted
 
 
 @njit

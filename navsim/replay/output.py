@@ -1,7 +1,8 @@
 """A replay's run directory: ``scenario.json`` (the checked replay file), ``summary.json``
 (:func:`navsim.replay.summary.summarize`) and ``timeseries.npz`` (the per-fix-epoch log of :mod:`navsim.replay.run`:
 t [s after the start], lat, lon [rad], h [m], v_n, q_nb, sigma_ned, error_ned [m], accepted, nis, gyro_bias [rad/s],
-accel_bias [m/s²], sigma_bias (ε, ∇), outage, held_out),
+accel_bias [m/s²], sigma_bias (ε, ∇), outage, held_out, at_rest (the IMU's detector), zupt, nhc (−1 not applied,
+0 rejected, 1 accepted) and their NIS zupt_nis, nhc_nis),
 written by :func:`navsim.output.write_npz` (no pickle)."""
 
 from pathlib import Path

@@ -9,6 +9,12 @@ gyros turn into the GNSS course at the first fix at ``heading_speed_m_per_s`` (:
 t_k along its own velocity (else the filter's): p_f + v (t_k − t_f), so that the grid's half-interval (up to 8 cm at
 16 m/s and 100 Hz) is not an error. Every fix epoch is logged (the filter's solution and σ before the update) with
 its error against the fix.
+
+With ``[replay.constraints]`` a land vehicle's constraints update the filter at every fix epoch after its fix, in the
+outages too: where the IMU's window before the epoch is at rest (:mod:`navsim.replay.stationarity`, the IMU alone) a
+zero-velocity update v_n = 0 of σ ``zupt_sigma_m_per_s`` (:meth:`NavFilter.update_velocity`), elsewhere the
+non-holonomic constraint, the body's lateral and vertical velocity zero of σ ``nhc_sigma_m_per_s``
+(:meth:`NavFilter.update_body_velocity`); each gated like a fix.
 """
 
 import time
@@ -18,7 +24,7 @@ import numpy as np
 
 from navsim.earth.wander import displaced, ned_offset
 from navsim.estimation.nav_filter import ImuNoise, NavFilter, NavFilterConfig
-from navsim.replay import alignment, fixes, outages, recording
+from navsim.replay import alignment, fixes, outages, recording, stationarity
 from startrack import InputError, units
 
 
@@ -91,6 +97,34 @@ def filter_config(replay):
                            covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"])
 
 
+def rest_epochs(replay):
+    """(N,) whether the vehicle is at rest at each fix epoch, from the IMU's window before it (the detector of
+    :mod:`navsim.replay.stationarity` with σ_a = VRW / √Δt of the filter's figure); all False without constraints."""
+    c, imu, f = replay.config["constraints"], replay.imu, replay.fixes
+    if not (c["zupt"] or c["nhc"]):
+        return np.zeros(len(f), dtype=bool)
+    window = round(c["zupt_window_s"] / imu.dt)
+    if window < 2:
+        raise InputError(f"replay.constraints.zupt_window_s: {c['zupt_window_s']:g} s is fewer than two IMU intervals "
+                         f"of {imu.dt:g} s")
+    ends = [_interval_end(imu, t) for t in f.t]
+    sigma = replay.config["filter"]["accel_vrw_m_per_s_per_sqrt_s"] / np.sqrt(imu.dt)
+    return stationarity.at_rest(imu.samples[:, 3:6], ends, window, sigma, c["zupt_probability"])
+
+
+def _interval_end(imu, t):
+    """The IMU grid's interval end nearest to the time ``t`` [s] (at most its last)."""
+    return min(round((t - imu.t0) / imu.dt), imu.samples.shape[0])
+
+
+def constrain(nav, constraints, at_rest):
+    """(ZUPT, NHC): the :class:`~navsim.estimation.updates.UpdateResult` of the constraint applied at an epoch (module
+    docstring), None for the one not applied."""
+    if at_rest:
+        return (nav.update_velocity(np.zeros(3), constraints["zupt_sigma_m_per_s"]) if constraints["zupt"] else None), None
+    return None, (nav.update_body_velocity(np.zeros(2), constraints["nhc_sigma_m_per_s"]) if constraints["nhc"] else None)
+
+
 def initial_filter(replay):
     """The :class:`NavFilter` at the replay's start: the first fix, at rest, levelled, its heading the one the gyros
     turn into the GNSS course at the aligning fix (module docstring)."""
@@ -98,7 +132,7 @@ def initial_filter(replay):
     roll, pitch = alignment.level(imu.samples[k0:k0 + max(1, round(replay.level_end / imu.dt)), 3:6])
     j = int(np.searchsorted(f.t, replay.start + replay.aligned - 1e-9))
     course = float(np.arctan2(*alignment.velocity_ne(f)[j, ::-1]))
-    k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
+    k_j = _interval_end(imu, f.t[j])
     heading = alignment.start_heading(course, alignment.q_nb(roll, pitch, 0.0), imu.samples[k0:k_j, 0:3], imu.dt)
     return NavFilter(f.lat[0], f.lon[0], f.h[0], np.zeros(3), alignment.q_nb(roll, pitch, heading), filter_config(replay))
 
@@ -114,10 +148,11 @@ def simulate(replay):
     held = (window >= 0) | (free & (t_rel > replay.aligned))
     k = replay.k0
     log = {name: [] for name in ("t", "lat", "lon", "h", "v_n", "q_nb", "sigma_ned", "error_ned", "accepted", "nis",
-                                 "gyro_bias", "accel_bias", "sigma_bias")}
+                                 "gyro_bias", "accel_bias", "sigma_bias", "zupt", "zupt_nis", "nhc", "nhc_nis")}
+    rest, constraints = rest_epochs(replay), replay.config["constraints"]
     floor, velocity = replay.config["gnss"]["sigma_floor_m"], replay.config["gnss"]["use_velocity"]
     for j in range(1, len(f)):
-        k_j = min(round((f.t[j] - imu.t0) / imu.dt), imu.samples.shape[0])
+        k_j = _interval_end(imu, f.t[j])
         if k_j > k:
             nav.predict(imu.samples[k:k_j], imu.dt)
             k = k_j
@@ -129,11 +164,14 @@ def simulate(replay):
         if velocity and not held[j]:
             nav.update_velocity(f.v_n[j], f.v_sigma[j])
         _log_epoch(log, t_rel[j], before, error, result)
+        for name, applied in zip(("zupt", "nhc"), constrain(nav, constraints, rest[j])):
+            _log_update(log, name, applied)
         if k >= imu.samples.shape[0]:
             break
     series = {name: np.array(values) for name, values in log.items()}
     series["outage"] = window[1:series["t"].size + 1]
     series["held_out"] = held[1:series["t"].size + 1]
+    series["at_rest"] = rest[1:series["t"].size + 1]
     counts = {"fixes": len(f), "imu_intervals": int(k - replay.k0), "filled_intervals": int(imu.filled[replay.k0:k].sum()),
               "gaps": int(imu.gaps.shape[0]), "gap_seconds": float(imu.gaps[:, 1].sum()) if imu.gaps.size else 0.0,
               "wall_seconds": round(time.perf_counter() - started, 3)}
@@ -163,5 +201,11 @@ def _log_epoch(log, t, before, error, result):
     log["accel_bias"].append(accel_bias)
     log["sigma_bias"].append(np.sqrt(np.diag(P)[9:15]))
     log["error_ned"].append(error)
-    log["accepted"].append(-1 if result is None else int(result.accepted[0]))
-    log["nis"].append(np.nan if result is None else float(result.nis[0]))
+    _log_update(log, None, result)
+
+
+def _log_update(log, name, result):
+    """Append whether an update was applied and accepted (−1: not applied) and its NIS (NaN: not applied) to the
+    columns ``name`` and ``name_nis`` (the fix's: ``accepted`` and ``nis``)."""
+    log["accepted" if name is None else name].append(-1 if result is None else int(result.accepted[0]))
+    log["nis" if name is None else f"{name}_nis"].append(np.nan if result is None else float(result.nis[0]))

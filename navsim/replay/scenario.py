@@ -10,6 +10,9 @@ schema (:mod:`navsim.scenario.schema`): every problem one :class:`InputError` na
                        the stated position σ), use_velocity (update with the fixes' velocity and its σ too)
     [replay.alignment] level_s, rest_speed_m_per_s, heading_speed_m_per_s
     [replay.filter]    initial σ, the IMU noise the filter assumes, covariance_interval, gate_probability
+    [replay.constraints] zupt (zero-velocity updates at rest, :mod:`navsim.replay.stationarity`), zupt_sigma_m_per_s,
+                       zupt_window_s, zupt_probability (the detector's), nhc (the non-holonomic constraint while
+                       moving), nhc_sigma_m_per_s; both off by default
     [replay.outages]   windows = [{start_s, duration_s}, ...] and/or schedule = {first_s, lengths_s, spacing_s}
                        [s after the replay's start]; free_ins = true holds out every fix after the alignment
 """
@@ -66,6 +69,14 @@ SCHEMA = Table({
             "accel_bias_rw_m_per_s2_per_sqrt_s": Value("float", default=2.75e-3, minimum=0.0),
             "covariance_interval": Value("int", default=5, minimum=1, maximum=1000),
             "gate_probability": Value("float", default=0.9999, exclusive_minimum=0.0, maximum=0.999999999),
+        }),
+        "constraints": Table({
+            "zupt": Value("bool", default=False),
+            "zupt_sigma_m_per_s": _positive(0.02, maximum=1.0),
+            "zupt_window_s": _positive(1.0, maximum=10.0),
+            "zupt_probability": Value("float", default=0.99, exclusive_minimum=0.0, maximum=0.999999999),
+            "nhc": Value("bool", default=False),
+            "nhc_sigma_m_per_s": _positive(0.1, maximum=5.0),
         }),
         "outages": Table({
             "windows": ListOfTables(Table({"start_s": Value("float", minimum=0.0),

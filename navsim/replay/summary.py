@@ -1,6 +1,6 @@
 """What a replay's summary says: its error against the held-out fixes in each outage (horizontal max, RMS and at the
-end, vertical max), beside the filter's own σ there, the aided epochs' one-step error, the updates, the gaps, the
-alignment and the timing. The horizontal error of an epoch is √(δN² + δE²) of the solution before any update against
+end, vertical max), beside the filter's own σ there, the aided epochs' one-step error, the updates, the constraints
+(ZUPT and non-holonomic: accepted, rejected, mean NIS), the gaps, the alignment and the timing. The horizontal error of an epoch is √(δN² + δE²) of the solution before any update against
 the fix moved to the epoch's time (:mod:`navsim.replay.run`); the RMS is over the outage's fixes at 4 Hz (or the
 solution's rate)."""
 
@@ -46,10 +46,23 @@ def summarize(name, replay, series, counts):
                     "held_out": int(series["held_out"].sum())},
         "aided_one_step_horizontal_m": {"median": float(np.median(error[after_first])) if after_first.any() else None,
                                         "rms": float(np.sqrt(np.mean(error[after_first] ** 2))) if after_first.any() else None},
+        "constraints": constraint_counts(series),
         "outages": outage_rows(series, replay.windows),
         "free_ins": bool(replay.config["outages"]["free_ins"]),
         "timing": {"wall_seconds": counts["wall_seconds"]},
     }
+
+
+def constraint_counts(series):
+    """The epochs the detector found at rest and, for the ZUPT (3 dof) and the non-holonomic constraint (2 dof), the
+    updates accepted and rejected by the gate and the accepted ones' mean NIS (its expectation the dof when the σ is
+    right; None without any)."""
+    out = {"at_rest_epochs": int(series["at_rest"].sum())}
+    for name, dof in (("zupt", 3), ("nhc", 2)):
+        accepted = series[name] == 1
+        out[name] = {"accepted": int(accepted.sum()), "rejected": int((series[name] == 0).sum()), "dof": dof,
+                     "mean_nis": float(np.mean(series[f"{name}_nis"][accepted])) if accepted.any() else None}
+    return out
 
 
 def first_level(series):
@@ -66,6 +79,12 @@ def lines(summary):
            f"{summary['alignment']['heading_aligned_s']:.1f} s",
            f"updates             {summary['updates']['accepted']} accepted, {summary['updates']['rejected']} rejected, "
            f"{summary['updates']['held_out']} held out"]
+    c = summary["constraints"]
+    for name, label in (("zupt", "ZUPT"), ("nhc", "NHC")):
+        if c[name]["accepted"] or c[name]["rejected"]:
+            out.append(f"{label:20s}{c[name]['accepted']} accepted, {c[name]['rejected']} rejected, mean NIS "
+                       f"{c[name]['mean_nis'] or float('nan'):.2f} of {c[name]['dof']} dof"
+                       + (f" ({c['at_rest_epochs']} epochs at rest)" if name == "zupt" else ""))
     for row in summary["outages"]:
         if row["fixes"]:
             out.append(f"outage {row['start_s']:7.1f} s + {row['duration_s']:5.1f} s   horizontal max {row['max_horizontal_m']:8.2f} m, "

@@ -31,15 +31,33 @@ def car_truth():
     return trajectory.generate(profile, RATE_HZ)
 
 
-def write_recording(directory, truth, seed=5, drop=()):
+def stop_and_go_truth():
+    """The truth of a 120 s drive at 100 Hz with two rest spans: 20 s at the start, 15 s after a stop at 1 m/s² from
+    8 m/s, then away again."""
+    profile = Profile(Start(40.0, -105.0, 1600.0, 0.0, heading_deg=60.0),
+                      (Hold(20.0), Accelerate(8.0, 1.0), Straight(15.0), Turn(90.0, 6.0), Accelerate(0.0, 1.0),
+                       Hold(15.0), Accelerate(8.0, 1.0), Straight(20.0)))
+    return trajectory.generate(profile, RATE_HZ)
+
+
+def moving(truth):
+    """(M,) whether the vehicle moves over each IMU interval of ``truth`` (a speed above 1 mm/s at either end)."""
+    speed = np.linalg.norm(truth.v_n, axis=1) > 1e-3
+    return speed[1:] | speed[:-1]
+
+
+def write_recording(directory, truth, seed=5, drop=(), vibration=0.0):
     """Write ``imu.csv`` (increments in the mounted IMU's axes, time [s]; the rows ``drop`` (consecutive) left out, their
     increments in the row after them, as an accumulating IMU's after lost packets: a gap) and
-    ``fixes.csv`` (4 Hz, with σ) of ``truth`` into ``directory``; returns their paths."""
+    ``fixes.csv`` (4 Hz, with σ) of ``truth`` into ``directory``; returns their paths. ``vibration`` [m/s²]: the RMS
+    per axis of white specific force added where the vehicle moves (:func:`moving`), a road's."""
     directory = Path(directory)
-    gyro_rng, accel_rng, fix_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3))
+    gyro_rng, accel_rng, fix_rng, road_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4))
     dt = truth.dt
     dtheta = truth.dtheta + GYRO_BIAS * dt + ARW * np.sqrt(dt) * gyro_rng.standard_normal(truth.dtheta.shape)
     dv = truth.dv + ACCEL_BIAS * dt + VRW * np.sqrt(dt) * accel_rng.standard_normal(truth.dv.shape)
+    if vibration:
+        dv += moving(truth)[:, None] * vibration * dt * road_rng.standard_normal(truth.dv.shape)
     C_imu_b = euler_matrix(*units.deg_to_rad(MOUNTING_RPY_DEG)).T
     rows = np.concatenate([dv @ C_imu_b.T, dtheta @ C_imu_b.T, truth.t[1:, None] + T0], axis=1)
     rows = np.concatenate([[[0.0] * 6 + [T0]], rows])  # the first row: the clock's start, its increments unused
