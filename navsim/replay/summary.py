@@ -96,7 +96,7 @@ def lines(summary):
         s = summary["star_sensor"]
         used = (f"{s['accepted']} accepted, {s['rejected']} rejected, NIS mean {s['nis_mean']:.2f} (3 dof)" if s["applied"]
                 else "drawn, not applied")
-        out.append(f"star sensor         {s['frames']} frames at {s['rate_hz']:g} Hz {used}; heading error against the "
+        out.append(f"star sensor         {s['frames']} frames at {s['rate_hz']:g} Hz: {used}; heading error against the "
                    f"reference RMS {s['heading_error_deg']['rms']:.4f} deg, max {s['heading_error_deg']['max']:.4f} deg")
     out.append(f"wall time           {summary['timing']['wall_seconds']:.2f} s")
     return out

@@ -30,7 +30,7 @@ def recording(tmp_path_factory):
 
 
 def _replay(recording, **keys):
-    truth, directory, imu, fixes, reference = recording
+    _, directory, imu, fixes, reference = recording
     extra = rh.star_table(reference, **keys) if keys else ""
     return output.replay(rh.replay_toml(directory, imu, fixes, outages=OUTAGE, extra=extra))
 
