@@ -123,7 +123,11 @@ def draw(table, imu, fixes, k0):
     k, t = k[inside], t[inside]
     frames = reference_frames(reference, fixes, t)
     start = imu.t0 + k0 * imu.dt
-    orientation = EarthOrientation.compute(gpst_epoch_utc(start), (k - k0) * imu.dt)
+    try:
+        epoch = gpst_epoch_utc(start)
+    except InputError as error:
+        raise InputError(f"replay.star_sensor: the Earth's orientation needs the fixes' time in GPST: {error}") from None
+    orientation = EarthOrientation.compute(epoch, (k - k0) * imu.dt)
     v_I = np.array([observer_velocity(orientation.c_ie[f], orientation.v_earth[f], frames.lat[f], frames.lon[f],
                                       frames.h[f], frames.v_n[f]) for f in range(k.size)])
     q_BS = q_nb(*units.deg_to_rad(table["mounting_rpy_deg"]))

@@ -134,3 +134,19 @@ def test_the_run_directory_holds_the_star_frames(runs, tmp_path):
     with np.load(tmp_path / "timeseries.npz", allow_pickle=False) as npz:
         assert {"star_t", "star_nis", "star_accepted", "star_attitude_error", "star_attitude_sigma",
                 "star_outage"} <= set(npz.files)
+
+
+def test_a_time_not_gpst_is_one_line(recording, tmp_path):
+    """Fixes and IMU on a clock from 0 (not GPST since 1970): the star sensor cannot place the Earth; one line."""
+    truth, _, _, _, _ = recording
+    imu, fixes = rh.write_recording(tmp_path, truth)
+    for path in (imu, fixes):
+        rows = np.loadtxt(path, delimiter=",", ndmin=2)
+        rows[:, -1 if path == imu else 0] -= rh.T0
+        np.savetxt(path, rows, delimiter=",", fmt="%.12f")
+    reference = rh.write_reference(tmp_path, truth)
+    table = np.loadtxt(reference, delimiter=",")
+    table[:, 0] -= rh.T0
+    np.savetxt(reference, table, delimiter=",", fmt="%.12f")
+    with pytest.raises(InputError, match="replay.star_sensor: the Earth's orientation needs the fixes' time in GPST"):
+        output.replay(rh.replay_toml(tmp_path, imu, fixes, outages=OUTAGE, extra=rh.star_table(reference)))
