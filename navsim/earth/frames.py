@@ -77,6 +77,22 @@ def utc_epoch(text):
         return erfa.dtf2d("UTC", when.year, when.month, when.day, when.hour, when.minute, seconds)
 
 
+#: TAI − GPST [s]: GPS time is TAI less the 19 leap seconds of its 1980 epoch (IS-GPS-200, §3.3.4).
+TAI_MINUS_GPST_S = 19.0
+
+
+def gpst_epoch_utc(gpst_s):
+    """The UTC calendar epoch 'YYYY-MM-DDTHH:MM:SS.ffffff' of ``gpst_s`` [s GPST since 1970-01-01, GPST counted
+    without leap seconds]: UTC = GPST + 19 s − (TAI − UTC), the leap seconds of erfa's table (``erfa.dat``) at
+    that date (18 s from 2017); an InputError for a time before GPS time began (1980-01-06) or after 2100."""
+    if not 315964800.0 <= gpst_s <= 4102444800.0:
+        raise InputError(f"GNSS time {gpst_s!r} s is not GPST seconds since 1970 between 1980-01-06 and 2100")
+    when = datetime(1970, 1, 1) + timedelta(seconds=float(gpst_s))
+    with utc_offsets_extrapolated():
+        tai_utc = erfa.dat(when.year, when.month, when.day, 0.0)
+    return (when + timedelta(seconds=TAI_MINUS_GPST_S - float(tai_utc))).isoformat(timespec="microseconds")
+
+
 @contextlib.contextmanager
 def utc_offsets_extrapolated():
     """A context in which erfa's "dubious year" (a UTC before 1960 or years past its leap-second table: it takes the

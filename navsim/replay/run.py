@@ -8,7 +8,10 @@ gyros turn into the GNSS course at the first fix at ``heading_speed_m_per_s`` (:
 (:mod:`navsim.replay.recording`); a fix at time t_f is applied at the IMU interval's end t_k nearest to it, moved to
 t_k along its own velocity (else the filter's): p_f + v (t_k − t_f), so that the grid's half-interval (up to 8 cm at
 16 m/s and 100 Hz) is not an error. Every fix epoch is logged (the filter's solution and σ before the update) with
-its error against the fix.
+its error against the fix. With a star sensor (:mod:`navsim.replay.star_sensor`) each of its frames is applied
+(:meth:`~navsim.estimation.nav_filter.NavFilter.update_attitude`, in the outages too) once the filter has mechanized
+the intervals before it, before the fixes at or after it; each frame is logged (its NIS, accepted, the attitude
+before it against the reference and the filter's attitude σ). Frames after the last fix are not reached.
 
 With ``[replay.constraints]`` a land vehicle's constraints update the filter at every fix epoch after its fix, in the
 outages too: where the IMU's window before the epoch is at rest (:mod:`navsim.replay.stationarity`, the IMU alone) a
@@ -24,8 +27,9 @@ import numpy as np
 
 from navsim.earth.wander import displaced, ned_offset
 from navsim.estimation.nav_filter import ImuNoise, NavFilter, NavFilterConfig
-from navsim.replay import alignment, fixes, outages, recording, stationarity
+from navsim.replay import alignment, fixes, outages, recording, star_sensor, stationarity
 from startrack import InputError, units
+from startrack import rotation as rot
 
 
 @dataclass(frozen=True)
@@ -33,7 +37,8 @@ class Replay:
     """The inputs of a replay read and checked: ``imu`` (:class:`~navsim.replay.recording.ImuRecording`, body axes),
     ``fixes`` (:class:`~navsim.replay.fixes.Fixes`), ``start`` [s] the first fix used and ``k0`` its IMU interval,
     ``level_end`` and ``aligned`` [s after start] the ends of levelling and the heading's alignment, ``windows``
-    (K, 2) [s after start] the outages, ``config`` the checked ``[replay]`` table."""
+    (K, 2) [s after start] the outages, ``config`` the checked ``[replay]`` table, ``stars`` the star sensor's frames
+    (:class:`~navsim.replay.star_sensor.StarFixes`, None without one)."""
 
     imu: recording.ImuRecording
     fixes: fixes.Fixes
@@ -43,6 +48,7 @@ class Replay:
     aligned: float
     windows: np.ndarray
     config: dict
+    stars: star_sensor.StarFixes | None = None
 
 
 def read(config):
@@ -79,8 +85,9 @@ def read(config):
         windows += outages.scheduled(o["schedule"]["first_s"], o["schedule"]["lengths_s"], o["schedule"]["spacing_s"]).tolist()
     windows = outages.checked(np.array(windows, dtype=float).reshape(-1, 2), aligned, imu.end - start)
     k0 = int(np.ceil((start - imu.t0) / imu.dt - 1e-9))
+    stars = star_sensor.draw(config["star_sensor"], imu, solution, k0) if "star_sensor" in config else None
     return Replay(imu=imu, fixes=solution, start=start, k0=k0, level_end=level_end, aligned=aligned, windows=windows,
-                  config=config)
+                  config=config, stars=stars)
 
 
 def filter_config(replay):
@@ -94,6 +101,7 @@ def filter_config(replay):
                      gyro_bias_rw=float(units.deg_to_rad(f["gyro_bias_rw_deg_per_s_per_sqrt_s"])),
                      accel_bias_rw=f["accel_bias_rw_m_per_s2_per_sqrt_s"])
     return NavFilterConfig(np.diag(np.square(np.array(sigma, dtype=float))), noise, replay.imu.dt,
+                           star_sensor=None if replay.stars is None else replay.stars.model,
                            covariance_interval=f["covariance_interval"], gate_probability=f["gate_probability"])
 
 
@@ -151,8 +159,10 @@ def simulate(replay):
                                  "gyro_bias", "accel_bias", "sigma_bias", "zupt", "zupt_nis", "nhc", "nhc_nis")}
     rest, constraints = rest_epochs(replay), replay.config["constraints"]
     floor, velocity = replay.config["gnss"]["sigma_floor_m"], replay.config["gnss"]["use_velocity"]
+    frames = _StarLog(replay)
     for j in range(1, len(f)):
         k_j = _interval_end(imu, f.t[j])
+        k = frames.apply_until(nav, k, k_j)
         if k_j > k:
             nav.predict(imu.samples[k:k_j], imu.dt)
             k = k_j
@@ -172,6 +182,7 @@ def simulate(replay):
     series["outage"] = window[1:series["t"].size + 1]
     series["held_out"] = held[1:series["t"].size + 1]
     series["at_rest"] = rest[1:series["t"].size + 1]
+    series.update(frames.series())
     counts = {"fixes": len(f), "imu_intervals": int(k - replay.k0), "filled_intervals": int(imu.filled[replay.k0:k].sum()),
               "gaps": int(imu.gaps.shape[0]), "gap_seconds": float(imu.gaps[:, 1].sum()) if imu.gaps.size else 0.0,
               "wall_seconds": round(time.perf_counter() - started, 3)}
@@ -209,3 +220,48 @@ def _log_update(log, name, result):
     columns ``name`` and ``name_nis`` (the fix's: ``accepted`` and ``nis``)."""
     log["accepted" if name is None else name].append(-1 if result is None else int(result.accepted[0]))
     log["nis" if name is None else f"{name}_nis"].append(np.nan if result is None else float(result.nis[0]))
+
+
+class _StarLog:
+    """The star sensor's frames of a replay (none without one), applied in time order, and their log: ``star_t``
+    [s after the start], ``star_accepted`` (1, 0; −1 not applied), ``star_nis`` (NaN: not applied), ``star_q_nb``
+    (F, 4) the solution's attitude before the frame, ``star_attitude_error`` (F, 3) [rad] its φ against the
+    reference (C_nb = (I − [φ×]) C_nb,ref, NED axes) and ``star_attitude_sigma`` (F, 3) [rad] the filter's σ of φ
+    there."""
+
+    def __init__(self, replay):
+        self.replay, self.stars, self.next = replay, replay.stars, 0
+        self.log = {name: [] for name in ("star_t", "star_accepted", "star_nis", "star_q_nb", "star_attitude_error",
+                                          "star_attitude_sigma")}
+
+    def apply_until(self, nav, k, k_end):
+        """Mechanize from grid index ``k`` through every frame before ``k_end``, applying each; returns the index
+        the filter stands at."""
+        stars, imu = self.stars, self.replay.imu
+        while stars is not None and self.next < stars.k.size and stars.k[self.next] < k_end:
+            i, k_s = self.next, int(stars.k[self.next])
+            if k_s > k:
+                nav.predict(imu.samples[k:k_s], imu.dt)
+                k = k_s
+            q_nb = nav.q_nb
+            error = -rot.to_rotation_vector(rot.multiply(q_nb, rot.conjugate(stars.q_nb_ref[i])))
+            sigma = np.sqrt(np.diag(nav.P)[0:3])
+            result = nav.update_attitude(stars.q_IS[i], stars.R_S) if stars.applied else None
+            self.log["star_t"].append(imu.t0 + k_s * imu.dt - self.replay.start)
+            self.log["star_accepted"].append(-1 if result is None else int(result.accepted[0]))
+            self.log["star_nis"].append(np.nan if result is None else float(result.nis[0]))
+            self.log["star_q_nb"].append(q_nb)
+            self.log["star_attitude_error"].append(error)
+            self.log["star_attitude_sigma"].append(sigma)
+            self.next += 1
+        return k
+
+    def series(self):
+        """The log as arrays (empty without a star sensor)."""
+        if self.stars is None:
+            return {}
+        out = {name: np.array(values) for name, values in self.log.items()}
+        for name, width in (("star_q_nb", 4), ("star_attitude_error", 3), ("star_attitude_sigma", 3)):
+            out[name] = out[name].reshape(-1, width)
+        out["star_outage"] = outages.held_out(out["star_t"], self.replay.windows)
+        return out

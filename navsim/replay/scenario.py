@@ -15,11 +15,15 @@ schema (:mod:`navsim.scenario.schema`): every problem one :class:`InputError` na
                        moving), nhc_sigma_m_per_s; both off by default
     [replay.outages]   windows = [{start_s, duration_s}, ...] and/or schedule = {first_s, lengths_s, spacing_s}
                        [s after the replay's start]; free_ins = true holds out every fix after the alignment
+    [replay.star_sensor] (optional) reference_attitude (a CSV: time [s, the fixes' GPST], roll, pitch, yaw [deg]),
+                       columns (its map), rate_hz, cross_boresight_arcsec, roll_arcsec, mounting_rpy_deg (S to B;
+                       the default [180, 0, 0] looks up), seed, apply (false: the frames drawn and logged, not used)
+                       (:mod:`navsim.replay.star_sensor`)
 """
 
 from pathlib import Path
 
-from navsim.replay import fixes, recording
+from navsim.replay import fixes, recording, star_sensor
 from navsim.scenario import checked_table, read_scenario_file
 from navsim.scenario.schema import ListOfTables, Table, Value
 from startrack import InputError
@@ -86,6 +90,17 @@ SCHEMA = Table({
                                "spacing_s": Value("float", minimum=0.0)}, optional=True),
             "free_ins": Value("bool", default=False),
         }),
+        "star_sensor": Table({
+            "reference_attitude": Value("str"),
+            "columns": Value("strs", default=list(star_sensor.REFERENCE_COLUMNS),
+                             choices=(*star_sensor.REFERENCE_COLUMNS, "-")),
+            "rate_hz": _positive(1.0, maximum=100.0),
+            "cross_boresight_arcsec": _positive(5.0, maximum=3600.0),
+            "roll_arcsec": _positive(40.0, maximum=3600.0),
+            "mounting_rpy_deg": Value("vector", default=[180.0, 0.0, 0.0], minimum=-360.0, maximum=360.0),
+            "seed": Value("int", default=0, minimum=0),
+            "apply": Value("bool", default=True),
+        }, optional=True),
     }),
 })
 
@@ -103,7 +118,10 @@ def load(path, overrides=()):
         raise InputError(f"{path.name}: replay.imu.columns: needs a {missing[0]!r} column")
     if replay["gnss"]["format"] == "csv" and not replay["gnss"]["columns"]:
         raise InputError(f"{path.name}: replay.gnss.columns: a csv solution needs its column map")
-    for table, key in ((replay["imu"], "file"), (replay["imu"], "time_tag_file"), (replay["gnss"], "file")):
+    files = [(replay["imu"], "file"), (replay["imu"], "time_tag_file"), (replay["gnss"], "file")]
+    if "star_sensor" in replay:
+        files.append((replay["star_sensor"], "reference_attitude"))
+    for table, key in files:
         if table[key]:
             table[key] = str((path.parent / table[key]).resolve())
     return data

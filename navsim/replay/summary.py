@@ -1,6 +1,6 @@
 """What a replay's summary says: its error against the held-out fixes in each outage (horizontal max, RMS and at the
 end, vertical max), beside the filter's own σ there, the aided epochs' one-step error, the updates, the constraints
-(ZUPT and non-holonomic: accepted, rejected, mean NIS), the gaps, the alignment and the timing. The horizontal error of an epoch is √(δN² + δE²) of the solution before any update against
+(ZUPT and non-holonomic: accepted, rejected, mean NIS), the gaps, the alignment, the timing and, with a star sensor, its frames and the heading error against the reference attitude. The horizontal error of an epoch is √(δN² + δE²) of the solution before any update against
 the fix moved to the epoch's time (:mod:`navsim.replay.run`); the RMS is over the outage's fixes at 4 Hz (or the
 solution's rate)."""
 
@@ -49,6 +49,7 @@ def summarize(name, replay, series, counts):
         "constraints": constraint_counts(series),
         "outages": outage_rows(series, replay.windows),
         "free_ins": bool(replay.config["outages"]["free_ins"]),
+        **({} if replay.stars is None else {"star_sensor": star_sensor(replay, series)}),
         "timing": {"wall_seconds": counts["wall_seconds"]},
     }
 
@@ -63,6 +64,26 @@ def constraint_counts(series):
         out[name] = {"accepted": int(accepted.sum()), "rejected": int((series[name] == 0).sum()), "dof": dof,
                      "mean_nis": float(np.mean(series[f"{name}_nis"][accepted])) if accepted.any() else None}
     return out
+
+
+def star_sensor(replay, series):
+    """The star sensor's block: its frames applied, accepted, rejected, their NIS's mean (3 dof) and, against the
+    reference attitude, the heading error's (|φ_D|) RMS and max over every frame and by outage (with the filter's
+    heading σ at the outage's end) [deg]."""
+    accepted, heading = series["star_accepted"], np.degrees(np.abs(series["star_attitude_error"][:, 2]))
+    nis = series["star_nis"][accepted >= 0]
+    rows = []
+    for i, (start, duration) in enumerate(replay.windows):
+        inside = series["star_outage"] == i
+        e = heading[inside]
+        rows.append({"start_s": float(start), "duration_s": float(duration), "frames": int(inside.sum()),
+                     "max_heading_error_deg": float(e.max()) if e.size else None,
+                     "heading_sigma_end_deg": float(np.degrees(series["star_attitude_sigma"][inside][-1, 2])) if e.size else None})
+    return {"applied": bool(replay.stars.applied), "frames": int(accepted.size), "accepted": int((accepted == 1).sum()),
+            "rejected": int((accepted == 0).sum()), "nis_mean": float(np.mean(nis)) if nis.size else None, "nis_dof": 3,
+            "rate_hz": replay.config["star_sensor"]["rate_hz"],
+            "heading_error_deg": {"rms": float(np.sqrt(np.mean(heading**2))), "max": float(heading.max())},
+            "outages": rows}
 
 
 def first_level(series):
@@ -89,6 +110,12 @@ def lines(summary):
         if row["fixes"]:
             out.append(f"outage {row['start_s']:7.1f} s + {row['duration_s']:5.1f} s   horizontal max {row['max_horizontal_m']:8.2f} m, "
                        f"RMS {row['rms_horizontal_m']:8.2f} m (filter 1σ at end {row['sigma_horizontal_end_m']:.2f} m)")
+    if "star_sensor" in summary:
+        s = summary["star_sensor"]
+        used = (f"{s['accepted']} accepted, {s['rejected']} rejected, NIS mean {s['nis_mean']:.2f} (3 dof)" if s["applied"]
+                else "drawn, not applied")
+        out.append(f"star sensor         {s['frames']} frames at {s['rate_hz']:g} Hz: {used}; heading error against the "
+                   f"reference RMS {s['heading_error_deg']['rms']:.4f} deg, max {s['heading_error_deg']['max']:.4f} deg")
     out.append(f"wall time           {summary['timing']['wall_seconds']:.2f} s")
     return out
 

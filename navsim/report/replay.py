@@ -25,6 +25,8 @@ def replay_report(summary, series) -> bytes:
             f"deg), heading from the GNSS course at {number(a['heading_aligned_s'], 1)} s. Fixes: {updates['accepted']} "
             f"accepted, {updates['rejected']} rejected, {updates['held_out']} held out"
             + (" (a free INS: every fix after the alignment)." if summary["free_ins"] else " in the outages.")))
+        if "star_sensor" in summary:
+            doc.paragraph(markup(_star_sentence(summary["star_sensor"])))
         doc.figure(_figure(series, summary["outages"]), "Horizontal error of the solution before each update against the "
                    "fix [m] (log scale), the filter's horizontal 1σ dashed; the outages shaded.")
         rows = [(number(r["start_s"], 1), number(r["duration_s"], 1), str(r["fixes"]), number(r["max_horizontal_m"]),
@@ -33,6 +35,15 @@ def replay_report(summary, series) -> bytes:
         doc.add(table(("Start [s]", "Length [s]", "Fixes", "Max horiz. [m]", "RMS horiz. [m]", "End horiz. [m]",
                        "Max vert. [m]", "Filter 1σ at end [m]"), rows))
         return doc.compile()
+
+
+def _star_sentence(block):
+    """The star sensor's sentence: its frames, their use and the heading error against the reference attitude."""
+    used = (f"applied ({block['accepted']} accepted, {block['rejected']} rejected, NIS mean "
+            f"{number(block['nis_mean'])} of 3 dof)" if block["applied"] else "drawn but not applied")
+    return (f"A simulated star sensor from the reference attitude: {block['frames']} frames at {number(block['rate_hz'])} "
+            f"Hz, {used}; the heading error against the reference RMS {number(block['heading_error_deg']['rms'], 4)} deg, "
+            f"max {number(block['heading_error_deg']['max'], 4)} deg.")
 
 
 def _figure(series, outages):

@@ -5,6 +5,7 @@ increments in a mounted IMU's axes and a CSV of 4 Hz position fixes with seeded 
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from navsim.earth.wander import displaced
 from navsim.replay.alignment import euler_matrix
@@ -107,3 +108,21 @@ initial_accel_bias_sigma_m_per_s2 = 0.1
 {extra}
 """)
     return path
+
+
+def write_reference(directory, truth, every=10):
+    """Write ``reference.csv``: the truth's attitude every ``every`` samples as time [s, the fixes' clock], roll,
+    pitch, yaw [deg] (scipy's intrinsic ZYX angles of q_nb: independent of the replay's Euler conversion); returns
+    its path."""
+    k = np.arange(0, truth.t.size, every)
+    yaw, pitch, roll = Rotation.from_quat(truth.q_nb[k]).as_euler("ZYX", degrees=True).T
+    path = Path(directory) / "reference.csv"
+    np.savetxt(path, np.column_stack([truth.t[k] + T0, roll, pitch, yaw]), delimiter=",", fmt="%.12f")
+    return path
+
+
+def star_table(reference, **keys):
+    """A ``[replay.star_sensor]`` table for :func:`replay_toml`'s ``extra``."""
+    lines = [f'reference_attitude = "{reference}"', *(f"{k} = {str(v).lower() if isinstance(v, bool) else v}"
+                                                      for k, v in keys.items())]
+    return "[replay.star_sensor]\n" + "\n".join(lines)
