@@ -1,8 +1,9 @@
 """What a replay's summary says: its error against the held-out fixes in each outage (horizontal max, RMS and at the
 end, vertical max), beside the filter's own σ there, the aided epochs' one-step error, the updates, the constraints
-(ZUPT and non-holonomic: accepted, rejected, mean NIS), the gaps, the alignment, the timing and, with a star sensor, its frames and the heading error against the reference attitude. The horizontal error of an epoch is √(δN² + δE²) of the solution before any update against
-the fix moved to the epoch's time (:mod:`navsim.replay.run`); the RMS is over the outage's fixes at 4 Hz (or the
-solution's rate)."""
+(ZUPT and non-holonomic: accepted, rejected, mean NIS), the gaps, the alignment, the timing and, with a star sensor,
+its frames and the heading error against the reference attitude. The horizontal error of an epoch is √(δN² + δE²) of
+the solution before any update against the fix moved to the epoch's time (:mod:`navsim.replay.run`); the RMS is over
+the outage's fixes at 4 Hz (or the solution's rate)."""
 
 import numpy as np
 

@@ -22,7 +22,7 @@ In (1) the star's s is then the track's and [s×] P_θ [s×]ᵀ is replaced by C
 the prior's, so the chance (2) that a coincidence falls inside it shrinks by the ratio of the two areas, and a
 detection that lies in the prior's gate but not in the track's is not that star. This is the validation gate of a confirmed
 track in target tracking (Bar-Shalom, Li & Kirubarajan). A match on a track is wrong only when the star went
-undetected and a false detection fell inside its gate: its (2) keeps the ρ_f P_miss term alone. Another star
+undetected and a false detection fell inside its gate: its (2) keeps the false detections' ρ_f alone in λ. Another star
 inside the gate, √χ²₂ √2 σ_c ≈ 6 centroid σ from the track, is one the sensor does not resolve from it, and one
 that stays there was there at the track's first match, whose (2) counts it.
 
@@ -31,18 +31,27 @@ the only one in the star's gate.
 
 Wrong match. A detection that is not the star its gate holds lies where the sky puts it independently of the
 catalog: another star whose own entry fell outside the gate (or an object the catalog lacks), or a false
-detection -- which uniqueness leaves only when the star itself went undetected (else two detections share its
-gate). The chance that the match is such a coincidence is
+detection -- which uniqueness leaves only when the star itself went undetected or fell outside its gate (else two
+detections share it). With clutter of density λ = ρ_m + ρ_f [sr⁻¹] in the gate, the chance that the detection is
+clutter and not the star is the parametric PDA's association probability β_0 of a single validated measurement
+(Bar-Shalom, Daum & Huang 2009, "the PDAF", β_i and β_0 of the Poisson clutter model):
 
-    P_wrong = 1 − exp(−(ρ_m + ρ_f P_miss) A),   A = π χ²₂(p_gate) √det S   [sr],                   (2)
+    P_wrong = λ (1 − P_D P_G) / (λ (1 − P_D P_G) + P_D N(r; 0, S)),
+    N(r; 0, S) = exp(−d²/2) / (2π √det S)   [sr⁻¹],                                                  (2)
 
-ρ_m the density [sr⁻¹] of catalog stars inside the detection's magnitude window (counted in a cap around the
-predicted boresight), ρ_f the density of false detections the sensor expects (their magnitudes are not
-trusted to reject them), P_miss = Φ((m − m_lim)/0.3 mag) the chance that the star of magnitude m went undetected
-below the frame's limiting magnitude m_lim (1 when the caller gives none). A match is kept when P_wrong <=
-``max_wrong`` (the ceiling). The ρ_m term supposes the detection unrelated to the star whatever its gate
-probability: (2) bounds the rate of wrong matches from above. Not modelled: the planets (bright, not in the
-catalog: the ρ_m term counts stars only).
+ρ_m the density of catalog stars inside the detection's magnitude window (counted in a cap around the predicted
+boresight), ρ_f the density of false detections the sensor expects (their magnitudes are not trusted to reject
+them), P_G = p_gate, and P_D = 1 − P_miss, P_miss = Φ((m − m_lim)/0.3 mag) the chance that the star of magnitude m
+went undetected below the frame's limiting magnitude m_lim, times the chance that the star truly lies inside the
+field (its prediction near the edge may be inside while it is outside: Φ((ρ − θ)/σ_θ), θ its predicted angle from
+the boresight). (2) is the posterior probability given where the
+detection lies, so its sum over a run's matches is the number of wrong matches to expect: a star below the limit
+(P_D small) is named only when its detection lies much closer to it than clutter would, and a detection at the
+gate's edge needs a rarer coincidence than one at its centre. With no limiting magnitude the star counts as
+detectable (the magnitude's factor of P_D taken as 1) but its miss is not ruled out (the factor 1 − P_D P_G taken as 1). A match
+is kept when P_wrong <= ``max_wrong`` (the ceiling). The ρ_m term supposes the detection unrelated to the star
+whatever its gate probability: (2) bounds the rate of wrong matches from above. Not modelled: the planets
+(bright, not in the catalog: the ρ_m term counts stars only).
 """
 
 from __future__ import annotations
@@ -58,7 +67,7 @@ from startrack.geometry.sphere import tangent_basis
 
 #: Radius [rad] of the cap around the predicted boresight in which ρ_m of eq. (2) is counted (at least).
 _DENSITY_RADIUS = np.radians(10.0)
-#: Width [mag] of the detection's fall-off around the limiting magnitude in P_miss of eq. (2).
+#: Width [mag] of the detection's fall-off around the limiting magnitude in P_D of eq. (2).
 _LIMIT_WIDTH = 0.3
 
 
@@ -155,9 +164,10 @@ class PriorMatch:
         mag_ok = np.abs(np.asarray(obs_mag, dtype=float)[:, None] - self.mags[candidates][None, :]) <= window[:, None]
         inside = (d2 <= self.gate) & mag_ok
         density = self._window_density(boresight, np.asarray(obs_mag, dtype=float), window)
-        miss = (np.ones(candidates.size) if limiting_mag is None
-                else norm.cdf((self.mags[candidates] - limiting_mag) / _LIMIT_WIDTH))
-        return self._unique(inside, d2, area, density, miss, candidates, tracked)
+        detect = _in_field(s, C, self.field_radius)
+        if limiting_mag is not None:
+            detect = detect * norm.sf((self.mags[candidates] - limiting_mag) / _LIMIT_WIDTH)
+        return self._unique(inside, d2, area, density, detect, candidates, tracked, limiting_mag is None)
 
     def _window_density(self, boresight, obs_mag, window):
         """ρ_m (M,) [sr⁻¹]: catalog stars within each detection's magnitude window per steradian of the cap of
@@ -167,9 +177,10 @@ class PriorMatch:
         counts = np.array([np.count_nonzero(np.abs(near - m) <= w) for m, w in zip(obs_mag, window)])
         return np.maximum(counts, 1) / (2.0 * np.pi * (1.0 - np.cos(radius)))
 
-    def _unique(self, inside, d2, area, density, miss, candidates, tracked):
-        """The mutually unique gate pairs, each kept when its eq. (2) is under the ceiling (its false-detection term
-        alone for a ``tracked`` (K,) star: the module docstring's track gate)."""
+    def _unique(self, inside, d2, area, density, detect, candidates, tracked, unknown_limit):
+        """The mutually unique gate pairs, each kept when its eq. (2) is under the ceiling (ρ_m left out of λ for a
+        ``tracked`` (K,) star: the module docstring's track gate); ``detect`` (K,) P_D of eq. (2), its miss not
+        ruled out when the frame's limit is unknown (``unknown_limit``)."""
         per_obs, per_star = inside.sum(axis=1), inside.sum(axis=0)
         obs_index, star_index, wrong, dist, rejected = [], [], [], [], []
         for i in range(inside.shape[0]):
@@ -183,7 +194,10 @@ class PriorMatch:
             if per_star[k] > 1:
                 rejected.append("shared")
                 continue
-            p = -np.expm1(-((0.0 if tracked[k] else density[i]) + self.false_density * miss[k]) * self.gate * area[i, k])
+            p_d = detect[k]
+            unseen = 1.0 if unknown_limit else 1.0 - p_d * self.gate_probability
+            p = _wrong_probability(((0.0 if tracked[k] else density[i]) + self.false_density) * unseen, p_d,
+                                   d2[i, k], area[i, k])
             if p > self.max_wrong:
                 rejected.append("chance")
                 continue
@@ -194,6 +208,22 @@ class PriorMatch:
             dist.append(d2[i, k])
         return PriorMatches(obs_index=np.array(obs_index, np.int64), star_index=np.array(star_index, np.int64),
                             wrong_probability=np.array(wrong), d2=np.array(dist), rejected=tuple(rejected))
+
+
+def _wrong_probability(unseen, detect, d2, area):
+    """P_wrong of eq. (2) from the clutter's share λ (1 − P_D P_G) ``unseen`` [sr⁻¹], the star's P_D ``detect``, the
+    detection's d² and π √det S ``area`` [sr] (:func:`_mahalanobis`); 1 when neither hypothesis can hold."""
+    total = unseen + detect * np.exp(-0.5 * d2) / (2.0 * area)
+    return unseen / total if total > 0.0 else 1.0
+
+
+def _in_field(s, C, field_radius):
+    """P_in (K,): the chance that each predicted star s (K, 3) of prediction covariance C (K, 3, 3) [rad²] truly lies
+    within ``field_radius`` [rad] of the boresight (the sensor's z): Φ((ρ − θ)/σ_θ), θ = arccos s_z and
+    σ_θ² = C_zz / sin²θ (eq. 2's P_D near the field's edge)."""
+    theta = np.arccos(np.clip(s[:, 2], -1.0, 1.0))
+    sigma = np.sqrt(np.maximum(C[:, 2, 2], 1e-30)) / np.maximum(np.sin(theta), 1e-12)
+    return norm.cdf((field_radius - theta) / sigma)
 
 
 def _attitude_covariance(s, P_theta):
