@@ -11,10 +11,10 @@ Fixes of a quality outside ``qualities`` are dropped; none left is an :class:`In
 
 import calendar
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from navsim.replay import csv_table
 from startrack import InputError, units
 
 #: The columns of an RTKLIB solution line after its date and time (the velocity ones optional).
@@ -63,7 +63,7 @@ def gpst_seconds(date, time):
 
 def read_pos(path, qualities=(1,)):
     """The :class:`Fixes` of an RTKLIB ``.pos`` solution (module docstring), those of a quality in ``qualities``."""
-    path = _existing(path)
+    path = csv_table.existing(path, "GNSS solution file")
     rows, times = [], []
     for number, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), start=1):
         if line.startswith("%"):
@@ -91,33 +91,14 @@ def read_pos(path, qualities=(1,)):
 
 def read_csv(path, columns, qualities=(1,)):
     """The :class:`Fixes` of a CSV with the column map ``columns`` (names of :data:`CSV_COLUMNS`, ``"-"`` to skip)."""
-    path = _existing(path)
-    unknown = [c for c in columns if c != "-" and c not in CSV_COLUMNS]
-    if unknown:
-        raise InputError(f"gnss.columns: unknown column {unknown[0]!r} (known: {', '.join(CSV_COLUMNS)}, '-')")
-    missing = [c for c in _REQUIRED if c not in columns]
-    if missing:
-        raise InputError(f"gnss.columns: needs a {missing[0]!r} column")
-    try:
-        table = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-    except ValueError as error:
-        raise InputError(f"{path}: not a numeric CSV ({str(error).splitlines()[0]})") from None
-    if table.shape[1] != len(columns):
-        raise InputError(f"{path}: {table.shape[1]} columns, gnss.columns names {len(columns)}")
-    named = {c: table[:, i] for i, c in enumerate(columns) if c != "-"}
+    path, table = csv_table.read_table(path, columns, "GNSS solution file", "gnss.columns", CSV_COLUMNS, _REQUIRED)
+    named = csv_table.named(table, columns)
     named.setdefault("quality", np.ones(table.shape[0]))
     given = [c for c in _VELOCITY if c in named]
     if given and len(given) < len(_VELOCITY):
         raise InputError(f"gnss.columns: a velocity needs all of {', '.join(_VELOCITY)}; "
                          f"{next(c for c in _VELOCITY if c not in named)!r} is missing")
     return _fixes(path, named, qualities)
-
-
-def _existing(path):
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: GNSS solution file not found")
-    return path
 
 
 def _fixes(path, named, qualities):

@@ -17,10 +17,10 @@ constant over the whole log (a dead sensor): each an :class:`InputError` naming 
 
 import struct
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from navsim.replay import csv_table
 from startrack import InputError, units
 
 #: The channel names of a column map: accelerometer x, y, z, gyro x, y, z and the time counter.
@@ -61,9 +61,7 @@ def read_time_tag(path):
     """(start [s GPST since 1970], last tick [s]) of an RTKLIB time-tag file: after the 60-byte header a uint32 tick
     frequency, the start as uint32 seconds and float64 fraction, then (uint32 tick [ms], uint32 file position)
     pairs, the last of which is the log's last tick."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: time-tag file not found")
+    path = csv_table.existing(path, "time-tag file")
     raw = path.read_bytes()
     body = len(raw) - _TAG_HEADER - 16
     if body < 8 or not raw.startswith(b"TIMETAG"):
@@ -71,26 +69,6 @@ def read_time_tag(path):
     seconds, fraction = struct.unpack_from("<Id", raw, _TAG_HEADER + 4)
     last_tick = struct.unpack_from("<I", raw, _TAG_HEADER + 16 + 8 * (body // 8 - 1))[0]
     return seconds + fraction, last_tick * 1e-3
-
-
-def read_table(path, columns):
-    """The numeric columns of a CSV log (N, len(columns)) by the column map (module docstring); an InputError for a
-    missing file, a row of the wrong width, a non-number or a NaN."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: IMU log not found")
-    try:
-        table = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-    except ValueError as error:
-        raise InputError(f"{path}: not a numeric CSV log ({str(error).splitlines()[0]})") from None
-    if table.shape[0] < 2:
-        raise InputError(f"{path}: fewer than two rows")
-    if table.shape[1] != len(columns):
-        raise InputError(f"{path}: {table.shape[1]} columns, the column map names {len(columns)}")
-    bad = np.flatnonzero(~np.isfinite(table).all(axis=1))
-    if bad.size:
-        raise InputError(f"{path}: row {bad[0] + 1} is not finite (NaN or inf; {bad.size} such rows)")
-    return table
 
 
 def read_imu(path, columns, quantity, accel_unit, gyro_unit, time_unit, time_tag=None, time_offset=0.0):
@@ -101,8 +79,9 @@ def read_imu(path, columns, quantity, accel_unit, gyro_unit, time_unit, time_tag
                                 ("time_unit", time_unit, tuple(TIME_UNITS))):
         if unit not in allowed:
             raise InputError(f"{name}: unknown unit {unit!r} for {quantity} (known: {', '.join(allowed)})")
-    table = read_table(path, columns)
-    pick = {name: table[:, i] for i, name in enumerate(columns) if name != "-"}
+    path, table = csv_table.read_table(path, columns, "IMU log", "replay.imu.columns")
+    csv_table.check_rows(path, table)
+    pick = csv_table.named(table, columns)
     counter = pick["time"] * TIME_UNITS[time_unit]
     steps = np.diff(counter)
     if not (steps > 0.0).all():

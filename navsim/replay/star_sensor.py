@@ -23,7 +23,6 @@ recording and applied with :meth:`navsim.estimation.nav_filter.NavFilter.update_
 """
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -31,6 +30,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from navsim.earth.frames import gpst_epoch_utc
 from navsim.earth.orientation import EarthOrientation, observer_velocity
 from navsim.estimation.nav_filter import StarSensorModel
+from navsim.replay import csv_table
 from navsim.replay.alignment import q_nb, velocity_ne
 from navsim.sensors.faults import SensorFaults
 from navsim.sensors.star_vector import AttitudeFixSensor
@@ -79,27 +79,10 @@ class StarFixes:
 def read_reference(path, columns):
     """The :class:`ReferenceAttitude` of a CSV with the column map ``columns`` (module docstring); an InputError for a
     missing file, an unknown or missing column, a row of the wrong width, a non-finite row or time not increasing."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: reference attitude file not found")
-    unknown = [c for c in columns if c != "-" and c not in REFERENCE_COLUMNS]
-    if unknown:
-        raise InputError(f"star_sensor.columns: unknown column {unknown[0]!r} (known: {', '.join(REFERENCE_COLUMNS)}, '-')")
-    missing = [c for c in REFERENCE_COLUMNS if c not in columns]
-    if missing:
-        raise InputError(f"star_sensor.columns: needs a {missing[0]!r} column")
-    try:
-        table = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-    except ValueError as error:
-        raise InputError(f"{path}: not a numeric CSV ({str(error).splitlines()[0]})") from None
-    if table.shape[1] != len(columns):
-        raise InputError(f"{path}: {table.shape[1]} columns, star_sensor.columns names {len(columns)}")
-    named = {c: table[:, i] for i, c in enumerate(columns) if c != "-"}
-    bad = np.flatnonzero(~np.isfinite(np.stack([named[c] for c in REFERENCE_COLUMNS], axis=1)).all(axis=1))
-    if bad.size:
-        raise InputError(f"{path}: row {bad[0] + 1} is not finite (NaN or inf; {bad.size} such rows)")
-    if table.shape[0] < 2:
-        raise InputError(f"{path}: fewer than two rows")
+    path, table = csv_table.read_table(path, columns, "reference attitude file", "star_sensor.columns",
+                                       REFERENCE_COLUMNS, REFERENCE_COLUMNS)
+    named = csv_table.named(table, columns)
+    csv_table.check_rows(path, np.stack([named[c] for c in REFERENCE_COLUMNS], axis=1))
     back = np.flatnonzero(np.diff(named["time_s"]) <= 0.0)
     if back.size:
         raise InputError(f"{path}: time not increasing at row {back[0] + 2}")
