@@ -203,9 +203,11 @@ def _add_fit_options(parser):
 def _fit_options(args):
     """(PSF radius, gain, smear) of the parsed fit options, checked; None without --psf-sigma-px."""
     if args.psf_sigma_px is None:
-        if args.gain_e_per_dn is not None or args.smear_px is not None:
-            raise InputError("options --gain-e-per-dn and --smear-px go with --psf-sigma-px (the PSF radius of the fit "
-                             "and of --smear-px's matched filter)")
+        given = [name for name, value in (("--gain-e-per-dn", args.gain_e_per_dn), ("--smear-px", args.smear_px))
+                 if value is not None]
+        if given:
+            raise InputError(f"{' and '.join(given)} given without --psf-sigma-px, the PSF radius of the fit and of "
+                             "--smear-px's matched filter")
         return None
     check_range("--psf-sigma-px", args.psf_sigma_px, 0.05, 100.0)
     if args.gain_e_per_dn is not None:
