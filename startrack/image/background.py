@@ -4,14 +4,14 @@ vignetting, sky gradients and nebulosity (SExtractor's background map, Bertin & 
 Global (:func:`estimate_background`): iterated 3-sigma-clipped mean and standard deviation of a regular
 subsample, started from the median and 1.4826 MAD.
 
-Mesh (:func:`mesh_background`): the frame is cut into square cells of ``cell_px`` (a remainder of half
-a cell or more is a last, smaller cell, a smaller one joins the last cell); in each cell a regular
-subsample (at most 256 pixels) gives a clipped level and noise as above, computed for all cells at
-once.  A cell whose level lies more than 3 sigma from the median of its 3 x 3 cells, or whose noise is
-over twice theirs (a bright star or a cluster filling it), takes those medians (SExtractor's filter
-with its threshold, so that a smooth gradient -- vignetting -- is kept to the edges); the cell values
-are interpolated bilinearly between cell centres to every pixel, linearly extrapolated beyond the
-outer centres.
+Mesh (:func:`mesh_background`): the frame is cut into square cells of ``cell_px`` (a remainder of half a cell
+or more is a last, smaller cell, a smaller one joins the last cell); in each cell a regular subsample (at most
+256 pixels, or as many as the caller asks: the level's error is ~σ_n/√k for k of them) gives a clipped level
+and noise as above, computed for all cells at once. A cell whose level lies more than 3 sigma from the median
+of its 3 x 3 cells, or whose noise is over twice theirs (a bright star or a cluster filling it), takes those
+medians (SExtractor's filter with its threshold, so that a smooth gradient -- vignetting -- is kept to the
+edges); the cell values are interpolated bilinearly between cell centres to every pixel, linearly extrapolated
+beyond the outer centres.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from scipy.special import ndtr
 
 #: Pixels used for the global estimate (regular subsample of the frame).
 _GLOBAL_SAMPLE = 16384
-#: Pixels per cell used for a mesh estimate (regular subsample of the cell).
-_CELL_SAMPLE = 256
+#: Pixels per cell used for a mesh estimate by default (regular subsample of the cell).
+CELL_SAMPLE = 256
 #: 1.4826 * MAD is sigma for a normal law.
 _MAD_TO_SIGMA = 1.482602218505602
 
@@ -90,11 +90,11 @@ def _cell_edges(size, cell_px):
     return np.array(edges)
 
 
-def _cell_samples(array, rows, cols):
-    """(cells_y, cells_x, k) subsamples of every cell: the same ny x nx grid (k <= 256 pixels) spread evenly
-    over each cell, whatever its size."""
+def _cell_samples(array, rows, cols, cell_sample):
+    """(cells_y, cells_x, k) subsamples of every cell: the same ny x nx grid (k <= ``cell_sample`` pixels) spread
+    evenly over each cell, whatever its size."""
     heights, widths = np.diff(rows), np.diff(cols)
-    step = max(1.0, np.sqrt(heights.min() * widths.min() / _CELL_SAMPLE))
+    step = max(1.0, np.sqrt(heights.min() * widths.min() / cell_sample))
     ny, nx = max(1, int(heights.min() / step)), max(1, int(widths.min() / step))
     r = (rows[:-1, None] + (np.arange(ny)[None, :] + 0.5) * heights[:, None] / ny).astype(np.int64)  # (cells_y, ny)
     c = (cols[:-1, None] + (np.arange(nx)[None, :] + 0.5) * widths[:, None] / nx).astype(np.int64)
@@ -167,11 +167,12 @@ class Background:
         return tuple(out)
 
 
-def mesh_background(image, cell_px=64, clip=3.0, iterations=5):
-    """The :class:`Background` of a frame on a mesh of ``cell_px`` cells (module text)."""
+def mesh_background(image, cell_px=64, clip=3.0, iterations=5, cell_sample=CELL_SAMPLE):
+    """The :class:`Background` of a frame on a mesh of ``cell_px`` cells, each from at most ``cell_sample`` of
+    its pixels (module text)."""
     array = np.asarray(image)
     rows, cols = _cell_edges(array.shape[0], int(cell_px)), _cell_edges(array.shape[1], int(cell_px))
-    samples = _cell_samples(array, rows, cols)
+    samples = _cell_samples(array, rows, cols, cell_sample)
     level, sigma = _clipped_level(samples.reshape(-1, samples.shape[-1]), clip, iterations)
     shape = samples.shape[:2]
     level, sigma = level.reshape(shape), sigma.reshape(shape)

@@ -58,7 +58,7 @@ import numpy as np
 from scipy import ndimage
 
 from startrack.base.errors import InputError
-from startrack.image.background import Background, estimate_background, mesh_background
+from startrack.image.background import CELL_SAMPLE, Background, estimate_background, mesh_background
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 #: Smallest ring ratio of a star image (module text).
@@ -320,13 +320,14 @@ def _centroid_sigma(index, n, coord, centre, npix, wsum, sigma_n):
     return np.sqrt(scale * np.maximum(spread, 0.0) / wsum**2 + 1.0 / (12.0 * npix * npix))
 
 
-def frame_background(array, background, sigma_n, mesh_px):
+def frame_background(array, background, sigma_n, mesh_px, every_pixel=False):
     """The :class:`~startrack.image.background.Background` of a frame: the given level and noise (the missing one
-    estimated over the frame), a mesh of ``mesh_px`` cells, or one estimate for the whole frame."""
+    estimated over the frame), a mesh of ``mesh_px`` cells (each from a subsample of its pixels, or from
+    ``every_pixel`` of it), or one estimate for the whole frame."""
     if background is None and sigma_n is None and mesh_px is not None:
         if isinstance(mesh_px, bool) or not isinstance(mesh_px, (int, np.integer)) or not 8 <= mesh_px <= 4096:
             raise InputError(f"mesh_px = {mesh_px!r} must be an integer number of pixels in [8, 4096]")
-        return mesh_background(array, int(mesh_px))
+        return mesh_background(array, int(mesh_px), cell_sample=int(mesh_px) ** 2 if every_pixel else CELL_SAMPLE)
     if background is None or sigma_n is None:
         b_est, s_est = estimate_background(array)
         background = b_est if background is None else background

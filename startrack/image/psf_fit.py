@@ -349,6 +349,21 @@ def fit_stars(image, uv0, psf_sigma_px, noise, background_dn, smear_px=None, sat
                       for name in out))
 
 
+def fit_detections(image, uv, psf_sigma_px, sigma_n_dn, background_dn, smear_px=None, gain_e_per_dn=None,
+                   saturation_dn=None):
+    """:func:`fit_stars` of a detector's detections at ``uv`` (N, 2) [px] in a full frame, each one's neighbours
+    the other detections (a star whose window another one's light reaches is ``blended``), the pixel noise the
+    frame's background noise ``sigma_n_dn`` [DN] as read (measured on the frame's pixels: the rounding to whole DN
+    is in it) with the stars' shot noise through ``gain_e_per_dn`` (None: left out), the background's start
+    ``background_dn`` [DN]; ``smear_px`` (Δu, Δv) [px] the trail of every star (None: none). What
+    :func:`startrack.image.trail_detection.detect_trailed` and ``startrack detect`` fit."""
+    uv = np.atleast_2d(np.asarray(uv, dtype=float)).reshape(-1, 2)
+    noise = PixelNoise(sigma_n_dn, gain_e_per_dn=gain_e_per_dn, quantised=False)
+    others = [np.delete(uv, k, axis=0) for k in range(len(uv))]
+    return fit_stars(image, uv, psf_sigma_px, noise, background_dn, smear_px=smear_px, saturation_dn=saturation_dn,
+                     neighbours=others)
+
+
 def neighbour_reach(psf_sigma_px, smear_px):
     """(2,) [px]: how far from the centre of a star's fit window, per axis, the centre of another source smeared
     like it (``smear_px`` (Δu, Δv)) may lie and still send light into the window -- its track within

@@ -191,7 +191,7 @@ def test_the_command_line_fits_and_reports_the_covariance(tmp_path, capsys):
         assert np.sqrt(np.diag(fit["cov_uv_px2"])) == pytest.approx(np.sqrt(np.diag(bound)), rel=0.1)
         assert np.hypot(fit["u"] - u, fit["v"] - v) < 5.0 * np.sqrt(np.trace(bound))
     assert cli.main(["detect", str(tmp_path / "frame.npy"), "--gain-e-per-dn", "1"]) == 2
-    assert "go with --psf-sigma-px" in capsys.readouterr().err
+    assert "--gain-e-per-dn given without --psf-sigma-px" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("call, message", [
