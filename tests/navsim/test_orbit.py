@@ -160,8 +160,9 @@ def test_drag_lowers_the_orbit_by_the_closed_form_decay_rate():
     """A circular equatorial orbit at 400 km with C_D A/m = B = 0.02 m²/kg for a day. The air turns with the Earth:
     relative to it the spacecraft moves at v_r = (n − ω) a, so the drag's power is −½ ρ B v_r² v and, with
     E = −μ/2a, da/dt = −ρ B √(μ a) (1 − ω/n)² (King-Hele 1987's atmospheric-rotation factor
-    F = (1 − r ω cos i/v)² at i = 0; 0.8752 at 400 km). The density grows as the orbit sinks through the exponential layer of scale height
-    H: with K = ρ0 B √(μ a) (1 − ω/n)², a0 − a(t) = −H ln(1 − K t/H) (0.28 % more than K t over the day's 294 m).
+    F = (1 − r ω cos i/v)² at i = 0; 0.8752 at 400 km). The density grows as the orbit sinks through the exponential
+    layer of scale height H: with K = ρ0 B √(μ a) (1 − ω/n)², a0 − a(t) = −H ln(1 − K t/H) (0.28 % more than K t over
+    the day's 294 m).
     Within 1e-4 (seen: −1.1e-5, what is neglected: the change of √(μ a) (1 − ω/n)² over the 294 m, −1.3e-5 at the
     end); an atmosphere turning at half the Earth's rate is 7 % off, a still one 14 %."""
     a = 6378137.0 + 400e3
