@@ -261,17 +261,16 @@ def test_alexander_1999_limiting_magnitude_against_its_closed_form():
     assert (m[0, 1] - m[0, 0]) / 0.4 == pytest.approx(0.5, abs=0.02)
 
 
-def test_the_balloon_scenario_is_alexanders_camera_under_the_air_above():
+def test_the_balloon_scenario_is_alexanders_camera_under_the_air_above(skyfield_sky):
     """scenarios/balloon_day_alexander1999.toml (35 km over Fort Sumner at noon, the boresight 50° up to the north, R_C,
     0.3 s): ``navsim sky``'s boresight sky is the single scattering of the air above (:func:`_single_scattering`, the
     Sun's position from skyfield, DE421: 30.5° from the zenith, 70° from the boresight) with an Earth of albedo in
     :data:`EARTH_ALBEDO` (seen 0.44), and its limiting magnitude the closed form's (:func:`_limiting_magnitude`, R_C's
     138 nm band, the silicon_cmos preset's 3 e⁻ read noise and 10 e⁻/s dark current) on that sky within 0.05 mag (seen
     0.02: the platform turning with the Earth trails the stars by 0.15 px in 0.3 s, which the closed form leaves out)."""
-    from importlib.resources import files
     from pathlib import Path
 
-    from skyfield.api import Loader, wgs84
+    from skyfield.api import wgs84
 
     from navsim.kinds import resolve_scenario
     from navsim.navigation.availability import star_availability
@@ -279,8 +278,7 @@ def test_the_balloon_scenario_is_alexanders_camera_under_the_air_above():
     balloon = Path(__file__).parents[2] / "scenarios" / "balloon_day_alexander1999.toml"
     series = star_availability(resolve_scenario(str(balloon), ["duration_s=60.0"])).series
     sky = float(np.median(series["sky_background_mag"]))
-    load = Loader(str(files("skyfield_data") / "data"), verbose=False)
-    ts, eph = load.timescale(builtin=True), load("de421.bsp")
+    ts, eph = skyfield_sky
     place = eph["earth"] + wgs84.latlon(34.5, -104.2, elevation_m=35000.0)
     altitude, azimuth, _ = place.at(ts.utc(2025, 9, 10, 18, 27, 30)).observe(eph["sun"]).apparent().altaz()
     sun_zenith, sun_azimuth, elevation = np.radians(90.0 - altitude.degrees), azimuth.radians, np.radians(50.0)
