@@ -11,15 +11,21 @@ those models, not a copy of them (the scenario's ``[radiation]`` table sets ever
     Φ = Φ_bg + Φ_SAA exp(−½ (Δφ/w_φ)² − ½ (Δλ/w_λ)²) (h/h_ref)^n + Φ_horn exp(−½ ((|φ_m| − φ_h)/w_h)²),
 
 Δφ, Δλ the geodetic latitude and longitude from the anomaly's centre, h the height, φ_m the geomagnetic (dipole)
-latitude of the IGRF-13 dipole at 2020, its north pole at (80.65 N, 72.68 W) (Alken et al. 2021).
+latitude: the complement of the angle between the geocentric position and the centred dipole's axis, the axis
+−(g11, h11, g10)/|…| (ECEF) of IGRF-13's first-degree Gauss coefficients at 2020.0 (Alken et al. 2021): the north
+geomagnetic pole at 80.59 N (geocentric; 80.65 N geodetic where the axis meets the ellipsoid), 72.68 W.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-#: The geomagnetic dipole's north pole (geodetic, deg) of IGRF-13 at 2020.0.
-DIPOLE_POLE_DEG = (80.65, -72.68)
+from navsim.earth.wgs84 import geodetic_to_ecef
+
+#: IGRF-13's first-degree Gauss coefficients (g10, g11, h11) [nT] at 2020.0 (Alken et al. 2021).
+IGRF13_DIPOLE_NT = (-29404.8, -1450.9, 4652.5)
+#: The unit ECEF vector of the north geomagnetic pole: −(g11, h11, g10)/|…|.
+DIPOLE_AXIS = -np.array(IGRF13_DIPOLE_NT)[[1, 2, 0]] / np.linalg.norm(IGRF13_DIPOLE_NT)
 
 
 @dataclass(frozen=True)
@@ -45,7 +51,7 @@ class ParticleFlux:
         dlon = (np.degrees(lon) - self.saa_lon_deg + 180.0) % 360.0 - 180.0
         saa = self.saa_peak * np.exp(-0.5 * (dlat / self.saa_lat_width_deg) ** 2 - 0.5 * (dlon / self.saa_lon_width_deg) ** 2)
         saa = saa * (np.maximum(h, 0.0) / self.saa_height_m) ** self.saa_height_exponent
-        magnetic = np.degrees(np.abs(geomagnetic_latitude(lat, lon)))
+        magnetic = np.degrees(np.abs(geomagnetic_latitude(lat, lon, h)))
         return saa, self.horn_peak * np.exp(-0.5 * ((magnetic - self.horn_lat_deg) / self.horn_width_deg) ** 2)
 
     def flux(self, lat, lon, h):
@@ -54,7 +60,8 @@ class ParticleFlux:
         return self.background + saa + horn
 
 
-def geomagnetic_latitude(lat, lon):
-    """The dipole latitude [rad] of geodetic (L, λ) [rad]: the complement of the angle from the dipole's pole."""
-    pole_lat, pole_lon = np.radians(DIPOLE_POLE_DEG)
-    return np.arcsin(np.clip(np.sin(lat) * np.sin(pole_lat) + np.cos(lat) * np.cos(pole_lat) * np.cos(lon - pole_lon), -1.0, 1.0))
+def geomagnetic_latitude(lat, lon, h):
+    """The dipole latitude [rad] of geodetic (L, λ, h) (N,) [rad, rad, m]: the complement of the angle between the
+    geocentric position and :data:`DIPOLE_AXIS`."""
+    r = np.stack(geodetic_to_ecef(*(np.asarray(x, dtype=float) for x in (lat, lon, h))), axis=-1)
+    return np.arcsin(np.clip(r @ DIPOLE_AXIS / np.linalg.norm(r, axis=-1), -1.0, 1.0))

@@ -4,7 +4,8 @@ against Patat 2003 §7, the air's scattering with height, the boresight's eclipt
 ``navsim sky``'s sources.
 
 Every measured number is quoted with its source; the tolerance is 0.25 mag/arcsec² unless the measurement's own
-scatter is larger (then stated). Comparisons the model does not meet are strict xfails with the measured miss."""
+scatter is larger (then stated). Comparisons the model does not meet hold its miss to the recorded one within
+:data:`MISS_TOLERANCE`: a worse miss fails, and so does a better one until the record is updated."""
 
 import tomllib
 from pathlib import Path
@@ -64,12 +65,15 @@ def test_zodiacal_light_at_the_ecliptic_pole_and_between_the_table():
 
 
 def test_starlight_by_galactic_latitude():
-    """30 S10 at the Galactic poles (Roach & Gordon 1973: V 24.1, the issue's "~V 24"), within 160-640 S10 on the
-    equator, rising monotonically towards the plane."""
-    b = np.radians([90.0, 60.0, 30.0, 10.0, 0.0])
-    s10 = night_sky.starlight_s10(b)
-    assert s10[0] == pytest.approx(30.0) and 160.0 <= s10[-1] <= 640.0 and np.all(np.diff(s10) >= 0.0)
+    """At the Galactic poles V 24.1 mag/arcsec² (Roach & Gordon 1973's 30 S10: 10 + 2.5 log10(3600²) − 2.5 log10 30 =
+    24.09, the issue's "~V 24") within 0.05; towards the plane a thin plane-parallel disk's, the pole's times csc |b|
+    (the path through the slab) within 1e-9 from 90 to 6 deg (a csc² or a cos law fails); on the equator inside Roach &
+    Gordon's 160-640 S10, which spans the longitudes the model does not resolve."""
     assert float(night_sky.magnitude(night_sky.starlight_flux(0.0, 0.5 * np.pi))) == pytest.approx(24.1, abs=0.05)
+    b = np.radians(np.arange(6.0, 91.0, 4.0))
+    pole = night_sky.starlight_s10(np.radians(90.0))
+    np.testing.assert_allclose(night_sky.starlight_s10(b) * np.sin(b), pole, rtol=1e-9)
+    assert 160.0 <= float(night_sky.starlight_s10(0.0)) <= 640.0
 
 
 def test_airglow_is_above_every_vehicle_below_its_shell():
@@ -131,8 +135,11 @@ SUPERBIT = {(2016, "V"): 1.0, (2016, "R"): 1.1, (2016, "I"): 0.6, (2018, "V"): 1
             (2019, "V"): 0.6, (2019, "I"): -0.1}
 #: The flights' own spread in each band (max − min of the above) where it exceeds 0.25: V 0.4, I 0.7.
 SUPERBIT_TOLERANCE = {"V": 0.4, "R": 0.25, "I": 0.7}
-#: What the model misses by (measured 2026-12): the flights it does not meet.
-SUPERBIT_NOT_MET = {(2016, "V"): 0.90, (2016, "R"): 1.12, (2016, "I"): 0.79, (2018, "V"): 0.53, (2018, "R"): 0.96}
+#: What the model misses the flights it does not meet by: its difference less SuperBIT's [mag] (measured 2026-12, the
+#: same since).
+SUPERBIT_MISSES = {(2016, "V"): -0.90, (2016, "R"): -1.12, (2016, "I"): -0.79, (2018, "V"): -0.53, (2018, "R"): -0.96}
+#: How far a recorded miss may move [mag]: the records' rounding, and well under any change of the model worth noting.
+MISS_TOLERANCE = 0.05
 
 
 def superbit_difference(year, name):
@@ -144,20 +151,20 @@ def superbit_difference(year, name):
     return float(balloon - ground)
 
 
-def _superbit_case(key):
-    marks = ([pytest.mark.xfail(strict=True, reason=f"model misses SuperBIT by {SUPERBIT_NOT_MET[key]:.2f} mag")]
-             if key in SUPERBIT_NOT_MET else [])
-    return pytest.param(*key, SUPERBIT[key], marks=marks, id=f"{key[0]}-{key[1]}")
-
-
-@pytest.mark.parametrize("year, name, darker", [_superbit_case(key) for key in SUPERBIT])
-def test_airglow_alone_against_superbit(year, name, darker):
+@pytest.mark.parametrize("year, name", list(SUPERBIT), ids=[f"{year}-{name}" for year, name in SUPERBIT])
+def test_airglow_alone_against_superbit(year, name):
     """Gill et al.'s difference between the balloon's airglow and the darkest ground sky, with the flights' own spread
     as the tolerance in V (0.4) and I (0.7), 0.25 in R. Met in 2019 (V 0.54 for 0.6, I 0.24 for −0.1); not met in 2016
-    and 2018, where the model's airglow at the balloon is 0.5-1.1 mag brighter than SuperBIT's: with the airglow above
-    both, the zodiacal light, starlight and the air's scattering at the ground make only 0.35-0.55 mag of the
-    difference near sunspot minimum, and the solar-cycle sinusoid puts mid-2016 at 1.12 of the mean activity."""
-    assert superbit_difference(year, name) == pytest.approx(darker, abs=SUPERBIT_TOLERANCE[name])
+    and 2018, where the model's airglow at the balloon is 0.5-1.1 mag brighter than SuperBIT's (:data:`SUPERBIT_MISSES`,
+    each held to :data:`MISS_TOLERANCE`): with the airglow above both, the zodiacal light, starlight and the air's
+    scattering at the ground make only 0.35-0.55 mag of the difference near sunspot minimum, and the solar-cycle
+    sinusoid puts mid-2016 at 1.12 of the mean activity."""
+    miss = superbit_difference(year, name) - SUPERBIT[(year, name)]
+    if (year, name) in SUPERBIT_MISSES:
+        assert miss == pytest.approx(SUPERBIT_MISSES[(year, name)], abs=MISS_TOLERANCE), \
+            f"the known miss of {year} {name} moved: {miss:+.2f} mag, recorded {SUPERBIT_MISSES[(year, name)]:+.2f}"
+    else:
+        assert abs(miss) <= SUPERBIT_TOLERANCE[name], miss
 
 
 def moonlit_brightening(name, days):
@@ -171,19 +178,25 @@ def moonlit_brightening(name, days):
     return float(np.max(s.night - s.total))
 
 
-@pytest.mark.parametrize("name, days, measured", [
-    ("V", 6.0, 1.0),
-    pytest.param("I", 10.0, 1.2, marks=pytest.mark.xfail(strict=True, reason="the model's moonlit I sky brightens "
-                                                                              "0.62 mag at 10 days, Patat's 1.2")),
-])
+#: The model's miss of Patat's moonlit I at 10 days [mag]: its brightening less his.
+PATAT_I_MISS = -0.47
+
+
+@pytest.mark.parametrize("name, days, measured", [("V", 6.0, 1.0), ("I", 10.0, 1.2)])
 def test_the_moonlit_sky_against_patat(name, days, measured):
     """Patat 2003 §7 (Paranal, Fig. 12, moonlight's brightening over his dark-time Table 4): "already at 6 days past new
     moon the observed V data show maximum deviations of the order of 1 mag"; in I "at roughly the same moon age"
     (10 days) "this deviation just reaches ~1.2 mag". The model's largest brightening over FORS1's sky within 0.25:
-    V 0.89 at 6 days (met); I 0.62 at 10 days (not met: KS91's moonlight carried to I by the λ⁻⁴ and λ⁻¹·³ scattering
-    is 0.6 mag too faint against the I sky). His comparison of the data with KS91 itself (Fig. 12, upper panel) was not
-    in the material this project could read."""
-    assert moonlit_brightening(name, days) == pytest.approx(measured, abs=0.25)
+    V 0.96 at 6 days (met); I 0.73 at 10 days (not met: KS91's moonlight carried to I by the λ⁻⁴ and λ⁻¹·³ scattering
+    is too faint against the I sky; its miss :data:`PATAT_I_MISS` held to :data:`MISS_TOLERANCE`). (Measured V 0.89,
+    I 0.62 when the test was written; issue 53's aerosol, scattering by its scattering share of KS91's k, brightened
+    the moonlight's aureole.) His comparison of the data with KS91 itself (Fig. 12, upper panel) was not in the material
+    this project could read."""
+    miss = moonlit_brightening(name, days) - measured
+    if name == "I":
+        assert miss == pytest.approx(PATAT_I_MISS, abs=MISS_TOLERANCE), f"the known miss in I moved: {miss:+.2f} mag"
+    else:
+        assert abs(miss) <= 0.25, miss
 
 
 def test_the_boresights_ecliptic_and_galactic_coordinates():
