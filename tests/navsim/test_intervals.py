@@ -49,9 +49,10 @@ def ar1_nees(rng, runs, frames, dof, phi):
 
 def test_the_t_interval_of_run_means_covers_a_correlated_nees_and_the_frames_chi_square_does_not():
     """4 runs of 400 frames of 3-dof NEES correlated over ~100 frames (AR(1), φ = 0.98) from a consistent filter:
-    over 1000 seeded campaigns Student's t over the run means covers the expectation 3 in 95 % ± 2 % of them (a
-    binomial σ of 0.7 %), while the χ² band of every frame as if independent (4·400 draws of χ²(3)) holds the pooled
-    mean in far fewer: a run's frames are not independent."""
+    over 1000 seeded campaigns Student's t over the run means covers the expectation 3 in 93.3 % of them (exact for
+    Gaussian run means; these, each worth about 8 independent frames, are skewed and undercover a little: 92-97 %
+    allowed, a binomial σ being 0.7 %), while the χ² band of every frame as if independent (4·400 draws of χ²(3))
+    holds the pooled mean in 18.7 %: a run's frames are not independent."""
     rng = np.random.default_rng(20240664)
     dof, runs, frames, trials = 3, 4, 400, 1000
     lo, hi = chi2_band(dof, runs * frames)
@@ -60,7 +61,7 @@ def test_the_t_interval_of_run_means_covers_a_correlated_nees_and_the_frames_chi
         nees = ar1_nees(rng, runs, frames, dof, 0.98)
         t_hits += contains(mean_interval(nees.mean(axis=1)), dof)
         chi2_hits += lo <= nees.mean() <= hi
-    assert t_hits / trials == pytest.approx(0.95, abs=0.02)
+    assert 0.92 <= t_hits / trials <= 0.97
     assert chi2_hits / trials < 0.5
 
 
