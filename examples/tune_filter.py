@@ -25,8 +25,8 @@ SEEDS = range(20)
 print(f"{'Q scale':>8} {'NEES/dof':>9} {'NIS/dof':>8} {'cross RMS':>10}")
 for q_scale in (0.5, 1.0, 2.0, 4.0, 8.0):
     results = run_batch(SCENARIO, SEEDS, overrides={"filter.process_noise_scale": q_scale})
-    nees, nis, errors = batch_statistics(results, settle_s=12.0)
-    print(f"{q_scale:8.2f} {nees:9.3f} {nis:8.3f} {errors['cross-boresight RMS'][0]:9.2f}\"")
+    batch = batch_statistics(results, settle_s=12.0)
+    print(f"{q_scale:8.2f} {batch.nees_per_dof:9.3f} {batch.nis_per_dof:8.3f} {batch.errors['cross-boresight RMS'][0]:9.2f}\"")
 
 fitted = tune(SCENARIO, runs=len(SEEDS))
 first, last = fitted.steps[0], fitted.steps[-1]

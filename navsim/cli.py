@@ -121,8 +121,11 @@ def _montecarlo(args):
     for line in kind.campaign_lines(summary):
         print(line)
     if nees:
-        print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof; {100 * nees['fraction_in_band']:.1f} % of frames "
-              f"inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
+        from navsim.estimation.intervals import interval_text
+
+        print(f"NEES (run average)  {nees['mean']:.2f} for {nees['dof']} dof, 95 % interval of the mean "
+              f"{interval_text(nees['mean_interval_95'])} over {nees['runs']} runs; {100 * nees['fraction_in_band']:.1f} % "
+              f"of frames inside the 95 % band [{nees['band_95'][0]:.2f}, {nees['band_95'][1]:.2f}]")
     if summary.get("divergent_runs"):
         print(f"divergent runs      {summary['divergent_runs']}")
     print(f"written to          {args.out}")
@@ -130,29 +133,53 @@ def _montecarlo(args):
 
 
 def _tune(args):
+    from tqdm import tqdm
+
     from navsim.campaign.tuning import tune
 
     _check_seed(args.seed)
-    if args.runs < 1:
-        raise InputError(f"--runs must be at least 1, got {args.runs}")
     if args.evaluations < 1:
         raise InputError(f"--evaluations must be at least 1, got {args.evaluations}")
-    result = tune(args.scenario, runs=args.runs, seed=args.seed, overrides=args.set or (), evaluations=args.evaluations)
+    with tqdm(total=args.runs, desc="evaluation 0", unit="run", leave=False, disable=True if args.quiet else None) as bar:
+        def on_step(k, step):
+            bar.clear()
+            if not args.json:
+                print("\n".join(_tune_rows(k, step)), flush=True)
+            bar.reset()
+            bar.set_description(f"evaluation {k + 1}")
+
+        result = tune(args.scenario, runs=args.runs, seed=args.seed, overrides=args.set or (),
+                      evaluations=args.evaluations, on_step=on_step, on_run=bar.update)
     if args.json:
         print(json.dumps(result.as_dict(), indent=2))
         return 0
-    labels = list(result.steps[0].errors)
-    print(f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} " + " ".join(f"{label:>20}" for label in labels))
-    for k, step in enumerate(result.steps):
-        errors = " ".join(f"{f'{value:.2f} {unit}':>20}" for value, unit in step.errors.values())
-        print(f"{k:>4} {step.process_noise_scale:9.3f} {step.measurement_noise_scale:9.3f} {step.nees_per_dof:9.3f} "
-              f"{step.nis_per_dof:8.3f} {errors}")
     first, last = result.steps[0], result.steps[-1]
-    print(f"before: NEES/dof {first.nees_per_dof:.2f}, NIS/dof {first.nis_per_dof:.2f}; "
-          f"after: NEES/dof {last.nees_per_dof:.2f}, NIS/dof {last.nis_per_dof:.2f}")
+    if not result.change_proposed:
+        print(f"{_consistency(first)}: {first.runs} runs cannot tell these from 1; no change proposed")
+        return 0
+    print(f"before: {_consistency(first)} ({first.runs} runs)")
+    still = "" if last.consistent else "; 1 still outside: more --evaluations or --runs"
+    print(f"after (step {result.steps.index(last)}): {_consistency(last)}{still}")
     print(f"use: --set filter.process_noise_scale={last.process_noise_scale:.4g} "
           f"--set filter.measurement_noise_scale={last.measurement_noise_scale:.4g}")
     return 0
+
+
+def _tune_rows(k, step):
+    """The lines of `navsim tune`'s table for evaluation ``k``: the header first."""
+    header = ([f"{'step':>4} {'Q scale':>9} {'R scale':>9} {'NEES/dof':>9} {'NIS/dof':>8} "
+               + " ".join(f"{label:>20}" for label in step.errors)] if k == 0 else [])
+    errors = " ".join(f"{f'{value:.2f} {unit}':>20}" for value, unit in step.errors.values())
+    return header + [f"{k:>4} {step.process_noise_scale:9.3f} {step.measurement_noise_scale:9.3f} "
+                     f"{step.nees_per_dof:9.3f} {step.nis_per_dof:8.3f} {errors}"]
+
+
+def _consistency(step):
+    """"NEES/dof 0.94, 95 % interval [0.82, 1.05]; NIS/dof ..." of a tuning step."""
+    from navsim.estimation.intervals import interval_text
+
+    return (f"NEES/dof {step.nees_per_dof:.2f}, 95 % interval {interval_text(step.nees_interval)}; "
+            f"NIS/dof {step.nis_per_dof:.2f}, 95 % interval {interval_text(step.nis_interval)}")
 
 
 def _budget(args):
@@ -293,13 +320,15 @@ def build_parser():
                         "outside it, such as a full disk, are always run again)")
     p.set_defaults(func=_montecarlo)
 
-    p = sub.add_parser("tune", help="fit the filter's Q and R scale factors for NEES/NIS consistency")
+    p = sub.add_parser("tune", help="fit the filter's Q and R scale factors for NEES/NIS consistency (no change when "
+                                    "the runs cannot tell the scenario's filter from a consistent one)")
     p.add_argument("scenario", help="scenario TOML file")
-    p.add_argument("--runs", type=int, default=20, help="seeded runs per iteration (default 20)")
+    p.add_argument("--runs", type=int, default=20, help="seeded runs per evaluation, at least 2 (default 20)")
     p.add_argument("--evaluations", type=int, default=30, help="most batches evaluated (default 30)")
     p.add_argument("--seed", type=int, default=None, help="first seed (default: the scenario's)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario value (repeatable)")
-    p.add_argument("--json", action="store_true", help="print the iterations as JSON")
+    p.add_argument("--json", action="store_true", help="print the evaluations as JSON at the end (no table)")
+    p.add_argument("--quiet", action="store_true", help="no progress line on stderr")
     p.set_defaults(func=_tune)
 
     p = sub.add_parser("budget", help="the error budget of a navigation scenario: what each error source leaves, by "

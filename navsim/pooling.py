@@ -5,6 +5,7 @@ filter's calibration states."""
 import numpy as np
 
 from navsim.estimation.consistency import nees_statistics
+from navsim.estimation.intervals import as_json, mean_interval
 
 #: A run diverged when an error exceeds this many σ of its filter (at least; more for a long run:
 #: :func:`divergence_sigmas`), or its NEES mean this many dof.
@@ -49,9 +50,15 @@ def run_averaged_nees(series):
 
 def averaged_nees(finished, settle):
     """The run-averaged NEES at the steady frames (after ``settle`` [s]) against the band of that many runs,
-    with the dof the runs' summaries record (:func:`navsim.estimation.consistency.nees_statistics`)."""
-    t, mean_nees = run_averaged_nees([series for _, _, series in finished])
-    return nees_statistics(mean_nees[t >= settle], finished[0][1]["nees"]["dof"], len(finished))
+    with the dof the runs' summaries record (:func:`navsim.estimation.consistency.nees_statistics`), and
+    ``mean_interval_95``: the 95 % interval of its mean, Student's t over the runs' own means of those frames
+    ([lo, null] for one run: :func:`navsim.estimation.intervals.mean_interval`)."""
+    series = [series for _, _, series in finished]
+    t, mean_nees = run_averaged_nees(series)
+    steady = t >= settle
+    per_run = [np.mean(s["nees"][: t.size][steady]) for s in series]
+    return {**nees_statistics(mean_nees[steady], finished[0][1]["nees"]["dof"], len(finished)),
+            "mean_interval_95": as_json(mean_interval(per_run, lowest=0.0))}
 
 
 def spread(values):

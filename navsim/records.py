@@ -28,7 +28,7 @@ from typing import ClassVar
 from startrack import InputError
 
 RUN_FORMAT = "navsim.run-summary/2"
-CAMPAIGN_FORMAT = "navsim.campaign-summary/1"
+CAMPAIGN_FORMAT = "navsim.campaign-summary/2"
 
 
 class Record(Mapping):

@@ -69,12 +69,20 @@ def run_study(scenario, seed=None, overrides=(), progress=False):
     return StudyResult(scenario=scenario.data, summary=summary, arrays=arrays)
 
 
-def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1):
+def run_batch(scenario, seeds, overrides=(), star_catalog=None, threads=1, on_run=None):
     """Many runs of one scenario sharing its seed-free part (truth, models, catalog): a batch of
     one equals :func:`run` with that seed. The compiled filter loop releases the GIL, so
-    ``threads`` > 1 runs members concurrently. Returns the list of :class:`~navsim.records.RunResult`."""
+    ``threads`` > 1 runs members concurrently; ``on_run()`` is called as each run ends. Returns the list of
+    :class:`~navsim.records.RunResult`."""
     prepared = prepare(scenario, overrides, star_catalog)
+
+    def one(seed):
+        result = simulate(prepared, int(seed))
+        if on_run is not None:
+            on_run()
+        return result
+
     if threads <= 1:
-        return [simulate(prepared, int(seed)) for seed in seeds]
+        return [one(seed) for seed in seeds]
     with ThreadPoolExecutor(max_workers=threads) as pool:
-        return list(pool.map(lambda seed: simulate(prepared, int(seed)), seeds))
+        return list(pool.map(one, seeds))

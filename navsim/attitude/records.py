@@ -39,7 +39,8 @@ class RunSummary(records.RunSummary):
 @dataclass(frozen=True, kw_only=True)
 class CampaignSummary(records.CampaignSummary):
     """An attitude campaign: the errors pooled over every steady frame of every run [arcsec], the spread
-    of the runs' RMS errors, the run-averaged NEES against its band for ``runs`` runs (``nees``), the
+    of the runs' RMS errors, the run-averaged NEES against its band for ``runs`` runs with the 95 % interval of
+    its mean (``nees``: :func:`navsim.pooling.averaged_nees`), the
     divergent runs (an error beyond 5σ or a NEES mean above 5 dof), the accepted and rejected updates;
     ``gyro_calibration`` pools the final normalised errors of the calibration states (RMS per state,
     expected 1, and the share within 3σ, expected 99.7 %); besides, what every kind's campaign record has

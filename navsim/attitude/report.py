@@ -23,6 +23,7 @@ from navsim.typeset.sections import (
     campaign_tables,
     comparison_section,
     frame_section,
+    nees_sentence,
     notes_section,
     scenario_section,
     sensor_section,
@@ -239,10 +240,7 @@ def _campaign_sentences(env, avg, metrics, success, criterion):
                      + (f" against a mean filter 1σ of {xyz(env.final_sigma_filter)} arcsec."
                         if env.final_sigma_filter is not None else "."))
     if avg is not None:
-        sentences.append(f"The NEES averaged over the {avg.runs} runs has mean {number(avg.mean_after_settle)} "
-                         f"after {number(avg.settle_s, 1)} s and {number(100 * avg.fraction_in_band, 1)} % of "
-                         f"those frames lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] "
-                         f"for {avg.runs} runs of {avg.dof} dof.")
+        sentences.append(nees_sentence(avg))
     if success:
         sentences.append(f"Success ({criterion}): " + "; ".join(
             f"{r.name} {number(100 * r.fraction, 1)} % ({r.identified} of {r.frames} frames)" for r in success) + ".")

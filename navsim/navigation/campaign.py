@@ -1,9 +1,11 @@
 """The campaign statistics of navigation runs (the INS): CEP50/95 of the final horizontal position
-error, the vertical error, the spread of the runs' velocity, tilt and heading errors, the
-run-averaged NEES over the filter's own error state, divergent runs and the IMU error states."""
+error and the vertical error's percentiles, each with its 95 % interval, the spread of the runs' velocity, tilt
+and heading errors, the run-averaged NEES over the filter's own error state, divergent runs and the IMU error
+states."""
 
 import numpy as np
 
+from navsim.estimation.intervals import as_json, quantile_interval, runs_to_bound
 from navsim.pooling import averaged_nees, calibration, diverged, spread
 from startrack import units
 
@@ -11,7 +13,8 @@ from startrack import units
 def pool(finished, settle):
     """The navigation fields of a :class:`~navsim.navigation.records.CampaignSummary` from the finished runs
     [(index, summary, series), ...]: CEP50/CEP95 are the median and 95th percentile over the runs
-    of the final horizontal position error (its radial distance from the truth)."""
+    of the final horizontal position error (its radial distance from the truth), each with its 95 % interval
+    (:func:`percentiles`), as the vertical error's p50/p95."""
     summaries = [summary for _, summary, _ in finished]
     divergent = [k for k, summary, _ in finished if diverged(summary)]
     horizontal = np.array([s["position_error_m"]["horizontal"]["final"] for s in summaries])
@@ -28,8 +31,8 @@ def pool(finished, settle):
 
     return {
         "position_error_m": {"horizontal": {**cep(horizontal), "rms": _rms(horizontal), "max": float(horizontal.max())},
-                             "vertical": {"p50": float(np.percentile(vertical, 50)), "p95": float(np.percentile(vertical, 95)),
-                                          "rms": _rms(vertical), "max": float(vertical.max())}},
+                             "vertical": {**percentiles(vertical, {"p50": 0.5, "p95": 0.95}), "rms": _rms(vertical),
+                                          "max": float(vertical.max())}},
         "position_error_nmi": {"horizontal": cep(horizontal / units.NAUTICAL_MILE)},
         "velocity_error_m_per_s": {"horizontal": per_run("velocity_error_m_per_s", "horizontal", "rms"),
                                    "vertical": per_run("velocity_error_m_per_s", "vertical", "rms")},
@@ -55,9 +58,20 @@ def identification(per_run):
 
 
 def cep(radial):
-    """{cep50, cep95}: the circular error probable (50 %) and its 95 % twin, the median and 95th
-    percentile of radial horizontal errors ``radial`` over the runs."""
-    return {"cep50": float(np.percentile(radial, 50)), "cep95": float(np.percentile(radial, 95))}
+    """{cep50, cep95, interval_95, runs_to_bound}: the circular error probable (50 %) and its 95 % twin, the
+    median and 95th percentile of radial horizontal errors ``radial`` over the runs (:func:`percentiles`)."""
+    return percentiles(radial, {"cep50": 0.5, "cep95": 0.95})
+
+
+def percentiles(sizes, named):
+    """{name: the p-quantile of ``sizes`` (errors' magnitudes, one per run) for each (name, p) of ``named``,
+    ``interval_95``: {name: [lo, hi]} its distribution-free 95 % interval (the order statistics around it: 0 below
+    and null above where no run bounds it), ``runs_to_bound``: {name: the runs that bound it}}
+    (:mod:`navsim.estimation.intervals`)."""
+    out = {name: float(np.percentile(sizes, 100.0 * p)) for name, p in named.items()}
+    out["interval_95"] = {name: as_json(quantile_interval(sizes, p, lowest=0.0)) for name, p in named.items()}
+    out["runs_to_bound"] = {name: runs_to_bound(p) for name, p in named.items()}
+    return out
 
 
 def _rms(values):

@@ -1,6 +1,8 @@
 """What the command line prints of a navigation run and campaign beside what it prints of every run
 (consistency, updates, wall time)."""
 
+from navsim.estimation.intervals import interval_text
+
 
 def run_lines(summary):
     """The scenario, the position, velocity and attitude errors and the final IMU bias errors of a run."""
@@ -29,14 +31,23 @@ def run_lines(summary):
 
 
 def campaign_lines(summary):
-    """CEP50/95 of the final horizontal error and the vertical p95 [m], and the pooled accelerometer bias
-    states, of a campaign with finished runs."""
+    """CEP50/95 of the final horizontal error and the vertical p95 [m] with their 95 % intervals (and which of
+    them too few runs leave unbounded), and the pooled accelerometer bias states, of a campaign with finished
+    runs."""
     lines = []
     if summary.get("position_error_m"):
         horizontal, nmi = summary["position_error_m"]["horizontal"], summary["position_error_nmi"]["horizontal"]
+        vertical = summary["position_error_m"]["vertical"]
         lines.append(f"final horizontal    CEP50 {horizontal['cep50']:.2f} m ({nmi['cep50']:.3f} nmi)  CEP95 "
-                     f"{horizontal['cep95']:.2f} m ({nmi['cep95']:.3f} nmi)   vertical p95 "
-                     f"{summary['position_error_m']['vertical']['p95']:.2f} m")
+                     f"{horizontal['cep95']:.2f} m ({nmi['cep95']:.3f} nmi)   vertical p95 {vertical['p95']:.2f} m")
+        quoted = (("CEP50", horizontal, "cep50"), ("CEP95", horizontal, "cep95"), ("vertical p95", vertical, "p95"))
+        lines.append("95 % intervals      " + "  ".join(f"{label} {interval_text(part['interval_95'][name], unit='m')}"
+                                                        for label, part, name in quoted))
+        short = [(label, part["runs_to_bound"][name]) for label, part, name in quoted if part["interval_95"][name][1] is None]
+        if short:
+            lines.append(f"too few runs        {summary['runs_finished']} runs leave these 95 % intervals unbounded above: "
+                         + ", ".join(f"{label} ({runs}{' runs bound it' if k == 0 else ''})"
+                                     for k, (label, runs) in enumerate(short)))
     ident = summary.get("star_identification")
     if ident:
         lines.append(f"star identification {ident['stars_identified']} of {ident['stars_detected']} detections identified "

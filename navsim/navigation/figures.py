@@ -8,6 +8,7 @@ minutes. The error state and its σ are the filter's (:mod:`navsim.navigation.su
 
 import numpy as np
 
+from navsim.estimation.intervals import interval_text
 from navsim.navigation.celestial import floor_ned
 from navsim.navigation.summary import ACCEL_BIAS, GYRO_BIAS, MICRO_G, group, ned_metres
 from navsim.typeset.figures import COLORS, new_figure
@@ -147,14 +148,20 @@ def truth_and_estimate(s, columns, suffixes=("_true", "")):
     return fig
 
 
-def horizontal_percentiles(percentiles):
-    """Horizontal position error over the runs against time: CEP50, CEP95, RMS and the filter's
-    mean 3σ (horizontal, √(σ_N² + σ_E²))."""
+def horizontal_percentiles(percentiles, runs_to_bound):
+    """Horizontal position error over the runs against time: CEP50 and CEP95 with their 95 % intervals shaded
+    (where the runs bound them: else the legend says how many runs would, ``runs_to_bound`` {cep50, cep95}), RMS
+    and the filter's mean 3σ (horizontal, √(σ_N² + σ_E²))."""
     fig, axes = new_figure(2.8)
     ax = axes[0, 0]
     t = _minutes(percentiles.t)
-    ax.plot(t, percentiles.cep50, color="tab:blue", lw=0.9, label="CEP50 (median)")
-    ax.plot(t, percentiles.cep95, color="tab:red", lw=0.9, label="CEP95")
+    for name, label, color in (("cep50", "CEP50 (median)", "tab:blue"), ("cep95", "CEP95", "tab:red")):
+        lo, hi = getattr(percentiles, f"{name}_interval")
+        bounded = bool(np.all(np.isfinite(hi)))
+        ax.plot(t, getattr(percentiles, name), color=color, lw=0.9, label=label + (
+            "" if bounded else f" (95 % interval unbounded above: {runs_to_bound[name]} runs bound it)"))
+        if bounded:
+            ax.fill_between(t, lo, hi, color=color, alpha=0.15, lw=0, label=f"{label.split()[0]} 95 % interval")
     ax.plot(t, percentiles.rms, color="k", lw=0.7, ls=":", label="RMS over runs")
     ax.plot(t, 3.0 * percentiles.sigma, "k--", lw=0.7, label="filter 3σ (mean P)")
     ax.set(xlabel="time [min]", ylabel="horizontal error [m]", title=f"{percentiles.runs} runs")
@@ -162,14 +169,17 @@ def horizontal_percentiles(percentiles):
     return fig
 
 
-def final_scatter(final_ne, cep50, cep95):
-    """Final north/east position errors of the runs [m] with the CEP50 and CEP95 circles."""
+def final_scatter(final_ne, horizontal):
+    """Final north/east position errors of the runs [m] with the CEP50 and CEP95 circles, their 95 % intervals
+    in the legend (``horizontal``: the campaign summary's final horizontal error, in metres)."""
     fig, axes = new_figure(3.6)
     ax = axes[0, 0]
     ax.plot(final_ne[:, 1], final_ne[:, 0], ".", color="tab:blue", ms=4, label="runs")
     angle = np.linspace(0.0, 2.0 * np.pi, 200)
-    for radius, color, label in ((cep50, "tab:green", "CEP50"), (cep95, "tab:red", "CEP95")):
-        ax.plot(radius * np.sin(angle), radius * np.cos(angle), color=color, lw=0.9, label=f"{label} {radius:.3g} m")
+    for name, color, label in (("cep50", "tab:green", "CEP50"), ("cep95", "tab:red", "CEP95")):
+        radius = horizontal[name]
+        ax.plot(radius * np.sin(angle), radius * np.cos(angle), color=color, lw=0.9,
+                label=f"{label} {radius:.3g} m, 95 % interval {interval_text(horizontal['interval_95'][name], 3, 'm')}")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set(xlabel="final east error [m]", ylabel="final north error [m]")
     ax.legend(loc="upper right")

@@ -48,10 +48,13 @@ class RunSummary(records.RunSummary):
 @dataclass(frozen=True, kw_only=True)
 class CampaignSummary(records.CampaignSummary):
     """A navigation campaign: ``position_error_m`` {horizontal: {cep50, cep95, rms, max} of the final
-    horizontal error over the runs, vertical: {p50, p95, rms, max} of the final vertical error};
-    ``position_error_nmi`` {horizontal: {cep50, cep95}}; ``velocity_error_m_per_s`` {horizontal,
-    vertical}, ``tilt_error_arcsec`` and ``heading_error_arcsec``: the spread {mean, p50, p95, max} of
-    the runs' RMS errors; the run-averaged NEES against its band (``nees``), the accepted and rejected
+    horizontal error over the runs, vertical: {p50, p95, rms, max} of the final vertical error}, each
+    percentile with ``interval_95`` {name: [lo, hi]} its distribution-free 95 % interval (hi null: too few runs
+    to bound it) and ``runs_to_bound`` {name: the runs that do} (:func:`navsim.navigation.campaign.percentiles`);
+    ``position_error_nmi`` {horizontal: {cep50, cep95, interval_95, runs_to_bound}}; ``velocity_error_m_per_s``
+    {horizontal, vertical}, ``tilt_error_arcsec`` and ``heading_error_arcsec``: the spread {mean, p50, p95, max} of
+    the runs' RMS errors; the run-averaged NEES against its band, with the 95 % interval of its mean
+    (``nees``: :func:`navsim.pooling.averaged_nees`), the accepted and rejected
     updates, the divergent runs; ``imu_calibration`` pools the IMU error states (normalised error RMS
     per state, expected 1, and the share within 3σ); ``star_identification`` the stars identified with the INS's
     prior over all runs and the wrong ones (None without); besides, what every kind's campaign record has."""

@@ -13,6 +13,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
+from navsim.estimation.intervals import interval_text
 from navsim.navigation import figures as nav_figures
 from navsim.navigation.report_statistics import RUN_METRICS, horizontal_percentiles, position_envelopes
 from navsim.typeset import figures
@@ -23,6 +24,7 @@ from navsim.typeset.sections import (
     campaign_summary_section,
     campaign_tables,
     comparison_section,
+    nees_sentence,
     notes_section,
     scenario_section,
 )
@@ -277,6 +279,21 @@ CAMPAIGN_AGGREGATE = ("The campaign's own aggregate (summary.json), as written b
                       "expected 1, and the share within 3σ, expected 99.7 %).")
 
 
+def cep_interval_sentence(summary):
+    """The 95 % intervals of CEP50 and CEP95 of a campaign ``summary`` and, when its runs leave one unbounded
+    above, how many runs would bound it."""
+    final = summary["position_error_m"]["horizontal"]
+    interval = {name: interval_text(final["interval_95"][name], unit="m") for name in ("cep50", "cep95")}
+    short = [name for name in ("cep50", "cep95") if final["interval_95"][name][1] is None]
+    caveat = ""
+    if short:
+        needs = ", ".join(f"{name.upper()} needs {final['runs_to_bound'][name]}" for name in short)
+        caveat = (f"; {summary['runs_finished']} runs are too few to bound {' and '.join(n.upper() for n in short)} "
+                  f"above ({needs} runs)")
+    return (f"Their 95 % intervals (distribution-free: the order statistics of the runs) are CEP50 {interval['cep50']} "
+            f"and CEP95 {interval['cep95']}{caveat}.")
+
+
 def _campaign_floor(doc, campaign):
     """Star-aided runs: each run's Schuler-mean horizontal error against its analytic-horizon floor."""
     floors = [(r.summary.get("celestial") or {}).get("horizon_floor") for r in campaign.runs]
@@ -309,22 +326,21 @@ def campaign_report(campaign) -> bytes:
         doc.heading("Key results")
         sentences = [f"At the end of the runs the horizontal position error has CEP50 {number(final['cep50'])} m "
                      f"({number(final['cep50'] / units.NAUTICAL_MILE, 3)} nmi) and CEP95 {number(final['cep95'])} m "
-                     f"({number(final['cep95'] / units.NAUTICAL_MILE, 3)} nmi) over the {len(campaign.runs)} runs."]
+                     f"({number(final['cep95'] / units.NAUTICAL_MILE, 3)} nmi) over the {len(campaign.runs)} runs.",
+                     cep_interval_sentence(campaign.summary)]
         if avg is not None:
-            sentences.append(f"The NEES averaged over the runs has mean {number(avg.mean_after_settle)} after "
-                             f"{number(avg.settle_s, 1)} s and {number(100 * avg.fraction_in_band, 1)} % of those frames "
-                             f"lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] for {avg.runs} "
-                             f"runs of {avg.dof} dof.")
+            sentences.append(nees_sentence(avg))
         doc.paragraph(*(markup(x) for x in sentences))
         campaign_tables(doc, campaign, metrics)
         doc.heading("Horizontal error over time")
         doc.paragraph(markup("At each frame the median (CEP50) and 95th percentile (CEP95) of the horizontal error over "
                              "the runs, their RMS and the filter's 3σ from the covariance averaged over the runs."))
-        doc.figure(nav_figures.horizontal_percentiles(percentiles), "Horizontal position error percentiles over the runs.")
+        doc.figure(nav_figures.horizontal_percentiles(percentiles, final["runs_to_bound"]),
+                   "Horizontal position error percentiles over the runs, with their 95 % intervals.")
         doc.heading("Position error envelopes")
         doc.figure(figures.error_envelopes(env, [f"δ{a} [m]" for a in nav_figures.NED], "time [min]", 60.0),
                    "Position error envelopes north, east, down over the runs, metres, with the filter's mean ±3σ.")
-        doc.figure(nav_figures.final_scatter(final_ne, final["cep50"], final["cep95"]),
+        doc.figure(nav_figures.final_scatter(final_ne, final),
                    "Final north and east errors of the runs with the CEP50 and CEP95 circles.")
         if avg is not None:
             doc.heading("Filter consistency over runs")

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from navsim.estimation.intervals import quantile_interval
 from navsim.navigation.summary import ned_metres
 from navsim.typeset.statistics import common_frames, envelopes_of
 
@@ -27,12 +28,16 @@ RUN_METRICS = (
 @dataclass(frozen=True)
 class HorizontalPercentiles:
     """Horizontal position error across M runs at each frame [m]: median (CEP50), 95th percentile
-    (CEP95), RMS, and the filter's horizontal σ from the covariance averaged over the runs."""
+    (CEP95), each with its distribution-free 95 % interval ((2, F): lo, hi; hi inf where M runs are too few:
+    :func:`navsim.estimation.intervals.quantile_interval`), RMS, and the filter's horizontal σ from the covariance
+    averaged over the runs."""
 
     t: np.ndarray
     runs: int
     cep50: np.ndarray
     cep95: np.ndarray
+    cep50_interval: np.ndarray
+    cep95_interval: np.ndarray
     rms: np.ndarray
     sigma: np.ndarray
 
@@ -49,8 +54,10 @@ def horizontal_percentiles(campaign):
     radial = np.hypot(errors[..., 0], errors[..., 1])
     variance = np.mean(np.stack([_position_sigma(r, n)[:, :2] ** 2 for r in campaign.runs]), axis=0)
     p50, p95 = np.percentile(radial, [50, 95], axis=0)
-    return HorizontalPercentiles(t=t, runs=radial.shape[0], cep50=p50, cep95=p95, rms=np.sqrt(np.mean(radial**2, axis=0)),
-                                 sigma=np.sqrt(variance.sum(axis=1)))
+    return HorizontalPercentiles(t=t, runs=radial.shape[0], cep50=p50, cep95=p95,
+                                 cep50_interval=np.array(quantile_interval(radial, 0.5, lowest=0.0)),
+                                 cep95_interval=np.array(quantile_interval(radial, 0.95, lowest=0.0)),
+                                 rms=np.sqrt(np.mean(radial**2, axis=0)), sigma=np.sqrt(variance.sum(axis=1)))
 
 
 def position_envelopes(campaign):

@@ -10,6 +10,7 @@ from matplotlib.patches import Circle
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from navsim.estimation.consistency import chi2_band
+from navsim.estimation.intervals import interval_text
 from navsim.typeset import statistics as stats
 from startrack import address
 
@@ -270,13 +271,20 @@ def error_envelopes(env, labels=tuple(f"δθ{axis} [arcsec]" for axis in AXES), 
 
 
 def nees_band(avg):
-    """NEES averaged over M runs with the chi-square band of M runs."""
+    """NEES averaged over M runs with the chi-square band of M runs, and its mean after the settling time with
+    the 95 % interval of that mean (unbounded for one run: said in the legend)."""
     fig, axes = new_figure(2.4)
     ax = axes[0, 0]
     ax.plot(avg.t, avg.mean, lw=0.8, color="tab:blue", label=f"NEES averaged over {avg.runs} runs")
     log_y(ax)
     ax.axhline(avg.dof, color="k", lw=0.8, label=f"expected ({avg.dof})")
     ax.axhspan(*avg.band, color="tab:green", alpha=0.2, label=f"95 % band for {avg.runs} runs")
+    lo, hi = avg.mean_interval
+    steady, mean = avg.t[avg.t >= avg.settle_s], avg.mean_after_settle
+    label = f"mean {mean:.2f}, 95 % interval {interval_text(avg.mean_interval)}"
+    ax.plot(steady[[0, -1]], [mean, mean], color="tab:purple", lw=0.8, ls="--", label=label)
+    if lo > 0.0 and hi is not None:  # a log axis: an interval from 0 is in the legend only
+        ax.errorbar(steady[0], mean, yerr=[[mean - lo], [hi - mean]], color="tab:purple", capsize=3, lw=0.9)
     if avg.settle_s > avg.t[0]:
         ax.axvline(avg.settle_s, color="0.4", lw=0.7, ls=":", label="settle time")
     ax.set(xlabel="time [s]", ylabel="average NEES")

@@ -4,6 +4,7 @@ frame, and a campaign's headline, settings, per-run metrics and aggregate."""
 
 import numpy as np
 
+from navsim.estimation.intervals import interval_text
 from navsim.typeset import figures
 from navsim.typeset import statistics as stats
 from navsim.typeset.document import flatten, general, markup, number, short, table
@@ -123,6 +124,15 @@ def campaign_headline(campaign, span):
             + (f", {general(requested)} requested" if requested is not None else "")
             + (f"; backend {general(campaign.campaign['backend'])}" if "backend" in campaign.campaign else "")
             + f"; {span}.")
+
+
+def nees_sentence(avg):
+    """The key result of a campaign's run-averaged NEES (:class:`navsim.typeset.statistics.AveragedNees`): its mean
+    with the 95 % interval of the mean and the frames inside the band."""
+    return (f"The NEES averaged over the {avg.runs} runs has mean {number(avg.mean_after_settle)} after "
+            f"{number(avg.settle_s, 1)} s (95 % interval of the mean {interval_text(avg.mean_interval)}, Student's t over "
+            f"the runs' own means; expected {avg.dof}) and {number(100 * avg.fraction_in_band, 1)} % of those frames "
+            f"lie inside the 95 % band [{number(avg.band[0])}, {number(avg.band[1])}] for {avg.runs} runs of {avg.dof} dof.")
 
 
 def campaign_tables(doc, campaign, metrics):

@@ -161,7 +161,8 @@ def envelopes_of(t, err, sigma):
 @dataclass(frozen=True)
 class AveragedNees:
     """The run-averaged NEES of a campaign: per frame (``t``, ``mean``) and the campaign summary's
-    statistics of it after the settling time (its dof, runs, 95 % band, fraction inside and mean)."""
+    statistics of it after the settling time (its dof, runs, 95 % band, fraction inside, mean and the 95 %
+    interval of the mean, [lo, hi] with hi None for one run)."""
 
     t: np.ndarray
     runs: int
@@ -171,6 +172,7 @@ class AveragedNees:
     settle_s: float
     fraction_in_band: float  # over the frames after settle_s
     mean_after_settle: float
+    mean_interval: list
 
 
 def averaged_nees(campaign):
@@ -182,7 +184,8 @@ def averaged_nees(campaign):
     t, mean = run_averaged_nees([r.series for r in campaign.runs])
     pooled = campaign.summary["nees"]
     return AveragedNees(t, int(pooled["runs"]), int(pooled["dof"]), mean, tuple(pooled["band_95"]),
-                        float(campaign.scenario["settle_s"]), float(pooled["fraction_in_band"]), float(pooled["mean"]))
+                        float(campaign.scenario["settle_s"]), float(pooled["fraction_in_band"]), float(pooled["mean"]),
+                        list(pooled["mean_interval_95"]))
 
 
 @dataclass(frozen=True)

@@ -123,10 +123,14 @@ def test_campaign_and_its_report(tmp_path, capsys):
         assert phrase in text
 
 
-def test_tune_fits_a_navigation_scenario(capsys):
+def test_tune_judges_a_navigation_scenario(capsys):
+    """The navigation kind through `navsim tune`: its headline errors in the table, its NEES/dof and NIS/dof with their
+    intervals in the verdict (the verdict itself: tests/navsim/test_tuning.py)."""
     status, printed = run_cli(["tune", BASE, "--runs", "2", "--evaluations", "3"], capsys)
     assert status == 0
-    assert "horizontal RMS" in printed.out and "use: --set filter.process_noise_scale=" in printed.out
+    assert "horizontal RMS" in printed.out.splitlines()[0]
+    assert "NEES/dof" in printed.out and "NIS/dof" in printed.out and "95 % interval [" in printed.out
+    assert "no change proposed" in printed.out or "use: --set filter.process_noise_scale=" in printed.out
 
 
 @pytest.mark.slow
