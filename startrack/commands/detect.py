@@ -62,13 +62,15 @@ def detection_options(args) -> dict:
 
 def detect_frame(frame, options):
     """:func:`startrack.image.detection.detect` of a :class:`startrack.image.files.Frame` with ``options``
-    (:func:`detection_options`; saturation at the frame's full scale unless given); a frame's pixels
+    (:func:`detection_options`; saturation at the frame's full scale unless given; a frame whose threshold lies
+    above its full scale, a stretched picture, detected at its clipped stars: :mod:`startrack.image.clipped`); a frame's pixels
     without data (its mask) take no star within :data:`startrack.image.fits.MASK_MARGIN_PX` of them."""
+    from startrack.image.clipped import retry
     from startrack.image.detection import detect
 
     if options["saturation_dn"] is None:
         options = {**options, "saturation_dn": frame.full_scale}
-    found = detect(frame.image, **options)
+    found = retry(detect, frame.image, options, detect(frame.image, **options), frame.full_scale)
     if frame.mask is None or not len(found):
         return found
     from scipy.ndimage import binary_dilation
