@@ -44,3 +44,19 @@ def probe_directory(directory, option, named):
         probe.unlink()
     except OSError as error:
         raise InputError(f"{option} {named}: cannot write in {directory} ({error.strerror or error})") from None
+
+
+def write_whole(path, write, what):
+    """Write ``path`` whole or not at all: ``write(temporary)`` writes a temporary file beside it, renamed over it;
+    ``what`` names the option in the message of a file that cannot be written.  Returns the Path."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.part")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    except OSError as error:
+        raise InputError(f"{what} {path} cannot be written ({error.strerror or error})") from None
+    finally:
+        if temporary.exists():
+            temporary.unlink()
+    return path

@@ -65,3 +65,24 @@ def vrw_to_si(x):
 def micro_g_per_sqrt_h_to_si(x):
     """Accelerometer bias random walk [µg/√h] -> σ [m/s²/√s] = [m/s^(5/2)]."""
     return np.asarray(x, dtype=float) * 1e-6 * STANDARD_GRAVITY / np.sqrt(HOUR)
+
+
+def _sexagesimal(value, decimals):
+    """(whole, minutes, seconds) of a non-negative ``value`` rounded to ``decimals`` of a second (no 60 s)."""
+    step = 10**decimals
+    units = round(value * 3600.0 * step)
+    whole, rest = divmod(units, 3600 * step)
+    minutes, seconds = divmod(rest, 60 * step)
+    return whole, minutes, seconds / step
+
+
+def ra_hms(ra_deg, decimals=3):
+    """Right ascension [deg] as "HH:MM:SS.sss" (hours, astrometry.net's form), within [0, 24 h)."""
+    hours, minutes, seconds = _sexagesimal(float(ra_deg) % 360.0 / 15.0, decimals)
+    return f"{hours % 24:02d}:{minutes:02d}:{seconds:0{3 + decimals}.{decimals}f}"
+
+
+def dec_dms(dec_deg, decimals=2):
+    """Declination [deg] as "+DD:MM:SS.ss" (sign always, astrometry.net's form)."""
+    degrees, minutes, seconds = _sexagesimal(abs(float(dec_deg)), decimals)
+    return f"{'-' if dec_deg < 0 else '+'}{degrees:02d}:{minutes:02d}:{seconds:0{3 + decimals}.{decimals}f}"

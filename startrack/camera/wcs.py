@@ -108,6 +108,28 @@ def reference(boresight):
     return np.array([ra, math.degrees(math.asin(np.clip(z[2], -1.0, 1.0)))]), np.array([east, np.cross(z, east)])
 
 
+def pixel_scale_arcsec(cd):
+    """The pixel scale [arcsec/px] of a CD matrix [deg/px]: 3600 sqrt|det CD| (astrometry.net's
+    ``sip_pixel_scale``)."""
+    return 3600.0 * math.sqrt(abs(float(np.linalg.det(cd))))
+
+
+def parity(cd):
+    """astrometry.net's parity of a CD matrix: "pos" when det CD < 0 (the sky as seen, east left of north
+    with +y up), else "neg" (solve-field's "Field parity")."""
+    return "pos" if np.linalg.det(cd) < 0.0 else "neg"
+
+
+def orientation_deg(cd):
+    """astrometry.net's field rotation [deg] in (-180, 180] of a CD matrix (its ``tan_get_orientation``, solve-field's
+    "up is ... degrees E of N"): with p = +1 for det CD >= 0, else -1, -atan2(p CD2_1 - CD1_2, p CD1_1 + CD2_2); for a
+    conformal CD (square pixels, ours) the position angle, east of north, of the +y axis of FITS pixels (rows
+    increasing), atan2(CD1_2, CD2_2)."""
+    sign = 1.0 if np.linalg.det(cd) >= 0.0 else -1.0
+    angle = -math.degrees(math.atan2(sign * cd[1, 0] - cd[0, 1], sign * cd[0, 0] + cd[1, 1]))
+    return 180.0 if angle <= -180.0 else angle + 0.0  # + 0.0: no -0
+
+
 def _terms(order):
     """(p, q) exponents of the SIP terms of total order 2..``order``."""
     return [(p, n - p) for n in range(2, order + 1) for p in range(n, -1, -1)]

@@ -81,11 +81,14 @@ def detection_options(args) -> dict:
 
 def detect_frame(frame, options):
     """:func:`startrack.image.detection.detect` of a :class:`startrack.image.files.Frame` with ``options``
-    (:func:`detection_options`; saturation at the frame's full scale unless given), without the stars near the
-    frame's pixels without data (:func:`without_masked`)."""
+    (:func:`detection_options`; saturation at the frame's full scale unless given; a frame whose threshold lies
+    above its full scale, a stretched picture, detected at its clipped stars: :mod:`startrack.image.clipped`),
+    without the stars near the frame's pixels without data (:func:`without_masked`)."""
+    from startrack.image.clipped import retry
     from startrack.image.detection import detect
 
-    return without_masked(frame, detect(frame.image, **{**options, "saturation_dn": saturation(frame, options)}))
+    options = {**options, "saturation_dn": saturation(frame, options)}
+    return without_masked(frame, retry(detect, frame.image, options, detect(frame.image, **options), frame.full_scale))
 
 
 def saturation(frame, options):
@@ -125,10 +128,15 @@ class ThresholdDetector:
     options: dict
 
     def find(self, frame):
+        from startrack.image.clipped import is_clipped
+
         found = detect_frame(frame, self.options)
         about = {"detector": "threshold", "centroider": self.options["centroider"], "a": self.options["a"],
                  "saturation_dn": saturation(frame, self.options)}
-        return Detected(found, about, f"V_th = {found.threshold:.2f} DN")
+        text = f"V_th = {found.threshold:.2f} DN"
+        if is_clipped(found, frame.full_scale):
+            text += " (b + a sigma_n lies above the full scale: the stars detected as their pixels at full scale)"
+        return Detected(found, about, text)
 
 
 @dataclass(frozen=True)

@@ -26,13 +26,16 @@ Two uses (:mod:`startrack.commands.solve_modes`):
 ``--boresight-error-deg``).  With ``--json`` one JSON object per frame and line: ``id``, ``status``
 ("ok", "no_match", "too_few", "error"), ``reason`` when not ok, ``q_IS`` [x, y, z, w] of the sensor
 frame (+z through the principal point), ``ra_deg``, ``dec_deg``, ``roll_deg`` of it, ``sigma_arcsec``,
-``center`` (the pointing of the image centre, as plate solvers report it), ``camera`` (the camera the
+``center`` (the pointing of the image centre, as plate solvers report it, with ``ra_hms``, ``dec_dms`` and
+``sigma_arcsec`` [east, north]), ``field`` (``width_deg``, ``height_deg``, ``pixel_scale_arcsec``,
+``orientation_deg``: up is it E of N, ``parity``: :mod:`startrack.camera.sky_field`), ``camera`` (the camera the
 attitude refers to: ``source`` given, fitted or refined, and for a fitted or refined camera its sigma),
-``matches`` [[centroid index, hip], ...], residuals, ``false_match_probability``, ``method``,
-``solve_ms``, ``epoch`` (of the star positions) and, for images, ``detection``.  ``--wcs``, ``--new-fits``
-and ``--corr`` write each identified frame's FITS WCS, image with it, and matched stars
-(:mod:`startrack.commands.solve_outputs`).  Exit status: 0 when every frame is identified, 1 when some
-is not, 2 for bad options or an unreadable INPUT.
+``stars_matched``, ``matches`` [[centroid index, hip], ...], residuals, ``false_match_probability``, ``method``,
+``solve_ms``, ``epoch`` (of the star positions) and, for images, ``detection`` (``clipped`` when its threshold
+lay above the full scale: :mod:`startrack.image.clipped`).  The text answer gives the same as astrometry.net's
+solve-field prints them.  ``--wcs``, ``--new-fits``, ``--corr`` and ``--annotate`` write each identified frame's
+FITS WCS, image with it, matched stars and a PNG of what was matched (:mod:`startrack.commands.solve_outputs`).
+Exit status: 0 when every frame is identified, 1 when some is not, 2 for bad options or an unreadable INPUT.
 """
 
 from __future__ import annotations
@@ -46,9 +49,10 @@ import numpy as np
 from startrack.base.errors import InputError, check_range
 from startrack.base.units import DEG
 from startrack.commands.detect import add_detection_options, detection_options
-from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame
+from startrack.commands.solve_input import SolveFrame, batch_frames, input_frame, is_picture
 from startrack.commands.solve_modes import FrameSolver, centroid_sigma, parse_refit
 from startrack.commands.solve_outputs import add_output_options, check_output_options, write_outputs
+from startrack.image.clipped import MIN_PIXELS
 
 
 def register(subparsers):
@@ -240,31 +244,61 @@ def _solve(solver, frame, boresight):
 
 
 def _nothing_detected(detection):
-    """The reason of a frame without detections (the threshold above the full scale says why)."""
+    """The reason of a frame without detections (a clipped frame, or a flat one, says why)."""
     text = (f"0 detections above the threshold {detection['threshold_dn']:.1f} DN (background "
             f"{detection['background_dn']:.1f} DN, noise {detection['sigma_n_dn']:.2f} DN)")
-    if detection["full_scale_dn"] is not None and detection["threshold_dn"] >= detection["full_scale_dn"]:
-        text += f"; the threshold lies above the full scale {detection['full_scale_dn']:.0f} DN"
+    if detection["clipped"]:
+        text += f"; {_CLIPPED} (no blob of {MIN_PIXELS} pixels or more)"
     elif detection["sigma_n_dn"] == 0.0:
         text += "; the frame is flat"
     return text + "."
 
 
-def _line(frame_id, result):
+#: What the detection of a clipped frame was (startrack.image.clipped).
+_CLIPPED = ("b + a sigma_n lies above the full scale (a picture stretched past it): its stars detected as the "
+            "pixels at full scale")
+
+
+def _line(frame, result):
+    """The text answer of a :class:`SolveFrame`: its status; when identified the matched stars and false-match
+    probability, the image centre, field, scale, orientation and parity as astrometry.net's solve-field prints
+    them, the sensor frame's attitude, a fitted camera and a clipped frame's detection."""
+    frame_id = frame.frame_id
     if not result.ok:
         return f"{frame_id}: {result.status}: {result.reason} ({result.solve_ms:.2f} ms)"
     sigma = np.degrees(np.sqrt(np.diag(result.covariance))) * 3600.0
-    text = (f"{frame_id}: ok  RA {math.degrees(result.ra):.5f} deg  Dec {math.degrees(result.dec):+.5f} deg  "
-            f"roll {math.degrees(result.roll):+.5f} deg  sigma {sigma[0]:.2f}/{sigma[1]:.2f}/{sigma[2]:.2f} arcsec  "
-            f"{len(result.matches)} stars  P_false {result.false_match_probability:.1e}  {result.method}  "
-            f"{result.solve_ms:.2f} ms")
+    lines = [f"{frame_id}: ok  {len(result.matches)} stars matched  false-match probability "
+             f"{result.false_match_probability:.1e}  {result.method}  {result.solve_ms:.2f} ms"]
+    if result.sky_field is not None:
+        lines += _field_lines(result.sky_field, is_picture(frame_id))
+    lines.append(f"  sensor  RA {math.degrees(result.ra):.5f} deg  Dec {math.degrees(result.dec):+.5f} deg  roll "
+                 f"{math.degrees(result.roll):+.5f} deg  sigma {sigma[0]:.2f}/{sigma[1]:.2f}/{sigma[2]:.2f} arcsec  "
+                 f"(+z through the principal point)")
     if result.calibration is not None:
         cam, spread = result.calibration.camera, result.calibration.sigma
-        text += (f"\n  camera ({result.camera_source}): FOV {math.degrees(cam.angular_width):.4f} +- {spread['fov_deg']:.4f} deg  "
-                 f"f {cam.focal_px:.2f} +- {spread['focal_px']:.2f} px  c ({cam.cx:.1f}, {cam.cy:.1f}) +- "
-                 f"({spread['cx']:.1f}, {spread['cy']:.1f}) px  k1 {cam.k1:+.4f} +- {spread['k1']:.4f}  "
-                 f"rms {result.calibration.rms_px:.2f} px")
-    return text
+        lines.append(f"  camera ({result.camera_source}): FOV {math.degrees(cam.angular_width):.4f} +- "
+                     f"{spread['fov_deg']:.4f} deg  f {cam.focal_px:.2f} +- {spread['focal_px']:.2f} px  "
+                     f"c ({cam.cx:.1f}, {cam.cy:.1f}) +- ({spread['cx']:.1f}, {spread['cy']:.1f}) px  "
+                     f"k1 {cam.k1:+.4f} +- {spread['k1']:.4f}  "
+                     f"rms {result.calibration.rms_px:.2f} px")
+    if frame.detection is not None and frame.detection["clipped"]:
+        lines.append(f"  detection: {_CLIPPED} ({frame.detection['detections']} blobs of {MIN_PIXELS} pixels or more)")
+    return "\n".join(lines)
+
+
+def _field_lines(field, picture):
+    """The centre and field lines of a :class:`startrack.camera.sky_field.SkyField` (a picture's note: its top as
+    shown, top row first, is the FITS axes' down)."""
+    ra_hms, dec_dms = field.sexagesimal
+    size = (f"{field.width_deg:.4f} x {field.height_deg:.4f} deg" if min(field.width_deg, field.height_deg) >= 1.0 else
+            f"{60 * field.width_deg:.3f} x {60 * field.height_deg:.3f} arcmin")
+    up = round(field.orientation_deg, 2) + 0.0  # + 0.0: no "-0.00"
+    top = (f"  (FITS axes: up is +y, rows increasing; as the picture is shown, top row first, its top is "
+           f"{round((field.orientation_deg + 360.0) % 360.0 - 180.0, 2) + 0.0:.2f} deg E of N)" if picture else "")
+    return [f"  centre  RA {field.ra_deg:.6f} deg  Dec {field.dec_deg:+.6f} deg  ({ra_hms}, {dec_dms})  sigma "
+            f"{field.sigma_east_arcsec:.2f}\" E, {field.sigma_north_arcsec:.2f}\" N",
+            f"  field   {size}  scale {field.scale_arcsec:.4f} arcsec/px  up is {up:.2f} deg E of N  "
+            f"parity {field.parity}{top}"]
 
 
 def run(args, frame_solver=frame_solver):
@@ -295,7 +329,7 @@ def run(args, frame_solver=frame_solver):
             write_outputs(args, frame, result, record["epoch"])
         if frame.detection is not None:
             record["detection"] = frame.detection
-        print(json.dumps(record) if args.json else _line(frame.frame_id, result), flush=True)
+        print(json.dumps(record) if args.json else _line(frame, result), flush=True)
     if args.write_camera is not None:
         if best is None:
             raise InputError(f"no frame was identified, so no camera was written to {args.write_camera}.")

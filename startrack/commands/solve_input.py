@@ -51,6 +51,13 @@ class SolveFrame:
     hdu: int | None = None
 
 
+def is_picture(frame_id):
+    """True for a frame read from a PNG, TIFF, JPEG or .npy file: an array shown top row first (row 0 at the top),
+    unlike a FITS image, whose viewers put row 1 at the bottom."""
+    suffix = Path(str(frame_id)).suffix.lower()
+    return suffix in IMAGE_SUFFIXES and not is_fits(str(frame_id))
+
+
 def _read_centroid_csv(path):
     """(uv (n, 2), flux (n,) or None) from a CSV of u,v[,flux] rows; a first non-numeric line is a header."""
     path = Path(path)
@@ -152,6 +159,7 @@ def image_frame(path, options, width=None, height=None, hdu=None):
     """The SolveFrame of an image file (a FITS file's HDU ``hdu``): read, size checked against the given one,
     detected."""
     from startrack.commands.detect import detect_frame
+    from startrack.image.clipped import is_clipped
     from startrack.image.files import read_frame
 
     frame = read_frame(path, hdu)
@@ -161,7 +169,8 @@ def image_frame(path, options, width=None, height=None, hdu=None):
         raise InputError(f"image {path} is {cols} x {rows} px, not the {wanted} px of --width/--height or the camera file.")
     found = detect_frame(frame, options)
     summary = {"detections": len(found), "background_dn": found.background, "sigma_n_dn": found.sigma_n,
-               "threshold_dn": found.threshold, "full_scale_dn": frame.full_scale}
+               "threshold_dn": found.threshold, "full_scale_dn": frame.full_scale,
+               "clipped": is_clipped(found, frame.full_scale)}
     sigma = np.hypot(found.sigma_u, found.sigma_v) / np.sqrt(2.0)
     sigma = np.where(found.saturated, 3.0 * sigma, sigma)  # a clipped peak biases the centroid
     return SolveFrame(str(path), found.uv, found.flux, sigma, cols, rows, detection=summary, image=frame.image,

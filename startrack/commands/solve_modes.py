@@ -113,13 +113,17 @@ class FrameSolver:
         return self._diagnosed(result, frame, known, sigma, boresight, epoch) if result.status == "no_match" else result
 
     # ------------------------------------------------------------------ internals
-    def plate(self, epoch):
-        """The plate solver of the star positions at ``epoch``."""
-        if epoch not in self._plates:
+    def plate(self, epoch, search=None):
+        """The plate solver of the star positions at ``epoch``, of the options' field-of-view range or of
+        ``search`` (a range [rad], or "default": the plate solver's whole default range)."""
+        options = self.plate_options if search is None else\
+            {**self.plate_options, "fov_range": None if search == "default" else search}
+        key = (epoch, options["fov_range"])
+        if key not in self._plates:
             from startrack.identify.plate_solver import PlateSolver
 
-            self._plates[epoch] = PlateSolver(**self.plate_options, epoch=epoch)
-        return self._plates[epoch]
+            self._plates[key] = PlateSolver(**options, epoch=epoch)
+        return self._plates[key]
 
     def _camera_file(self, width, height):
         if self.camera_file is not None:
@@ -139,19 +143,27 @@ class FrameSolver:
         return self._calibrated[key]
 
     def _diagnosed(self, result, frame, known, sigma, boresight, epoch):
-        """``result`` (no_match with the given camera) with what a solve as an unknown camera finds."""
-        unknown = self.plate(epoch).solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
-                                   fov_hint=known.camera.angular_width, boresight=boresight)
+        """``result`` (no_match with the given camera) with what a solve as an unknown camera over the plate
+        solver's whole default range (the given field searched first) finds, or that it finds nothing either."""
+        from startrack.identify.plate_solver import DEFAULT_FOV_RANGE
+
+        unknown = self.plate(epoch, "default").solve(frame.uv, frame.width, frame.height, frame.flux, sigma,
+                                                     fov_hint=known.camera.angular_width, boresight=boresight)
+        given = f"{result.reason.rstrip('.')} with the given camera (FOV {math.degrees(known.camera.angular_width):.4f} deg)."
         if not unknown.ok:
-            return result
-        reason = (f"{result.reason.rstrip('.')} with the given camera. Solved as an unknown camera, the frame shows "
-                  f"{_camera_change(known.camera, unknown.camera)}: the given camera does not fit it (--refit refines "
-                  f"it per frame, no geometry fits one from the stars).")
+            low, high = (math.degrees(x) for x in DEFAULT_FOV_RANGE)
+            reason = f"{given} Solved as an unknown camera ({low:g}-{high:g} deg) it is not identified either: {unknown.reason}"
+        else:
+            reason = (f"{given} Solved as an unknown camera, the frame shows {_camera_change(known.camera, unknown.camera)}"
+                      f": the given camera does not fit it (--refit refines it per frame if it is near; give the "
+                      f"shown camera, e.g. --fov-deg {math.degrees(unknown.camera.angular_width):.4f}, or no geometry "
+                      f"to fit one from the stars).")
         return dataclasses.replace(result, reason=reason)
 
 
 def _camera_change(given, fitted):
     """The fitted camera beside the given one, in words."""
-    return (f"focal {fitted.focal_px:.2f} px (given {given.focal_px:.2f}), FOV {math.degrees(fitted.angular_width):.4f} deg "
-            f"(given {math.degrees(given.angular_width):.4f}), centre ({fitted.cx:.1f}, {fitted.cy:.1f}) px (given "
+    return (f"FOV {math.degrees(fitted.angular_width):.4f} deg (given {math.degrees(given.angular_width):.4f}), scale "
+            f"{math.degrees(3600.0 / fitted.focal_px):.4f} arcsec/px (given {math.degrees(3600.0 / given.focal_px):.4f}), "
+            f"focal {fitted.focal_px:.2f} px (given {given.focal_px:.2f}), centre ({fitted.cx:.1f}, {fitted.cy:.1f}) px (given "
             f"({given.cx:.1f}, {given.cy:.1f})), k1 {fitted.k1:+.4f} (given {given.k1:+.4f})")

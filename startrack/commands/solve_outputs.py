@@ -1,9 +1,11 @@
-"""The files ``startrack solve`` writes per solved frame for the astronomers' tools (FITS, astropy.io.fits).
+"""The files ``startrack solve`` writes per solved frame for the astronomers' tools (FITS, astropy.io.fits) and eyes.
 
 * ``--wcs FILE``: the solution's WCS (:func:`startrack.camera.wcs.frame_wcs`: TAN with SIP of the order the camera
   model needs, ZPN for a fisheye) as the header of a FITS file without data, as astrometry.net's ``.wcs`` files;
 * ``--new-fits FILE``: the input image with that header -- a FITS input keeps its HDUs and header, its
   earlier celestial WCS replaced; another image is written as the frame read (grey levels);
+* ``--annotate FILE.png``: the image with its detections, the matched catalog stars and an RA/Dec grid
+  (:mod:`startrack.commands.solve_annotate`);
 * ``--corr FILE``: the matched stars as a FITS table: ``field_x``, ``field_y`` (FITS pixels, 1-based),
   ``field_ra``, ``field_dec`` (the WCS's direction of the star's centroid), ``index_ra``, ``index_dec``
   (the catalog's, at the epoch) [deg], ``index_id`` (HIP, else the Gaia DR3 source_id), ``field_id`` (the
@@ -26,15 +28,18 @@ from startrack.image.fits import FITS_SUFFIXES, WCS_KEYWORDS, fits_stem, is_fits
 
 #: The options, and the file suffixes each takes (astrometry.net's .wcs, .new and .corr are FITS files too).
 _OUTPUTS = {"wcs": ("--wcs", FITS_SUFFIXES + (".wcs",)), "new_fits": ("--new-fits", FITS_SUFFIXES + (".new",)),
-           "corr": ("--corr", FITS_SUFFIXES + (".corr",))}
+           "corr": ("--corr", FITS_SUFFIXES + (".corr",)), "annotate": ("--annotate", (".png",))}
 
 
 def add_output_options(parser):
-    """``--wcs``, ``--new-fits``, ``--corr`` (module text)."""
-    group = parser.add_argument_group("FITS outputs (per identified frame; {stem} names each of several frames)")
+    """``--wcs``, ``--new-fits``, ``--corr``, ``--annotate`` (module text)."""
+    group = parser.add_argument_group("outputs (per identified frame; {stem} names each of several frames)")
     group.add_argument("--wcs", metavar="FILE", help="write the solution's FITS WCS header (TAN-SIP) to FILE")
     group.add_argument("--new-fits", metavar="FILE", help="write the image with the solution's WCS header to FILE")
     group.add_argument("--corr", metavar="FILE", help="write the matched stars (pixel, catalog RA/Dec, HIP, V) to FILE")
+    group.add_argument("--annotate", metavar="FILE.png",
+                       help="draw the image with its detections, the matched catalog stars (HIP or Gaia DR3 id, "
+                            "constellation, V) and an RA/Dec grid to FILE.png")
 
 
 def check_output_options(args, frames):
@@ -54,12 +59,20 @@ def write_outputs(args, frame, result, epoch):
     """Write the files of the options for the identified ``frame`` (a SolveFrame) and its ``result``."""
     if not result.ok or not any(getattr(args, name) for name in _OUTPUTS):
         return
+    stem = _stem(frame.frame_id)
+    if args.annotate:
+        if frame.image is None:
+            raise InputError(f"--annotate needs an image; {frame.frame_id} is a list of centroids")
+        from startrack.commands.solve_annotate import write_annotation
+
+        write_annotation(args.annotate.replace("{stem}", stem), frame, result, epoch)
+    if not (args.wcs or args.new_fits or args.corr):
+        return
     from astropy.io import fits
 
     from startrack.camera.wcs import frame_wcs
 
     solution = frame_wcs(result.camera, result.q_IS)
-    stem = _stem(frame.frame_id)
     header = fits.Header(solution.cards())
     model = "ZPN, exact" if solution.projection == "ZPN" else\
         f"SIP order {solution.order} within {solution.max_error_px:.1e} px of the camera model"
@@ -101,17 +114,14 @@ def _corr(frame, result, header, epoch):
     from astropy.io import fits
     from astropy.wcs import WCS
 
-    from startrack.catalog.hipparcos import HIP_MAX
     from startrack.geometry.sphere import vector_to_radec
-    from startrack.identify.pattern_catalog import load_source
+    from startrack.identify.pattern_catalog import magnitudes_of
 
     index = result.matches[:, 0]
     pixels = frame.uv[index] + 1.0
     ra, dec = np.degrees(vector_to_radec(result.ref_I))
     field_ra, field_dec = WCS(header).all_pix2world(pixels[:, 0], pixels[:, 1], 1)
-    stars = load_source("gaia" if (result.matched_hip > HIP_MAX).any() else "hipparcos", epoch)
-    ids, order = stars.ids, np.argsort(stars.ids, kind="stable")
-    mag = stars.v_mag[order[np.searchsorted(ids[order], result.matched_hip)]]
+    mag = magnitudes_of(result.matched_hip, epoch)
     columns = [fits.Column("field_x", "D", array=pixels[:, 0]), fits.Column("field_y", "D", array=pixels[:, 1]),
                fits.Column("field_ra", "D", "deg", array=field_ra), fits.Column("field_dec", "D", "deg", array=field_dec),
                fits.Column("index_ra", "D", "deg", array=ra % 360.0), fits.Column("index_dec", "D", "deg", array=dec),

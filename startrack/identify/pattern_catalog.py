@@ -447,6 +447,17 @@ def load_source(source: str, epoch: float):
     return load_star_catalog(epoch)
 
 
+def magnitudes_of(ids, epoch: float) -> np.ndarray:
+    """V magnitudes of the stars ``ids`` (HIP numbers; with any Gaia DR3 source_id above
+    :data:`startrack.catalog.hipparcos.HIP_MAX`, all looked up in the Gaia stars) at ``epoch``."""
+    from startrack.catalog.hipparcos import HIP_MAX
+
+    ids = np.asarray(ids, np.int64)
+    stars = load_source("gaia" if (ids > HIP_MAX).any() else "hipparcos", epoch)
+    known, order = stars.ids, np.argsort(stars.ids, kind="stable")
+    return stars.v_mag[order[np.searchsorted(known[order], ids)]]
+
+
 def load_pattern_catalog(params: PatternCatalogParams | None = None, progress: bool = False) -> PatternCatalog:
     """The pattern catalog of ``params`` from the cache directory, built and written there when absent."""
     params = PatternCatalogParams() if params is None else params

@@ -14,6 +14,7 @@ import numpy as np
 
 from startrack.attitude.solvers import cramer_rao_covariance
 from startrack.base.units import ARCSEC
+from startrack.camera.sky_field import sky_field
 from startrack.geometry.attitude_angles import radec_roll_from_quaternion
 from startrack.geometry.rotation import to_matrix
 
@@ -119,6 +120,15 @@ class IdentificationResult:
             return self.calibration.covariance[:3, :3].copy()
         return cramer_rao_covariance(self.obs_S, self.sigma)
 
+    @functools.cached_property
+    def sky_field(self):
+        """The field as plate solvers report it (:class:`startrack.camera.sky_field.SkyField`: the image centre
+        with its sigma, size, scale, orientation, parity); None unless ok with a camera."""
+        if not self.ok or self.camera is None:
+            return None
+        return sky_field(self.camera, self.q_IS,
+                         self.covariance if self.calibration is None else self.calibration.covariance)
+
     @property
     def matched_hip(self) -> np.ndarray:
         """HIP numbers (or Gaia DR3 source_ids, :attr:`matches`) of the matched stars, in the order of :attr:`matches`."""
@@ -141,9 +151,15 @@ class IdentificationResult:
                 sigma_arcsec=sigma.tolist(),
                 false_match_probability=float(self.false_match_probability),
             )
+            out["stars_matched"] = len(self.matches)
             if self.camera is not None:
-                ra, dec, roll = (math.degrees(float(x)) for x in self.camera.center_radec_roll(self.q_IS))
-                out["center"] = {"ra_deg": ra, "dec_deg": dec, "roll_deg": roll}
+                roll = math.degrees(float(self.camera.center_radec_roll(self.q_IS)[2]))
+                field = self.sky_field
+                out["center"] = {"ra_deg": field.ra_deg, "dec_deg": field.dec_deg, "roll_deg": roll,
+                                 "ra_hms": field.sexagesimal[0],
+                                 "dec_dms": field.sexagesimal[1],
+                                 "sigma_arcsec": [field.sigma_east_arcsec, field.sigma_north_arcsec]}
+                out["field"] = field.to_dict()
                 out["camera"] = {"source": self.camera_source, **_camera_dict(self.camera),
                                  **({} if self.calibration is None else self.calibration.to_dict())}
             if self.method == "tracking":

@@ -1,4 +1,6 @@
 """Read and write star-sensor frames: PNG/TIFF/JPEG (pillow), FITS (:mod:`startrack.image.fits`) and NumPy .npy.
+Pictures are written as 16-bit PNG, or as 8-bit PNG or JPEG of levels stretched from the counts
+(:func:`stretch_to_8_bit`).
 
 Frames are 2-D arrays [DN].  Integer greyscale images come back as uint16 (8-bit files are widened),
 floating ones as float64.  Colour images (RGB, RGBA, palette, CMYK, YCbCr: colour JPEGs from ordinary
@@ -26,6 +28,9 @@ from startrack.image.fits import FITS_SUFFIXES, is_fits
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".npy") + FITS_SUFFIXES
 #: Greyscale pillow modes read as they are.
 _GREY_MODES = ("L", "I;16", "I;16B", "I;16L", "I", "F", "1")
+#: The picture files written (PNG, JPEG) and the JPEG quality (pillow's scale, 1-95).
+_PICTURES = (".png", ".jpg", ".jpeg")
+JPEG_QUALITY = 90
 #: ITU-R BT.601 luma weights of R, G, B.
 _LUMA_WEIGHTS = np.array([0.299, 0.587, 0.114])
 
@@ -128,9 +133,19 @@ def full_scale(image):
     return float((1 << bits) - step)
 
 
+def stretch_to_8_bit(image, black_dn, white_dn):
+    """8-bit levels (uint8) of a frame [DN], linear: round(255 (DN - black) / (white - black)), clipped to 0..255
+    (``black_dn`` < ``white_dn``)."""
+    if not (np.isfinite(black_dn) and np.isfinite(white_dn) and black_dn < white_dn):
+        raise InputError(f"the 8-bit stretch needs black < white, got black {black_dn!r} DN and white {white_dn!r} DN")
+    levels = 255.0 * (np.asarray(image, dtype=float) - black_dn) / (white_dn - black_dn)
+    return np.clip(np.rint(levels), 0, 255).astype(np.uint8)
+
+
 def write_image(path, image):
-    """Write a frame: 16-bit greyscale PNG (.png, values rounded and clipped to 0..65535), FITS or .npy (as
-    is)."""
+    """Write a frame: a greyscale PNG (.png: 8-bit for uint8 data, else 16-bit, values rounded and clipped to
+    0..65535), a greyscale JPEG (.jpg/.jpeg, quality :data:`JPEG_QUALITY`: uint8 data only, e.g. of
+    :func:`stretch_to_8_bit`), FITS or .npy (as is)."""
     path = Path(path)
     array = np.asarray(image)
     if array.ndim != 2 or array.size == 0:
@@ -144,11 +159,16 @@ def write_image(path, image):
         from startrack.image.fits import write_hdus
 
         write_hdus(path, fits.HDUList([fits.PrimaryHDU(array)]), "image file")
-    elif suffix == ".png":
+    elif suffix in _PICTURES:
         if not np.all(np.isfinite(array)):
             raise InputError(f"cannot write {path}: the frame contains NaN or infinite values")
-        data = np.clip(np.rint(array), 0, 65535).astype(np.uint16)
-        Image.fromarray(data).save(path)
+        if array.dtype == np.uint8:
+            Image.fromarray(array).save(path, **({"quality": JPEG_QUALITY} if suffix != ".png" else {}))
+        elif suffix != ".png":
+            raise InputError(f"cannot write {path}: a JPEG holds 8-bit levels, got {array.dtype} (stretch the frame first)")
+        else:
+            Image.fromarray(np.clip(np.rint(array), 0, 65535).astype(np.uint16)).save(path)
     else:
-        raise InputError(f"output file {path} must end in .png (16-bit), {', '.join(FITS_SUFFIXES)} or .npy")
+        raise InputError(f"output file {path} must end in .png (8- or 16-bit), .jpg/.jpeg (8-bit), "
+                         f"{', '.join(FITS_SUFFIXES)} or .npy")
     return path

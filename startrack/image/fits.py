@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import datetime
 import math
-import os
 import re
 import warnings
 from pathlib import Path
@@ -23,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from startrack.base.errors import InputError
+from startrack.base.output_paths import write_whole
 
 FITS_SUFFIXES = (".fits", ".fit", ".fts")
 #: File names read as FITS: those suffixes, gzipped, or tile-compressed (.fz, fpack).
@@ -130,15 +130,7 @@ def _epoch(path, header):
 
 
 def write_hdus(path, hdus, what):
-    """Write the astropy HDUList ``hdus`` to ``path`` whole or not at all (a temporary file beside it,
-    renamed over it); ``what`` names the option in the message of a file that cannot be written."""
-    path = Path(path)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.part")
-    try:
-        hdus.writeto(temporary, overwrite=True, output_verify="silentfix")
-        os.replace(temporary, path)
-    except OSError as error:
-        raise InputError(f"{what} {path} cannot be written ({error.strerror or error})") from None
-    finally:
-        if temporary.exists():
-            temporary.unlink()
+    """Write the astropy HDUList ``hdus`` to ``path`` whole or not at all
+    (:func:`startrack.base.output_paths.write_whole`); ``what`` names the option in the message of a file that
+    cannot be written."""
+    write_whole(path, lambda temporary: hdus.writeto(temporary, overwrite=True, output_verify="silentfix"), what)

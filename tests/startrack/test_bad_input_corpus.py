@@ -21,6 +21,8 @@ COMMANDS = {
     "render": (["render", "--ra-deg", "10", "--dec-deg", "20", "--width", "64", "--height", "64", "-o", "{tmp}/r.png"],
                ["--ra-deg", "--dec-deg", "--roll-deg", "--fov-deg", "--width", "--height", "--mag-limit",
                 "--exposure-ms", "--rate-deg-s", "--epoch", "--seed"]),
+    "render 8-bit": (["render", "--ra-deg", "10", "--dec-deg", "20", "--width", "64", "--height", "64", "-o",
+                      "{tmp}/r.png", "--bits", "8"], ["--black-dn", "--white-dn"]),
     "detect": (["detect", "{tmp}/frame.png"], ["--a", "--background-dn", "--sigma-n-dn", "--mesh-px", "--min-pixels",
                                                "--saturation-dn", "--psf-sigma-px", "--gain-e-per-dn"]),
     "detect --smear-px": (["detect", "{tmp}/frame.png", "--psf-sigma-px", "0.8", "--smear-px", "3,0"],

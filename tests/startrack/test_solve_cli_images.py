@@ -51,7 +51,7 @@ def test_batch_list_of_images_and_several_inputs(tmp_path, capsys):
     listing = tmp_path / "frames.txt"
     listing.write_text("# two frames\n" + "\n".join(str(f) for f in FRAMES[:2]) + "\n")
     status, out, _ = _run(capsys, ["solve", "--batch", str(listing)])
-    assert status == 0 and out.count(": ok  RA") == 2 and out.count("camera (fitted): FOV") == 2
+    assert status == 0 and out.count(": ok  ") == 2 and out.count("  centre  RA ") == 2 and out.count("camera (fitted): FOV") == 2
     status, out, _ = _run(capsys, ["solve", str(FRAMES[0]), str(tmp_path / "missing.tiff"), "--json"])
     records = [json.loads(line) for line in out.splitlines()]
     assert status == 1 and [r["status"] for r in records] == ["ok", "error"]
